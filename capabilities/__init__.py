@@ -1,0 +1,1 @@
+"""Capabilities: groups of robot operations, their registry, and the cells they run on."""

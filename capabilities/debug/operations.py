@@ -1,0 +1,233 @@
+"""Operations of the debug capability: succeed, fail, run for N ticks, set, check, log.
+
+They need no cell, so a plan built from them runs anywhere: the paper's Figure 3 can be
+tried without a robot, and every node kind has an example plan.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from capabilities.base import Capability, CapabilityEnv
+from engine.operations import (
+    Direction,
+    Job,
+    OperationCall,
+    OperationFailed,
+    OperationKind,
+    OperationManifest,
+    PortSpec,
+    StartResult,
+)
+from engine.status import FAILURE, RUNNING, SUCCESS, Status
+from engine.types import ParamType
+
+__all__ = ["build_debug_capability"]
+
+CAP = "debug"
+ANY = (ParamType.ANY,)
+ALL_TYPES = (*(t for t in ParamType if t is not ParamType.ANY), ParamType.ANY)
+
+
+def _manifest(op: str, kind: OperationKind, doc: str, *ports: PortSpec) -> OperationManifest:
+    return OperationManifest(f"{CAP}.{op}", kind, doc, CAP, tuple(ports))
+
+
+class _Succeed:
+    def start(self, call: OperationCall) -> StartResult:
+        return True
+
+
+class _Fail:
+    def start(self, call: OperationCall) -> StartResult:
+        raise OperationFailed(str(call.args.get("message") or "failed on purpose"))
+
+
+class _TickJob(Job):
+    """RUNNING for a number of polls, then the given status."""
+
+    def __init__(self, ticks: int, then: Status, message: str) -> None:
+        super().__init__()
+        self._left = ticks
+        self._then = then
+        self._final_message = message
+
+    def poll(self) -> Status:
+        if self._left > 0:
+            self._left -= 1
+            return RUNNING
+        if self._then is FAILURE:
+            self.message = self._final_message or "failed on purpose"
+        return self._then
+
+
+def _then_status(value: Any) -> Status:
+    text = str(value).upper()
+    if text not in ("SUCCESS", "FAILURE"):
+        raise OperationFailed(f"'then' must be SUCCESS or FAILURE, not {value!r}")
+    return SUCCESS if text == "SUCCESS" else FAILURE
+
+
+class _Running:
+    def start(self, call: OperationCall) -> StartResult:
+        ticks = int(call.args["ticks"])
+        if ticks < 0:
+            raise OperationFailed(f"ticks must be 0 or more, not {ticks}")
+        return _TickJob(ticks, _then_status(call.args["then"]), str(call.args.get("message", "")))
+
+
+class _PretendMove:
+    def start(self, call: OperationCall) -> StartResult:
+        call.log(f"moving to {call.args['target']}")
+        return _TickJob(int(call.args["ticks"]), SUCCESS, "")
+
+
+class _SetParam:
+    def start(self, call: OperationCall) -> StartResult:
+        call.write("name", call.args["value"])
+        return True
+
+
+class _Query:
+    def start(self, call: OperationCall) -> StartResult:
+        call.write("result", call.args["value"])
+        return True
+
+
+class _CheckParam:
+    def start(self, call: OperationCall) -> StartResult:
+        return bool(call.args["value"] == call.args["expected"])
+
+
+class _Condition:
+    def start(self, call: OperationCall) -> StartResult:
+        return bool(call.args["result"])
+
+
+class _SucceedAfter:
+    """False the first N times it is evaluated, true afterwards (state kept per leaf)."""
+
+    def __init__(self) -> None:
+        self.evaluations = 0
+
+    def start(self, call: OperationCall) -> StartResult:
+        self.evaluations += 1
+        return self.evaluations > int(call.args["failures"])
+
+
+class _Log:
+    def start(self, call: OperationCall) -> StartResult:
+        call.log(str(call.args["message"]))
+        return True
+
+
+def _maker(cls: type) -> Any:
+    def make(env: CapabilityEnv) -> Any:
+        return cls()
+
+    return make
+
+
+def build_debug_capability() -> Capability:
+    """The debug capability with all its operations."""
+    cap = Capability(CAP, "Operations for trying plans without a robot.")
+    ticks = PortSpec("ticks", (ParamType.NUMBER,), default=3, doc="ticks spent RUNNING")
+    entries: list[tuple[OperationManifest, type]] = [
+        (_manifest("succeed", OperationKind.ACTION, "Succeeds at once."), _Succeed),
+        (
+            _manifest(
+                "fail",
+                OperationKind.ACTION,
+                "Fails at once with a message.",
+                PortSpec("message", (ParamType.TEXT,), default="failed on purpose", doc="why"),
+            ),
+            _Fail,
+        ),
+        (
+            _manifest(
+                "running",
+                OperationKind.ACTION,
+                "Runs for a number of ticks, then succeeds or fails.",
+                ticks,
+                PortSpec(
+                    "then",
+                    (ParamType.TEXT,),
+                    default="SUCCESS",
+                    doc="status at the end",
+                    choices=("SUCCESS", "FAILURE"),
+                ),
+                PortSpec("message", (ParamType.TEXT,), default="", doc="failure message"),
+            ),
+            _Running,
+        ),
+        (
+            _manifest(
+                "pretend_move",
+                OperationKind.ACTION,
+                "Pretends to move to a pose for some ticks.",
+                PortSpec("target", (ParamType.POSE, ParamType.WAYPOINT), doc="where to go"),
+                ticks,
+            ),
+            _PretendMove,
+        ),
+        (
+            _manifest(
+                "set_param",
+                OperationKind.ACTION,
+                "Writes a value to a named parameter.",
+                PortSpec("value", ALL_TYPES, doc="the value"),
+                PortSpec("name", ANY, Direction.OUT, doc="the parameter written"),
+            ),
+            _SetParam,
+        ),
+        (
+            _manifest(
+                "query",
+                OperationKind.QUERY,
+                "Answers with a given value (a stand-in query).",
+                PortSpec("value", ALL_TYPES, doc="the answer"),
+                PortSpec("result", ANY, Direction.OUT, doc="where the answer goes"),
+            ),
+            _Query,
+        ),
+        (
+            _manifest(
+                "check_param",
+                OperationKind.CONDITION,
+                "True when a parameter equals a value.",
+                PortSpec("value", ALL_TYPES, doc="the parameter (a reference)"),
+                PortSpec("expected", ALL_TYPES, doc="the value it should have"),
+            ),
+            _CheckParam,
+        ),
+        (
+            _manifest(
+                "condition",
+                OperationKind.CONDITION,
+                "True or false, as set.",
+                PortSpec("result", (ParamType.BOOL,), default=True, doc="the answer"),
+            ),
+            _Condition,
+        ),
+        (
+            _manifest(
+                "succeed_after",
+                OperationKind.CONDITION,
+                "False the first N times it is checked, then true (e.g. an object that appears).",
+                PortSpec("failures", (ParamType.NUMBER,), default=2, doc="how many false answers"),
+            ),
+            _SucceedAfter,
+        ),
+        (
+            _manifest(
+                "log",
+                OperationKind.ACTION,
+                "Writes a message to the run's log.",
+                PortSpec("message", (ParamType.TEXT,), doc="the message"),
+            ),
+            _Log,
+        ),
+    ]
+    for manifest, cls in entries:
+        cap.add(manifest, _maker(cls))
+    return cap

@@ -1,0 +1,1 @@
+"""The behavior-tree engine of CoSTAR Instructor: pure Python, no Qt, no robot libraries."""

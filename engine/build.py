@@ -1,0 +1,162 @@
+"""Spec + operation registry -> runnable tree.
+
+The builder assumes a valid plan (see :mod:`engine.validation`) but never trusts it: what it
+cannot build raises :class:`BuildError` naming the node's path.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from engine.blackboard import Blackboard
+from engine.composites import (
+    Parallel,
+    ParallelPolicy,
+    ReactiveSelector,
+    ReactiveSequence,
+    Selector,
+    Sequence,
+)
+from engine.context import TreeContext
+from engine.decorators import (
+    Enforce,
+    ForceFailure,
+    ForceSuccess,
+    Inverter,
+    Iterator,
+    Repeat,
+    Retry,
+    Timeout,
+)
+from engine.kinds import KIND_CONFIG
+from engine.leaves import OperationLeaf, Wait
+from engine.node import Node
+from engine.operations import Direction, OperationNotFound, OperationSource
+from engine.spec import NodeKind, NodeSpec, PlanSpec
+from engine.tree import BehaviorTree, Root
+
+__all__ = ["BuildError", "build_tree", "ROOT_ID"]
+
+ROOT_ID = "root"
+
+_SIMPLE: dict[NodeKind, type[Node]] = {
+    NodeKind.SEQUENCE: Sequence,
+    NodeKind.SELECTOR: Selector,
+    NodeKind.REACTIVE_SEQUENCE: ReactiveSequence,
+    NodeKind.REACTIVE_SELECTOR: ReactiveSelector,
+    NodeKind.INVERTER: Inverter,
+    NodeKind.FORCE_SUCCESS: ForceSuccess,
+    NodeKind.FORCE_FAILURE: ForceFailure,
+}
+
+
+class BuildError(Exception):
+    """A spec node could not be turned into a runtime node."""
+
+    def __init__(self, path: str, message: str) -> None:
+        self.path = path
+        super().__init__(f"{path}: {message}")
+
+
+def _settings(spec: NodeSpec) -> dict[str, Any]:
+    values = {f.name: f.default for f in KIND_CONFIG.get(spec.kind, ())}
+    values.update({k: v for k, v in spec.config.items() if v is not None})
+    return values
+
+
+def _logic_node(spec: NodeSpec, ctx: TreeContext) -> Node:
+    simple = _SIMPLE.get(spec.kind)
+    if simple is not None:
+        return simple(ctx, spec.id, spec.label)
+    cfg = _settings(spec)
+    label = spec.label
+    factories: dict[NodeKind, Callable[[], Node]] = {
+        NodeKind.PARALLEL: lambda: Parallel(
+            ctx, spec.id, label, ParallelPolicy(cfg["success"], cfg["failure"])
+        ),
+        NodeKind.ITERATOR: lambda: Iterator(ctx, spec.id, label, cfg["count"], cfg["timeout"]),
+        NodeKind.ENFORCE: lambda: Enforce(ctx, spec.id, label, cfg["count"], cfg["timeout"]),
+        NodeKind.REPEAT: lambda: Repeat(ctx, spec.id, label, cfg["count"]),
+        NodeKind.RETRY: lambda: Retry(ctx, spec.id, label, cfg["count"]),
+        NodeKind.TIMEOUT: lambda: Timeout(ctx, spec.id, label, float(cfg["seconds"])),
+        NodeKind.WAIT: lambda: Wait(ctx, spec.id, label, float(cfg["seconds"])),
+    }
+    return factories[spec.kind]()
+
+
+def _operation_leaf(spec: NodeSpec, ctx: TreeContext, source: OperationSource, path: str) -> Node:
+    if not spec.op:
+        raise BuildError(path, "an operation node needs an operation id")
+    try:
+        manifest = source.manifest(spec.op)
+        operation = source.create(spec.op)
+    except OperationNotFound as exc:
+        raise BuildError(path, f"unknown operation {spec.op!r}") from exc
+    fixed: dict[str, Any] = {}
+    refs: dict[str, str] = {}
+    outputs: dict[str, str] = {}
+    for port in manifest.ports:
+        binding = spec.params.get(port.name)
+        if port.direction is Direction.OUT:
+            if binding is not None and binding.ref:
+                outputs[port.name] = binding.ref
+            continue
+        if binding is None:
+            if port.default is None:
+                raise BuildError(path, f"parameter {port.name!r} is not set")
+            fixed[port.name] = port.default
+        elif binding.ref is not None:
+            refs[port.name] = binding.ref
+        else:
+            fixed[port.name] = binding.value
+    return OperationLeaf(ctx, spec.id, spec.label, manifest.kind, operation, fixed, refs, outputs)
+
+
+def _build_node(spec: NodeSpec, ctx: TreeContext, source: OperationSource, path: str) -> Node:
+    try:
+        if spec.kind is NodeKind.OPERATION:
+            node = _operation_leaf(spec, ctx, source, path)
+        else:
+            node = _logic_node(spec, ctx)
+        children = [
+            _build_node(child, ctx, source, f"{path}/{child.label}[{index}]")
+            for index, child in enumerate(spec.children)
+        ]
+        if children or not isinstance(node, (OperationLeaf, Wait)):
+            node.set_children(children)
+    except BuildError:
+        raise
+    except (ValueError, KeyError, TypeError) as exc:
+        raise BuildError(path, str(exc)) from exc
+    return node
+
+
+def build_tree(
+    plan: PlanSpec,
+    source: OperationSource,
+    *,
+    clock: Callable[[], float] | None = None,
+    blackboard: Blackboard | None = None,
+) -> BehaviorTree:
+    """Build the runnable tree of a plan.
+
+    Args:
+        plan: the plan; validate it first (``engine.validation.validate_plan``).
+        source: where operations come from (a capability registry).
+        clock: the tree's clock (default: monotonic seconds); the simulated cell passes
+            its simulated time.
+        blackboard: start values; by default a fresh one with the plan's parameters.
+    """
+    if plan.tree is None:
+        raise BuildError(plan.name or "plan", "the plan has no tree")
+    board = blackboard if blackboard is not None else Blackboard()
+    for decl in plan.parameters:
+        board.declare(decl.name, decl.type)
+        if decl.value is not None:
+            board.set(decl.name, decl.value, "plan")
+    ctx = TreeContext(board, clock) if clock is not None else TreeContext(board)
+    top = _build_node(plan.tree, ctx, source, plan.tree.label)
+    root = Root(ctx, ROOT_ID, plan.name or "root", plan.run_policy)
+    root.set_children([top])
+    return BehaviorTree(root, ctx)

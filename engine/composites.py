@@ -1,0 +1,210 @@
+"""Logic nodes with several children: Sequence, Selector, Parallel and reactive variants.
+
+Sequence and Selector keep their place (memory semantics, as BehaviorTree.CPP's Sequence and
+py_trees' ``memory=True``): a RUNNING child is resumed, finished children are not ticked
+again until the node is reset. The reactive variants re-check their condition children every
+tick and halt a running sibling when the answer changes.
+"""
+
+from __future__ import annotations
+
+from engine.context import TreeContext
+from engine.node import Node
+from engine.status import FAILURE, RUNNING, SUCCESS, Status
+
+__all__ = [
+    "Sequence",
+    "Selector",
+    "Parallel",
+    "ParallelPolicy",
+    "ReactiveSequence",
+    "ReactiveSelector",
+]
+
+
+class Sequence(Node):
+    """Children in order, the next only after SUCCESS; FAILURE at the first failure."""
+
+    kind = "sequence"
+
+    def __init__(self, ctx: TreeContext, node_id: str, name: str = "") -> None:
+        super().__init__(ctx, node_id, name)
+        self._index = 0
+
+    def update(self) -> Status:
+        children = self.children
+        index = self._index
+        count = len(children)
+        while index < count:
+            child = children[index]
+            status = child.tick()
+            if status is SUCCESS:
+                index += 1
+                continue
+            self._index = index
+            if status is FAILURE:
+                self.message = f"{child.name} failed"
+            return status
+        self._index = index
+        return SUCCESS
+
+    def on_reset(self) -> None:
+        self._index = 0
+
+
+class Selector(Node):
+    """Children in order until one succeeds; FAILURE when all failed (a fallback)."""
+
+    kind = "selector"
+
+    def __init__(self, ctx: TreeContext, node_id: str, name: str = "") -> None:
+        super().__init__(ctx, node_id, name)
+        self._index = 0
+
+    def update(self) -> Status:
+        children = self.children
+        index = self._index
+        count = len(children)
+        while index < count:
+            status = children[index].tick()
+            if status is FAILURE:
+                index += 1
+                continue
+            self._index = index
+            return status
+        self._index = index
+        self.message = "every option failed"
+        return FAILURE
+
+    def on_reset(self) -> None:
+        self._index = 0
+
+
+class ParallelPolicy:
+    """When a Parallel finishes: ``success`` is "all", "any" or a count M; ``failure`` is
+    "any" (= 1) or a count N."""
+
+    __slots__ = ("failure", "success")
+
+    def __init__(self, success: str | int = "all", failure: str | int = "any") -> None:
+        if not (success in ("all", "any") or (isinstance(success, int) and success >= 1)):
+            raise ValueError(
+                f"success policy must be 'all', 'any' or a count >= 1, not {success!r}"
+            )
+        if not (failure == "any" or (isinstance(failure, int) and failure >= 1)):
+            raise ValueError(f"failure policy must be 'any' or a count >= 1, not {failure!r}")
+        self.success = success
+        self.failure = failure
+
+    def thresholds(self, n_children: int) -> tuple[int, int]:
+        """(successes needed, failures that end it) for ``n_children`` children."""
+        if self.success == "all":
+            need = n_children
+        elif self.success == "any":
+            need = 1
+        else:
+            need = int(self.success)
+        fail = 1 if self.failure == "any" else int(self.failure)
+        return max(need, 0), fail
+
+
+class Parallel(Node):
+    """Ticks every unfinished child each tick; finishes by its policy and then halts the
+    children still running."""
+
+    kind = "parallel"
+
+    def __init__(
+        self,
+        ctx: TreeContext,
+        node_id: str,
+        name: str = "",
+        policy: ParallelPolicy | None = None,
+    ) -> None:
+        super().__init__(ctx, node_id, name)
+        self.policy = policy or ParallelPolicy()
+        self._need = 0
+        self._fail = 1
+
+    def set_children(self, children: list[Node] | tuple[Node, ...]) -> None:
+        super().set_children(children)
+        self._need, self._fail = self.policy.thresholds(len(self.children))
+
+    def update(self) -> Status:
+        succeeded = failed = 0
+        for child in self.children:
+            status = child.status
+            if status is not SUCCESS and status is not FAILURE:
+                status = child.tick()
+            if status is SUCCESS:
+                succeeded += 1
+            elif status is FAILURE:
+                failed += 1
+        if failed >= self._fail:
+            self._halt_running()
+            self.message = f"{failed} of {len(self.children)} failed"
+            return FAILURE
+        if succeeded >= self._need:
+            self._halt_running()
+            return SUCCESS
+        if len(self.children) - failed < self._need:
+            self._halt_running()
+            self.message = "too many children failed to reach the success policy"
+            return FAILURE
+        return RUNNING
+
+    def _halt_running(self) -> None:
+        for child in self.children:
+            if child.status is RUNNING:
+                child.reset()
+
+
+def _halt_after(children: tuple[Node, ...], index: int) -> None:
+    for child in children[index + 1 :]:
+        if child.status is RUNNING:
+            child.reset()
+
+
+class ReactiveSequence(Node):
+    """A Sequence whose condition children are re-checked every tick.
+
+    When a condition that held turns false, the running sibling is halted and the node
+    fails: the way a plan stops when a person enters a region. Finished actions are not
+    started again (they stay latched until the node is reset).
+    """
+
+    kind = "reactive_sequence"
+
+    def update(self) -> Status:
+        children = self.children
+        for index, child in enumerate(children):
+            if child.is_condition and child.status is not RUNNING:
+                child.reset()
+            status = child.tick()
+            if status is SUCCESS:
+                continue
+            _halt_after(children, index)
+            if status is FAILURE:
+                self.message = f"{child.name} failed"
+            return status
+        return SUCCESS
+
+
+class ReactiveSelector(Node):
+    """A Selector whose condition children are re-checked every tick; when a higher
+    priority condition succeeds, the running lower-priority sibling is halted."""
+
+    kind = "reactive_selector"
+
+    def update(self) -> Status:
+        children = self.children
+        for index, child in enumerate(children):
+            if child.is_condition and child.status is not RUNNING:
+                child.reset()
+            status = child.tick()
+            if status is FAILURE:
+                continue
+            _halt_after(children, index)
+            return status
+        self.message = "every option failed"
+        return FAILURE

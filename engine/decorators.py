@@ -1,0 +1,213 @@
+"""Nodes with one child that change its result or repeat it.
+
+Iterator and Enforce are the paper's (section III-B): Iterator resets its child on SUCCESS
+(repeat while it succeeds), Enforce resets it on FAILURE (retry until it succeeds); both take
+an optional count and timeout. Repeat(n) and Retry(n) are their counted forms under the
+names BehaviorTree.CPP and py_trees users know. A repeated child runs at most once per tick,
+so a child that succeeds at once cannot spin the engine.
+"""
+
+from __future__ import annotations
+
+from engine.context import TreeContext
+from engine.node import Node
+from engine.status import FAILURE, RUNNING, SUCCESS, Status
+
+__all__ = [
+    "Decorator",
+    "Inverter",
+    "ForceSuccess",
+    "ForceFailure",
+    "Iterator",
+    "Enforce",
+    "Repeat",
+    "Retry",
+    "Timeout",
+]
+
+
+class Decorator(Node):
+    """A node with exactly one child."""
+
+    kind = "decorator"
+
+    @property
+    def child(self) -> Node:
+        return self.children[0]
+
+    def set_children(self, children: list[Node] | tuple[Node, ...]) -> None:
+        if len(children) != 1:
+            raise ValueError(
+                f"{self.kind} {self.name!r} needs exactly one child, got {len(children)}"
+            )
+        super().set_children(children)
+        # A decorator that only maps a predicate's answer is itself a predicate.
+        self.is_condition = self._passes_condition and self.children[0].is_condition
+
+    _passes_condition = False
+
+
+class Inverter(Decorator):
+    """SUCCESS <-> FAILURE; RUNNING passes through."""
+
+    kind = "inverter"
+    _passes_condition = True
+
+    def update(self) -> Status:
+        status = self.children[0].tick()
+        if status is SUCCESS:
+            return FAILURE
+        if status is FAILURE:
+            return SUCCESS
+        return status
+
+
+class ForceSuccess(Decorator):
+    """SUCCESS once the child finished, whatever its result."""
+
+    kind = "force_success"
+    _passes_condition = True
+
+    def update(self) -> Status:
+        status = self.children[0].tick()
+        return RUNNING if status is RUNNING else SUCCESS
+
+
+class ForceFailure(Decorator):
+    """FAILURE once the child finished, whatever its result."""
+
+    kind = "force_failure"
+    _passes_condition = True
+
+    def update(self) -> Status:
+        status = self.children[0].tick()
+        if status is RUNNING:
+            return RUNNING
+        self.message = "forced failure"
+        return FAILURE
+
+
+class _Looping(Decorator):
+    """Shared loop of Iterator and Enforce: reset the child on ``repeat_on``."""
+
+    repeat_on = SUCCESS
+    on_count: Status = SUCCESS
+    on_timeout: Status = SUCCESS
+
+    def __init__(
+        self,
+        ctx: TreeContext,
+        node_id: str,
+        name: str = "",
+        count: int | None = None,
+        timeout: float | None = None,
+    ) -> None:
+        super().__init__(ctx, node_id, name)
+        if count is not None and count < 1:
+            raise ValueError(f"{self.kind} count must be at least 1, not {count}")
+        if timeout is not None and timeout <= 0:
+            raise ValueError(f"{self.kind} timeout must be above 0 s, not {timeout}")
+        self.count = count
+        self.timeout = timeout
+        self.done = 0
+        self._started: float | None = None
+
+    def update(self) -> Status:
+        if self._started is None:
+            self._started = self.ctx.clock()
+        child = self.children[0]
+        status = child.tick()
+        if status is not RUNNING and status is not self.repeat_on:
+            return status
+        if status is self.repeat_on:
+            self.done += 1
+            if self.count is not None and self.done >= self.count:
+                return self._finish_count()
+            child.reset()
+        if self.timeout is not None and self.ctx.clock() - self._started >= self.timeout:
+            child.reset()
+            self.message = f"time limit of {self.timeout:g} s reached after {self.done} rounds"
+            return self.on_timeout
+        return RUNNING
+
+    def _finish_count(self) -> Status:
+        if self.on_count is FAILURE:
+            self.message = f"failed {self.done} times"
+        return self.on_count
+
+    def on_reset(self) -> None:
+        self.done = 0
+        self._started = None
+
+
+class Iterator(_Looping):
+    """Repeat the child while it succeeds: reset on SUCCESS, FAILURE ends it.
+
+    With a count, SUCCESS after that many successes; with a timeout, SUCCESS when the time
+    is up (the child kept succeeding for the whole time).
+    """
+
+    kind = "iterator"
+    repeat_on = SUCCESS
+    on_count = SUCCESS
+    on_timeout = SUCCESS
+
+
+class Enforce(_Looping):
+    """Retry the child until it succeeds: reset on FAILURE, SUCCESS ends it.
+
+    With a count, FAILURE after that many failures; with a timeout, FAILURE when the time
+    is up.
+    """
+
+    kind = "enforce"
+    repeat_on = FAILURE
+    on_count = FAILURE
+    on_timeout = FAILURE
+
+
+class Repeat(Iterator):
+    """Run the child ``count`` times while it succeeds (BehaviorTree.CPP's Repeat)."""
+
+    kind = "repeat"
+
+    def __init__(self, ctx: TreeContext, node_id: str, name: str = "", count: int = 1) -> None:
+        super().__init__(ctx, node_id, name, count=count)
+
+
+class Retry(Enforce):
+    """Try the child up to ``count`` times until it succeeds (RetryUntilSuccessful)."""
+
+    kind = "retry"
+
+    def __init__(self, ctx: TreeContext, node_id: str, name: str = "", count: int = 1) -> None:
+        super().__init__(ctx, node_id, name, count=count)
+
+
+class Timeout(Decorator):
+    """FAILURE, halting the child, when it runs longer than ``seconds``."""
+
+    kind = "timeout"
+
+    def __init__(
+        self, ctx: TreeContext, node_id: str, name: str = "", seconds: float = 1.0
+    ) -> None:
+        super().__init__(ctx, node_id, name)
+        if seconds <= 0:
+            raise ValueError(f"timeout must be above 0 s, not {seconds}")
+        self.seconds = seconds
+        self._started: float | None = None
+
+    def update(self) -> Status:
+        if self._started is None:
+            self._started = self.ctx.clock()
+        child = self.children[0]
+        status = child.tick()
+        if status is RUNNING and self.ctx.clock() - self._started >= self.seconds:
+            child.reset()
+            self.message = f"timed out after {self.seconds:g} s"
+            return FAILURE
+        return status
+
+    def on_reset(self) -> None:
+        self._started = None

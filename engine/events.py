@@ -1,0 +1,67 @@
+"""What a run reports to those who watch it, without Qt: plain, immutable events."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from engine.status import Status
+
+__all__ = [
+    "Event",
+    "RunStarted",
+    "StatusChanged",
+    "BlackboardWritten",
+    "LogMessage",
+    "RunFinished",
+    "Listener",
+]
+
+
+@dataclass(frozen=True, slots=True)
+class RunStarted:
+    time: float
+    plan: str
+
+
+@dataclass(frozen=True, slots=True)
+class StatusChanged:
+    tick: int
+    node_id: str
+    old: Status
+    new: Status
+    message: str
+    time: float
+
+
+@dataclass(frozen=True, slots=True)
+class BlackboardWritten:
+    tick: int
+    key: str
+    value: Any
+    node_id: str
+    time: float
+
+
+@dataclass(frozen=True, slots=True)
+class LogMessage:
+    tick: int
+    node_id: str
+    message: str
+    time: float
+
+
+@dataclass(frozen=True, slots=True)
+class RunFinished:
+    """The run ended: ``reason`` is "finished", "stopped", "timeout" or "error"."""
+
+    tick: int
+    status: Status
+    reason: str
+    message: str
+    time: float
+
+
+Event = RunStarted | StatusChanged | BlackboardWritten | LogMessage | RunFinished
+Listener = Callable[[Event], None]

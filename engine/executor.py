@@ -1,0 +1,280 @@
+"""Runs a tree in its own thread at a rate, and tells listeners what happens.
+
+The engine thread ticks; when an asynchronous job finishes it wakes the engine, which ticks
+again at once instead of waiting for the next period. Events are queued by the engine
+thread and delivered to listeners by a separate dispatcher thread, so a slow listener
+(a GUI, a file) never holds up a tick.
+"""
+
+from __future__ import annotations
+
+import collections
+import enum
+import threading
+import time
+
+from engine.events import (
+    BlackboardWritten,
+    Event,
+    Listener,
+    LogMessage,
+    RunFinished,
+    RunStarted,
+    StatusChanged,
+)
+from engine.node import Node
+from engine.status import RUNNING, Status
+from engine.tree import BehaviorTree
+
+__all__ = ["Executor", "ExecutorState", "run_to_end"]
+
+
+class ExecutorState(str, enum.Enum):
+    READY = "ready"
+    RUNNING = "running"
+    PAUSED = "paused"
+    FINISHED = "finished"
+
+
+class _Dispatcher:
+    """Delivers queued events to listeners on its own thread."""
+
+    def __init__(self, listeners: list[Listener]) -> None:
+        self._listeners = listeners
+        self._queue: collections.deque[Event] = collections.deque()
+        self._ready = threading.Condition()
+        self._closed = False
+        self.errors: list[str] = []
+        self._thread = threading.Thread(target=self._loop, name="costar-events", daemon=True)
+
+    def start(self) -> None:
+        self._thread.start()
+
+    def put(self, event: Event) -> None:
+        self._queue.append(event)  # deque.append is atomic: no lock on the engine's path
+        if len(self._queue) == 1:
+            with self._ready:
+                self._ready.notify()
+
+    def close(self) -> None:
+        with self._ready:
+            self._closed = True
+            self._ready.notify()
+
+    def join(self, timeout: float | None = None) -> None:
+        if self._thread.is_alive():
+            self._thread.join(timeout)
+
+    def _loop(self) -> None:
+        while True:
+            with self._ready:
+                while not self._queue and not self._closed:
+                    self._ready.wait(0.1)
+                if not self._queue and self._closed:
+                    return
+            while self._queue:
+                event = self._queue.popleft()
+                for listener in self._listeners:
+                    try:
+                        listener(event)
+                    except Exception as exc:  # a listener's bug must not stop the others
+                        self.errors.append(f"{type(exc).__name__}: {exc}")
+
+
+class Executor:
+    """Ticks a tree in a thread: start, pause, resume, step, stop.
+
+    Args:
+        tree: the tree to run.
+        rate_hz: ticks per second when nothing wakes it earlier (the paper's delta).
+        listeners: callables that receive every :mod:`engine.events` event.
+        plan_name: for the RunStarted event.
+    """
+
+    def __init__(
+        self,
+        tree: BehaviorTree,
+        rate_hz: float = 20.0,
+        listeners: list[Listener] | None = None,
+        plan_name: str = "",
+    ) -> None:
+        if rate_hz <= 0:
+            raise ValueError(f"rate must be above 0 Hz, not {rate_hz}")
+        self.tree = tree
+        self.period = 1.0 / rate_hz
+        self.plan_name = plan_name
+        self._listeners: list[Listener] = list(listeners or [])
+        self._cond = threading.Condition()
+        self._woken = False
+        self._paused = False
+        self._steps = 0
+        self._stop_reason: str | None = None
+        self._state = ExecutorState.READY
+        self._result: RunFinished | None = None
+        self._done = threading.Event()
+        self._dispatcher = _Dispatcher(self._listeners)
+        self._thread = threading.Thread(target=self._run, name="costar-engine", daemon=True)
+
+    # ------------------------------------------------------------------ control (any thread)
+
+    def add_listener(self, listener: Listener) -> None:
+        """Add before start()."""
+        self._listeners.append(listener)
+
+    @property
+    def state(self) -> ExecutorState:
+        return self._state
+
+    @property
+    def result(self) -> RunFinished | None:
+        """The RunFinished event once the run ended."""
+        return self._result
+
+    def start(self, paused: bool = False) -> None:
+        """Start the engine thread (paused: wait for step() or resume())."""
+        if self._state is not ExecutorState.READY:
+            raise RuntimeError("an executor runs once; build a new one to run again")
+        self._paused = paused
+        self._state = ExecutorState.PAUSED if paused else ExecutorState.RUNNING
+        self._attach()
+        self._dispatcher.start()
+        self._thread.start()
+
+    def pause(self) -> None:
+        with self._cond:
+            if self._state is ExecutorState.RUNNING:
+                self._paused = True
+                self._state = ExecutorState.PAUSED
+
+    def resume(self) -> None:
+        with self._cond:
+            if self._state is ExecutorState.PAUSED:
+                self._paused = False
+                self._state = ExecutorState.RUNNING
+                self._cond.notify()
+
+    def step(self) -> None:
+        """One tick while paused."""
+        with self._cond:
+            self._steps += 1
+            self._cond.notify()
+
+    def stop(self, reason: str = "stopped", timeout: float | None = 5.0) -> None:
+        """Halt what runs and end the run; waits for the engine thread (up to ``timeout``)."""
+        with self._cond:
+            if self._stop_reason is None:
+                self._stop_reason = reason
+            self._cond.notify()
+        if self._thread.is_alive() and threading.current_thread() is not self._thread:
+            self._thread.join(timeout)
+
+    def wake(self) -> None:
+        """Tick now rather than at the next period (jobs call this when they finish)."""
+        with self._cond:
+            self._woken = True
+            self._cond.notify()
+
+    def wait(self, timeout: float | None = None) -> RunFinished | None:
+        """Block until the run ended and its events were delivered; the result or None."""
+        if not self._done.wait(timeout):
+            return None
+        self._dispatcher.join(timeout)
+        return self._result
+
+    # ------------------------------------------------------------------ engine thread
+
+    def _attach(self) -> None:
+        ctx = self.tree.ctx
+        put = self._dispatcher.put
+        clock = time.monotonic
+
+        def on_status(node: Node, old: Status, new: Status) -> None:
+            put(StatusChanged(ctx.tick_count, node.id, old, new, node.message, clock()))
+
+        def on_log(node_id: str, message: str) -> None:
+            put(LogMessage(ctx.tick_count, node_id, message, clock()))
+
+        def on_write(key: str, value: object, writer: str) -> None:
+            put(BlackboardWritten(ctx.tick_count, key, value, writer, clock()))
+
+        ctx.status_sink = on_status
+        ctx.log_sink = on_log
+        ctx.wake = self.wake
+        self.tree.blackboard.add_write_listener(on_write)
+
+    def _wait_for_turn(self, deadline: float) -> str | None:
+        """Sleep until the next tick is due; returns a stop reason when stopping."""
+        with self._cond:
+            while True:
+                if self._stop_reason is not None:
+                    return self._stop_reason
+                if self._paused:
+                    if self._steps:
+                        self._steps -= 1
+                        return None
+                    self._cond.wait()
+                    continue
+                if self._woken:
+                    self._woken = False
+                    return None
+                remaining = deadline - time.monotonic()
+                if remaining <= 0:
+                    return None
+                self._cond.wait(remaining)
+
+    def _run(self) -> None:
+        self._dispatcher.put(RunStarted(time.monotonic(), self.plan_name))
+        status: Status = RUNNING
+        reason, message = "finished", ""
+        next_tick = time.monotonic()
+        try:
+            while True:
+                stop = self._wait_for_turn(next_tick)
+                if stop is not None:
+                    reason = stop
+                    break
+                next_tick = time.monotonic() + self.period
+                status = self.tree.tick()
+                if status is not RUNNING:
+                    message = self.tree.root.message
+                    break
+        except Exception as exc:  # a bug in the engine itself: end the run, keep the app
+            reason, message = "error", f"{type(exc).__name__}: {exc}"
+        if status is RUNNING or reason != "finished":
+            self._halt_all()
+        self._finish(status, reason, message)
+
+    def _halt_all(self) -> None:
+        try:
+            self.tree.reset()
+        except Exception as exc:
+            self._dispatcher.put(
+                LogMessage(0, "root", f"error while halting: {exc}", time.monotonic())
+            )
+
+    def _finish(self, status: Status, reason: str, message: str) -> None:
+        # A stopped run reports the status of its last tick (RUNNING when it was cut short).
+        self._result = RunFinished(
+            self.tree.ctx.tick_count, status, reason, message, time.monotonic()
+        )
+        self._state = ExecutorState.FINISHED
+        self._dispatcher.put(self._result)
+        self._dispatcher.close()
+        self._done.set()
+
+
+def run_to_end(
+    tree: BehaviorTree,
+    rate_hz: float = 20.0,
+    timeout: float | None = None,
+    listeners: list[Listener] | None = None,
+) -> RunFinished:
+    """Run a tree in an executor until it finishes or ``timeout`` seconds pass."""
+    executor = Executor(tree, rate_hz, listeners)
+    executor.start()
+    result = executor.wait(timeout)
+    if result is None:
+        executor.stop("timeout")
+        result = executor.wait(5.0)
+    assert result is not None
+    return result

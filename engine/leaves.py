@@ -1,0 +1,168 @@
+"""Leaves: operation leaves (Action, Query, Condition) and Wait.
+
+An operation leaf never blocks a tick: on its first tick it resolves its inputs and calls
+the operation's ``start``; if that returns a Job, later ticks poll it, and a reset cancels
+it. Anything the operation raises becomes FAILURE of this node with the message.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from engine.blackboard import MISSING
+from engine.context import TreeContext
+from engine.node import Node
+from engine.operations import (
+    Job,
+    Operation,
+    OperationCall,
+    OperationFailed,
+    OperationKind,
+)
+from engine.status import FAILURE, RUNNING, SUCCESS, Status
+
+__all__ = ["OperationLeaf", "Wait"]
+
+
+def _error_text(exc: BaseException) -> str:
+    if isinstance(exc, OperationFailed):
+        return str(exc)
+    return f"{type(exc).__name__}: {exc}"
+
+
+class OperationLeaf(Node):
+    """A leaf that runs one capability operation.
+
+    Args:
+        ctx: the tree's context.
+        node_id: id of the spec node.
+        name: label.
+        op_kind: action, query or condition (from the manifest).
+        operation: the operation's code, one instance for this leaf.
+        fixed: input port -> literal value (defaults included).
+        refs: input port -> blackboard key read at each start.
+        outputs: output port -> blackboard key written.
+    """
+
+    kind = "operation"
+
+    def __init__(
+        self,
+        ctx: TreeContext,
+        node_id: str,
+        name: str,
+        op_kind: OperationKind,
+        operation: Operation,
+        fixed: Mapping[str, Any] | None = None,
+        refs: Mapping[str, str] | None = None,
+        outputs: Mapping[str, str] | None = None,
+    ) -> None:
+        super().__init__(ctx, node_id, name)
+        self.op_kind = op_kind
+        self.kind = op_kind.value
+        self.is_condition = op_kind is OperationKind.CONDITION
+        self.operation = operation
+        self._fixed = dict(fixed or {})
+        self._refs = tuple((refs or {}).items())
+        self._written: set[str] = set()
+        self._call = OperationCall(
+            node_id, self.name, outputs or {}, self._write, ctx.log, self._wake, ctx.clock
+        )
+        self._call.args = dict(self._fixed)
+        self._job: Job | None = None
+
+    def _wake(self) -> None:
+        self.ctx.wake()
+
+    def _write(self, key: str, value: Any, writer: str) -> None:
+        self.ctx.blackboard.set(key, value, writer)
+        self._written.add(key)
+
+    def update(self) -> Status:
+        job = self._job
+        if job is None:
+            try:
+                result = self._start()
+            except Exception as exc:  # the operation's fault: FAILURE of this node, never a crash
+                return self.fail(_error_text(exc))
+            if not isinstance(result, Job):
+                return result
+            job = self._job = result
+            job.bind_wake(self.ctx.wake)
+        try:
+            status = job.poll()
+            if status is RUNNING:
+                return RUNNING
+            self._job = None
+            if status is SUCCESS:
+                for port, value in job.outputs.items():
+                    self._call.write(port, value)
+                return self._succeeded(job.message)
+        except Exception as exc:
+            self._job = None
+            return self.fail(_error_text(exc))
+        return self.fail(job.message or "failed")
+
+    def _start(self) -> Status | Job:
+        call = self._call
+        if self._refs:
+            board = self.ctx.blackboard
+            args = dict(self._fixed)
+            for port, key in self._refs:
+                value = board.get(key, MISSING)
+                if value is MISSING:
+                    raise OperationFailed(f"parameter {key!r} (for {port!r}) has no value yet")
+                args[port] = value
+            call.args = args
+        if self.op_kind is OperationKind.QUERY:
+            self._written.clear()
+        result = self.operation.start(call)
+        if result is True or result is None or result is SUCCESS:
+            return self._succeeded("")
+        if result is False or result is FAILURE:
+            self.message = "false" if self.is_condition else "failed"
+            return FAILURE
+        if isinstance(result, Job):
+            return result
+        raise TypeError(f"start() returned {result!r}; expected a bool, a Status or a Job")
+
+    def _succeeded(self, message: str) -> Status:
+        if self.op_kind is OperationKind.QUERY:
+            missing = [k for k in self._call.outputs.values() if k not in self._written]
+            if missing:
+                return self.fail(f"the query wrote no value for {', '.join(missing)}")
+        self.message = message
+        return SUCCESS
+
+    def on_halt(self) -> None:
+        job = self._job
+        self._job = None
+        if job is not None:
+            job.cancel()
+
+
+class Wait(Node):
+    """RUNNING for ``seconds`` of the tree's clock, then SUCCESS."""
+
+    kind = "wait"
+
+    def __init__(
+        self, ctx: TreeContext, node_id: str, name: str = "", seconds: float = 1.0
+    ) -> None:
+        super().__init__(ctx, node_id, name)
+        if seconds < 0:
+            raise ValueError(f"wait needs a duration of at least 0 s, not {seconds}")
+        self.seconds = seconds
+        self._deadline: float | None = None
+
+    def update(self) -> Status:
+        now = self.ctx.clock()
+        if self._deadline is None:
+            self._deadline = now + self.seconds
+        if now >= self._deadline:
+            return SUCCESS
+        return RUNNING
+
+    def on_reset(self) -> None:
+        self._deadline = None

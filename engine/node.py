@@ -1,0 +1,118 @@
+"""The runtime node: tick, latching and reset (paper section III-B).
+
+A node that returned SUCCESS or FAILURE is latched: ticking it again returns that status
+without evaluating anything, until it is reset. Reset clears the whole subtree and halts the
+leaves that are running; halting happens exactly once per run of a leaf, because a reset
+node is IDLE and resetting an IDLE node does nothing.
+
+Subclasses implement :meth:`update` (one evaluation; must not block), and may implement
+:meth:`on_halt` (the node was RUNNING and is being reset) and :meth:`on_reset`
+(clear private state).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+from engine.context import TreeContext
+from engine.status import FAILURE, IDLE, RUNNING, SUCCESS, Status
+
+__all__ = ["Node"]
+
+
+class Node:
+    """Base of all runtime nodes.
+
+    Attributes:
+        id: the stable id of the spec node this was built from.
+        name: the label shown to users.
+        status: the last status returned (IDLE after a reset).
+        message: why the node failed, or what it is doing; may be empty.
+        children: child nodes in tick order (empty for leaves).
+        is_condition: True for predicates (and decorators of them) that reactive
+            composites re-check every tick.
+    """
+
+    kind = "node"
+    is_condition = False
+
+    def __init__(self, ctx: TreeContext, node_id: str, name: str = "") -> None:
+        self.ctx = ctx
+        self.id = node_id
+        self.name = name or self.kind
+        self.status: Status = IDLE
+        self.message = ""
+        self.children: tuple[Node, ...] = ()
+        self.parent: Node | None = None
+
+    def __repr__(self) -> str:
+        return f"<{type(self).__name__} {self.name!r} {self.status.value}>"
+
+    # ------------------------------------------------------------------ ticking
+
+    def tick(self) -> Status:
+        """Evaluate once, unless latched; returns the status."""
+        status = self.status
+        if status is SUCCESS or status is FAILURE:
+            return status
+        new = self.update()
+        if new is not status:
+            self.status = new
+            sink = self.ctx.status_sink
+            if sink is not None:
+                sink(self, status, new)
+        return new
+
+    def update(self) -> Status:
+        """One evaluation. Must return quickly; long work returns RUNNING."""
+        raise NotImplementedError(f"{type(self).__name__} must implement update()")
+
+    # ------------------------------------------------------------------ reset / halt
+
+    def reset(self) -> None:
+        """Back to IDLE with the whole subtree; running leaves are halted first.
+
+        Never raises: halting errors become log lines.
+        """
+        status = self.status
+        if status is IDLE:
+            return
+        for child in self.children:
+            child.reset()
+        if status is RUNNING:
+            try:
+                self.on_halt()
+            except Exception as exc:  # a capability's cancel must not break the reset
+                self.ctx.log(self.id, f"error while halting: {type(exc).__name__}: {exc}")
+        self.on_reset()
+        self.message = ""
+        self.status = IDLE
+        sink = self.ctx.status_sink
+        if sink is not None:
+            sink(self, status, IDLE)
+
+    halt = reset
+
+    def on_halt(self) -> None:
+        """The node was RUNNING and is being reset: stop the work it started."""
+
+    def on_reset(self) -> None:
+        """Clear private state kept between ticks."""
+
+    # ------------------------------------------------------------------ structure
+
+    def set_children(self, children: list[Node] | tuple[Node, ...]) -> None:
+        self.children = tuple(children)
+        for child in self.children:
+            child.parent = self
+
+    def iterate(self) -> Iterator[Node]:
+        """This node and all below it, depth first, in tick order."""
+        yield self
+        for child in self.children:
+            yield from child.iterate()
+
+    def fail(self, message: str) -> Status:
+        """Set the message and return FAILURE (for ``return self.fail(...)`` in update)."""
+        self.message = message
+        return FAILURE

@@ -1,0 +1,204 @@
+"""The editable plan: plain dataclasses with stable uuid ids (what the editor edits).
+
+The spec is kept apart from the runtime nodes (engine.node and friends): the Instructor and
+the files work on the spec, :mod:`engine.build` turns a spec into a runnable tree. A task
+plan is a spec whose every operation parameter is bound, to a fixed value ("CUP") or to a
+reference to a named parameter that a query writes (CUP_POSE).
+"""
+
+from __future__ import annotations
+
+import enum
+import uuid
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from typing import Any
+
+from engine.tree import RunPolicy
+from engine.types import ParamType, Waypoint
+
+__all__ = [
+    "NodeKind",
+    "Category",
+    "KIND_CATEGORY",
+    "Binding",
+    "NodeSpec",
+    "ParameterDecl",
+    "NodeLayout",
+    "PlanSpec",
+    "new_id",
+    "RunPolicy",
+]
+
+
+def new_id() -> str:
+    """A fresh stable node id (uuid4, hex)."""
+    return uuid.uuid4().hex
+
+
+class Category(str, enum.Enum):
+    COMPOSITE = "composite"
+    DECORATOR = "decorator"
+    LEAF = "leaf"
+
+
+class NodeKind(str, enum.Enum):
+    """The node kinds a plan can hold; operation leaves name their operation in ``op``."""
+
+    SEQUENCE = "sequence"
+    SELECTOR = "selector"
+    PARALLEL = "parallel"
+    REACTIVE_SEQUENCE = "reactive_sequence"
+    REACTIVE_SELECTOR = "reactive_selector"
+    ITERATOR = "iterator"
+    ENFORCE = "enforce"
+    INVERTER = "inverter"
+    REPEAT = "repeat"
+    RETRY = "retry"
+    TIMEOUT = "timeout"
+    FORCE_SUCCESS = "force_success"
+    FORCE_FAILURE = "force_failure"
+    WAIT = "wait"
+    OPERATION = "operation"
+
+
+KIND_CATEGORY: dict[NodeKind, Category] = {
+    NodeKind.SEQUENCE: Category.COMPOSITE,
+    NodeKind.SELECTOR: Category.COMPOSITE,
+    NodeKind.PARALLEL: Category.COMPOSITE,
+    NodeKind.REACTIVE_SEQUENCE: Category.COMPOSITE,
+    NodeKind.REACTIVE_SELECTOR: Category.COMPOSITE,
+    NodeKind.ITERATOR: Category.DECORATOR,
+    NodeKind.ENFORCE: Category.DECORATOR,
+    NodeKind.INVERTER: Category.DECORATOR,
+    NodeKind.REPEAT: Category.DECORATOR,
+    NodeKind.RETRY: Category.DECORATOR,
+    NodeKind.TIMEOUT: Category.DECORATOR,
+    NodeKind.FORCE_SUCCESS: Category.DECORATOR,
+    NodeKind.FORCE_FAILURE: Category.DECORATOR,
+    NodeKind.WAIT: Category.LEAF,
+    NodeKind.OPERATION: Category.LEAF,
+}
+
+
+@dataclass(frozen=True)
+class Binding:
+    """An operation parameter's binding: a fixed value or a reference to a named parameter.
+
+    Attributes:
+        value: the literal (a Python value of ``type``) when fixed.
+        type: the literal's type; files record it so they can be read without a registry.
+        ref: the blackboard name when a reference (inputs read it, outputs write it).
+    """
+
+    value: Any = None
+    type: ParamType | None = None
+    ref: str | None = None
+
+    @classmethod
+    def fixed(cls, value: Any, ptype: ParamType) -> Binding:
+        return cls(value=value, type=ParamType(ptype))
+
+    @classmethod
+    def reference(cls, name: str) -> Binding:
+        return cls(ref=name)
+
+    @property
+    def is_ref(self) -> bool:
+        return self.ref is not None
+
+
+@dataclass
+class NodeSpec:
+    """One node of the plan tree.
+
+    Attributes:
+        kind: what the node is.
+        name: the label users gave it (may be empty: the UI shows the kind or operation).
+        id: stable uuid, kept through edits, saves and copies within a document.
+        op: operation id, for kind OPERATION.
+        params: operation port -> binding.
+        config: settings of logic nodes (Parallel policy, counts, timeouts, Wait seconds).
+        children: in tick order.
+    """
+
+    kind: NodeKind
+    name: str = ""
+    id: str = field(default_factory=new_id)
+    op: str | None = None
+    params: dict[str, Binding] = field(default_factory=dict)
+    config: dict[str, Any] = field(default_factory=dict)
+    children: list[NodeSpec] = field(default_factory=list)
+
+    @property
+    def category(self) -> Category:
+        return KIND_CATEGORY[self.kind]
+
+    @property
+    def label(self) -> str:
+        """What the UI and error messages call this node."""
+        return self.name or self.op or self.kind.value
+
+    def walk(self, path: str = "") -> Iterator[tuple[str, NodeSpec]]:
+        """(path, node) for this node and all below, depth first in tick order.
+
+        A path is the labels from the top joined by "/", each child with its index:
+        ``Transfer/pick[1]/move_to CUP_POSE[3]``.
+        """
+        here = path or self.label
+        yield here, self
+        for index, child in enumerate(self.children):
+            yield from child.walk(f"{here}/{child.label}[{index}]")
+
+    def find(self, node_id: str) -> NodeSpec | None:
+        for _, node in self.walk():
+            if node.id == node_id:
+                return node
+        return None
+
+
+@dataclass
+class ParameterDecl:
+    """A named parameter the plan declares, with an optional initial value (X of the paper)."""
+
+    name: str
+    type: ParamType
+    value: Any = None
+    doc: str = ""
+
+
+@dataclass
+class NodeLayout:
+    """Where the canvas draws a node; the engine ignores it."""
+
+    x: float = 0.0
+    y: float = 0.0
+    collapsed: bool = False
+
+
+@dataclass
+class PlanSpec:
+    """A task plan: the tree, its run policy, parameters, waypoints, objects and layout."""
+
+    tree: NodeSpec | None = None
+    name: str = ""
+    description: str = ""
+    run_policy: RunPolicy = RunPolicy.ONCE
+    parameters: list[ParameterDecl] = field(default_factory=list)
+    waypoints: list[Waypoint] = field(default_factory=list)
+    objects: list[str] = field(default_factory=list)
+    layout: dict[str, NodeLayout] = field(default_factory=dict)
+    id: str = field(default_factory=new_id)
+
+    def walk(self) -> Iterator[tuple[str, NodeSpec]]:
+        if self.tree is not None:
+            yield from self.tree.walk()
+
+    def find(self, node_id: str) -> NodeSpec | None:
+        return self.tree.find(node_id) if self.tree is not None else None
+
+    def path_of(self, node_id: str) -> str:
+        for path, node in self.walk():
+            if node.id == node_id:
+                return path
+        return node_id

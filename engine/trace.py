@@ -1,0 +1,195 @@
+"""Traces: every event of a run as JSON lines (``*.trace.jsonl``), for replay and analysis.
+
+The first line is a header with the plan's nodes (id, label, kind, path), so a trace can be
+read without the plan; each further line is one event.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import threading
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, TextIO
+
+from engine.events import (
+    BlackboardWritten,
+    Event,
+    LogMessage,
+    RunFinished,
+    StatusChanged,
+)
+from engine.spec import PlanSpec
+from engine.status import Status
+from engine.types import encode_value
+
+__all__ = ["TraceRecorder", "Trace", "TraceError", "read_trace", "format_timeline"]
+
+TRACE_FORMAT = "costar-trace"
+TRACE_VERSION = 1
+
+
+class TraceError(Exception):
+    """A trace file cannot be read; the message names the file and line."""
+
+
+def _event_record(event: Event) -> dict[str, Any]:
+    if isinstance(event, StatusChanged):
+        record: dict[str, Any] = {
+            "event": "status",
+            "tick": event.tick,
+            "node": event.node_id,
+            "old": event.old.value,
+            "new": event.new.value,
+        }
+        if event.message:
+            record["message"] = event.message
+        return record | {"time": event.time}
+    if isinstance(event, BlackboardWritten):
+        return {
+            "event": "write",
+            "tick": event.tick,
+            "key": event.key,
+            "value": encode_value(event.value),
+            "node": event.node_id,
+            "time": event.time,
+        }
+    if isinstance(event, LogMessage):
+        return {
+            "event": "log",
+            "tick": event.tick,
+            "node": event.node_id,
+            "message": event.message,
+            "time": event.time,
+        }
+    if isinstance(event, RunFinished):
+        return {
+            "event": "finished",
+            "tick": event.tick,
+            "status": event.status.value,
+            "reason": event.reason,
+            "message": event.message,
+            "time": event.time,
+        }
+    return {"event": "started", "plan": event.plan, "time": event.time}
+
+
+class TraceRecorder:
+    """A listener that writes a run's events to a JSON-lines file.
+
+    It runs on the executor's dispatcher thread, so file writes never delay a tick.
+    """
+
+    def __init__(self, path: str | os.PathLike[str], plan: PlanSpec | None = None) -> None:
+        self.path = Path(path)
+        self._lock = threading.Lock()
+        self._file: TextIO | None = self.path.open("w", encoding="utf-8")
+        header: dict[str, Any] = {"format": TRACE_FORMAT, "format_version": TRACE_VERSION}
+        if plan is not None:
+            header["plan"] = plan.name
+            header["nodes"] = [
+                {
+                    "id": node.id,
+                    "label": node.label,
+                    "kind": node.op or node.kind.value,
+                    "path": path,
+                }
+                for path, node in plan.walk()
+            ]
+        self._write(header)
+
+    def _write(self, record: dict[str, Any]) -> None:
+        with self._lock:
+            if self._file is not None:
+                self._file.write(json.dumps(record, separators=(",", ":")) + "\n")
+
+    def __call__(self, event: Event) -> None:
+        self._write(_event_record(event))
+        if isinstance(event, RunFinished):
+            self.close()
+
+    def close(self) -> None:
+        with self._lock:
+            if self._file is not None:
+                self._file.close()
+                self._file = None
+
+
+@dataclass
+class Trace:
+    """A trace read back: its header and its event records, in order."""
+
+    header: dict[str, Any]
+    events: list[dict[str, Any]] = field(default_factory=list)
+
+    def labels(self) -> dict[str, str]:
+        return {n["id"]: n["label"] for n in self.header.get("nodes", [])}
+
+    def statuses(self, node_id: str) -> list[str]:
+        """The statuses a node went through, in order."""
+        return [e["new"] for e in self.events if e["event"] == "status" and e["node"] == node_id]
+
+    @property
+    def final_status(self) -> Status | None:
+        for event in reversed(self.events):
+            if event["event"] == "finished":
+                return Status(event["status"])
+        return None
+
+
+def read_trace(path: str | os.PathLike[str]) -> Trace:
+    """Load a trace; raises TraceError naming the file and line of anything wrong."""
+    path = Path(path)
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except OSError as exc:
+        raise TraceError(f"{path}: cannot read: {exc.strerror or exc}") from exc
+    records: list[dict[str, Any]] = []
+    for number, line in enumerate(lines, start=1):
+        if not line.strip():
+            continue
+        try:
+            record = json.loads(line)
+        except json.JSONDecodeError as exc:
+            raise TraceError(f"{path}:{number}: not JSON ({exc.msg})") from exc
+        if not isinstance(record, dict):
+            raise TraceError(f"{path}:{number}: expected a JSON object")
+        records.append(record)
+    if not records or records[0].get("format") != TRACE_FORMAT:
+        raise TraceError(f"{path}:1: expected a header with format {TRACE_FORMAT!r}")
+    version = records[0].get("format_version")
+    if version != TRACE_VERSION:
+        raise TraceError(
+            f"{path}:1: format_version {version!r} is not supported (only {TRACE_VERSION})"
+        )
+    for number, record in enumerate(records[1:], start=2):
+        if "event" not in record:
+            raise TraceError(f"{path}:{number}: expected an 'event' field")
+    return Trace(records[0], records[1:])
+
+
+def format_timeline(trace: Trace) -> Iterable[str]:
+    """Readable lines: time since start, tick, node, change, message."""
+    labels = trace.labels()
+    start: float | None = None
+    for event in trace.events:
+        stamp = float(event.get("time", 0.0))
+        start = stamp if start is None else start
+        head = f"{stamp - start:9.3f}s"
+        kind = event["event"]
+        if kind == "status":
+            label = labels.get(event["node"], event["node"])
+            text = f"{head} tick {event['tick']:>5}  {label}: {event['old']} -> {event['new']}"
+            yield text + (f"  ({event['message']})" if event.get("message") else "")
+        elif kind == "write":
+            yield f"{head} tick {event['tick']:>5}  {event['key']} = {json.dumps(event['value'])}"
+        elif kind == "log":
+            label = labels.get(event["node"], event["node"])
+            yield f"{head} tick {event['tick']:>5}  {label}: {event['message']}"
+        elif kind == "finished":
+            tail = f" ({event['message']})" if event.get("message") else ""
+            yield f"{head} tick {event['tick']:>5}  run {event['reason']}: {event['status']}{tail}"
+        elif kind == "started":
+            yield f"{head} run of {event.get('plan') or 'plan'} started"

@@ -1,0 +1,99 @@
+"""The root of a tree and the tree as a whole.
+
+The root holds the run policy: ``once`` returns its child's result; ``until_success``
+resets the child after a FAILURE and runs it again (the paper's "evaluated until it returns
+SUCCESS"); ``forever`` resets the child after every result.
+"""
+
+from __future__ import annotations
+
+import enum
+from collections.abc import Iterator
+
+from engine.blackboard import Blackboard
+from engine.context import TreeContext
+from engine.node import Node
+from engine.status import FAILURE, RUNNING, SUCCESS, Status
+
+__all__ = ["RunPolicy", "Root", "BehaviorTree"]
+
+
+class RunPolicy(str, enum.Enum):
+    """How often the root runs its child."""
+
+    ONCE = "once"
+    UNTIL_SUCCESS = "until_success"
+    FOREVER = "forever"
+
+
+class Root(Node):
+    """The tree's root: ticks its one child and applies the run policy."""
+
+    kind = "root"
+
+    def __init__(
+        self, ctx: TreeContext, node_id: str, name: str = "", policy: RunPolicy = RunPolicy.ONCE
+    ) -> None:
+        super().__init__(ctx, node_id, name or "root")
+        self.policy = RunPolicy(policy)
+        self.runs = 0  # finished runs of the child
+
+    def update(self) -> Status:
+        child = self.children[0]
+        status = child.tick()
+        if status is RUNNING:
+            return RUNNING
+        self.runs += 1
+        if self.policy is RunPolicy.ONCE or (
+            self.policy is RunPolicy.UNTIL_SUCCESS and status is SUCCESS
+        ):
+            if status is FAILURE:
+                self.message = child.message or f"{child.name} failed"
+            return status
+        # Run again from a clean subtree on the next tick.
+        self.ctx.log(self.id, f"run {self.runs} ended with {status.value}; starting again")
+        child.reset()
+        return RUNNING
+
+    def on_reset(self) -> None:
+        self.runs = 0
+
+
+class BehaviorTree:
+    """A runnable tree: the root, its context, and its nodes by id."""
+
+    def __init__(self, root: Root, ctx: TreeContext) -> None:
+        self.root = root
+        self.ctx = ctx
+        self.nodes: dict[str, Node] = {node.id: node for node in root.iterate()}
+
+    @property
+    def status(self) -> Status:
+        return self.root.status
+
+    @property
+    def blackboard(self) -> Blackboard:
+        return self.ctx.blackboard
+
+    def tick(self) -> Status:
+        """One tick from the root."""
+        self.ctx.tick_count += 1
+        return self.root.tick()
+
+    def reset(self) -> None:
+        """Halt what runs and put every node back to IDLE."""
+        self.root.reset()
+
+    def iterate(self) -> Iterator[Node]:
+        return self.root.iterate()
+
+    def running_leaves(self) -> list[Node]:
+        return [n for n in self.root.iterate() if not n.children and n.status is RUNNING]
+
+    def tick_until_done(self, max_ticks: int = 1_000_000) -> Status:
+        """Tick until the root finishes (tests and benchmarks; no waiting between ticks)."""
+        for _ in range(max_ticks):
+            status = self.tick()
+            if status is not RUNNING:
+                return status
+        return RUNNING

@@ -1,0 +1,1 @@
+"""The Instructor: the PySide6 desktop application."""
