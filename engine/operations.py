@@ -136,10 +136,14 @@ class OperationCall:
         self.clock = clock
 
     def write(self, port: str, value: Any) -> None:
-        """Write the value of an output port to the blackboard entry it is bound to."""
+        """Write the value of an output port to the blackboard entry it is bound to.
+
+        An output the plan does not store (validation only warns about it) is dropped: the
+        operation cannot know which of its results the plan keeps, and must not fail for it.
+        """
         key = self.outputs.get(port)
         if key is None:
-            raise KeyError(f"output port {port!r} of {self.node_name!r} is not bound")
+            return
         self._writer(key, value, self.node_id)
 
     def log(self, message: str) -> None:
@@ -258,6 +262,10 @@ class OperationSource(Protocol):
 
     def aliases(self) -> Mapping[str, str]:
         """Former operation ids mapped to the current ones."""
+        ...
+
+    def manifests(self) -> list[OperationManifest]:
+        """Every operation's manifest (for listings and "did you mean" hints)."""
         ...
 
 

@@ -35,6 +35,7 @@ class ValueError_(ValueError):
     def __init__(self, path: str, expected: str, got: Any) -> None:
         self.path = path
         self.expected = expected
+        self.got = got
         super().__init__(f"{path}: expected {expected}, got {_describe(got)}")
 
 
@@ -73,7 +74,11 @@ class Pose:
         norm = math.sqrt(sum(v * v for v in q))
         if len(q) != 4 or not norm > 1e-9:
             raise ValueError(f"orientation must be a non-zero quaternion (x, y, z, w), got {q}")
-        object.__setattr__(self, "orientation", tuple(v / norm for v in q))
+        # Normalising an already unit quaternion again changes its last bits, and then a
+        # save -> load -> save would not be byte-identical.
+        if abs(norm - 1.0) > 1e-12:
+            q = tuple(v / norm for v in q)
+        object.__setattr__(self, "orientation", q)
         if len(self.position) != 3:
             raise ValueError(f"position must have 3 values, got {self.position}")
 

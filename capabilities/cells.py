@@ -1,0 +1,72 @@
+"""Opening a cell by name: what ``costar run --cell NAME`` and the Instructor use."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping
+from types import TracebackType
+from typing import Any
+
+__all__ = ["CELL_NAMES", "CellError", "ManagedCell", "open_cell"]
+
+CELL_NAMES: tuple[str, ...] = ("none", "sim")
+
+
+class CellError(Exception):
+    """A cell could not be opened."""
+
+
+class ManagedCell:
+    """A cell with a lifetime: a context manager that closes it.
+
+    The ``none`` cell has no interfaces: only cell-free capabilities (``debug``) run.
+    """
+
+    name = "none"
+
+    def interfaces(self) -> Mapping[str, Any]:
+        return {}
+
+    def clock(self) -> float:
+        return time.monotonic()
+
+    def close(self) -> None:
+        """Release the cell (threads, connections)."""
+
+    def __enter__(self) -> ManagedCell:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()
+
+
+def open_cell(
+    name: str, seed: int = 0, start: bool = True, scene: str | None = None, speed: float | None = None
+) -> Any:
+    """The cell called ``name``, as a context manager.
+
+    Args:
+        name: "none" (no robot) or "sim" (the pybullet cell; imported only when asked for).
+        seed: randomisation seed of the simulated scene.
+        start: begin the cell's threads (the simulated cell always starts: it needs its
+            physics thread to answer anything).
+        scene: scene name or path for the simulated cell (default: cup_to_bin).
+        speed: real-time factor of the simulated cell (None: as fast as possible).
+    """
+    if name == "none":
+        return ManagedCell()
+    if name == "sim":
+        try:
+            from capabilities.sim.session import SimCellSession
+        except ImportError as exc:
+            raise CellError(f"the simulated cell cannot load: {exc}") from exc
+        try:
+            return SimCellSession(scene or "cup_to_bin", seed, speed)
+        except Exception as exc:  # scene or model errors: say which, do not crash the CLI/GUI
+            raise CellError(f"the simulated cell did not start: {exc}") from exc
+    raise CellError(f"unknown cell {name!r}; cells: {', '.join(CELL_NAMES)}")

@@ -1,0 +1,147 @@
+"""Adapters from the ways cells report work to engine Jobs.
+
+Operations must never block a tick: a motion returns a handle that the cell finishes later,
+a camera frame takes tens of milliseconds. These helpers turn both into :class:`Job` objects
+that the engine polls and can cancel.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable, Mapping
+from concurrent.futures import Future, ThreadPoolExecutor
+from typing import Any, Protocol
+
+from engine.operations import Job, OperationFailed
+
+__all__ = ["CommandHandleLike", "job_from_handle", "WorkerPool", "chain_jobs"]
+
+
+class CommandHandleLike(Protocol):
+    """What a cell returns for a command (the simulated and the UR cell alike)."""
+
+    ok: bool | None
+    message: str
+
+    def done(self) -> bool: ...
+
+    def cancel(self) -> None: ...
+
+    def add_done_callback(self, fn: Callable[[Any], None]) -> None: ...
+
+
+def job_from_handle(
+    handle: CommandHandleLike,
+    describe: str = "",
+    outputs: Callable[[], Mapping[str, Any]] | None = None,
+) -> Job:
+    """A Job that finishes with the handle and cancels it when halted.
+
+    Args:
+        handle: the cell's command handle.
+        describe: what the command does, prefixed to a failure message.
+        outputs: called on success for the values to write (output port -> value).
+    """
+    job = Job(on_cancel=handle.cancel)
+
+    def finished(_: Any) -> None:
+        if handle.ok:
+            try:
+                job.succeed(outputs=outputs() if outputs else None)
+            except Exception as exc:  # computing outputs failed: the job fails, nothing is lost
+                job.fail(f"{describe}: {type(exc).__name__}: {exc}" if describe else str(exc))
+        else:
+            text = handle.message or "failed"
+            job.fail(f"{describe}: {text}" if describe else text)
+
+    handle.add_done_callback(finished)
+    return job
+
+
+class WorkerPool:
+    """Runs blocking work (camera frames, perception) off the engine thread.
+
+    One pool per cell session; ``submit`` returns a Job whose result is what the function
+    returns: a mapping of outputs (SUCCESS), or it raises (FAILURE with the message).
+    """
+
+    def __init__(self, workers: int = 2, name: str = "costar-worker") -> None:
+        self._pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix=name)
+        self._closed = False
+        self._lock = threading.Lock()
+
+    def submit(self, fn: Callable[[], Mapping[str, Any] | None], describe: str = "") -> Job:
+        cancelled = threading.Event()
+        job = Job(on_cancel=cancelled.set)
+
+        def run() -> None:
+            try:
+                outputs = fn()
+            except OperationFailed as exc:
+                job.fail(str(exc))
+            except Exception as exc:  # a perception bug fails the node, never the engine
+                prefix = f"{describe}: " if describe else ""
+                job.fail(f"{prefix}{type(exc).__name__}: {exc}")
+            else:
+                if not cancelled.is_set():
+                    job.succeed(outputs=outputs or None)
+
+        with self._lock:
+            if self._closed:
+                raise OperationFailed("the cell is shut down")
+            future: Future[None] = self._pool.submit(run)
+        del future
+        return job
+
+    def close(self) -> None:
+        with self._lock:
+            self._closed = True
+        self._pool.shutdown(wait=True, cancel_futures=True)
+
+
+class _ChainJob(Job):
+    """Runs job factories one after another; cancelling cancels the current one."""
+
+    def __init__(self, steps: list[tuple[str, Callable[[], Job]]]) -> None:
+        super().__init__(on_cancel=self._cancel_current)
+        self._steps = list(steps)
+        self._current: Job | None = None
+        self._step_name = ""
+        self._index = 0
+
+    def _cancel_current(self) -> None:
+        current = self._current
+        if current is not None:
+            current.cancel()
+
+    def poll(self) -> Any:
+        from engine.status import FAILURE, RUNNING, SUCCESS
+
+        while True:
+            if self._cancelled:
+                return FAILURE
+            if self._current is None:
+                if self._index >= len(self._steps):
+                    return SUCCESS
+                self._step_name, make = self._steps[self._index]
+                self._index += 1
+                try:
+                    self._current = make()
+                except Exception as exc:
+                    self.message = f"{self._step_name}: {exc}"
+                    return FAILURE
+                if self._on_done is not None:
+                    self._current.bind_wake(self._on_done)
+            status = self._current.poll()
+            if status is RUNNING:
+                return RUNNING
+            if status is FAILURE:
+                self.message = f"{self._step_name}: {self._current.message}"
+                return FAILURE
+            self.outputs.update(self._current.outputs)
+            self._current = None
+
+
+def chain_jobs(steps: list[tuple[str, Callable[[], Job]]]) -> Job:
+    """One Job made of steps run in order (unholster: approach, descend, grip, lift)."""
+    return _ChainJob(steps)

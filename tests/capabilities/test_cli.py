@@ -1,0 +1,175 @@
+"""The `costar` command line: exit codes, output, traces, Ctrl-C."""
+
+from __future__ import annotations
+
+import io
+import json
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from capabilities.cli import main
+from engine.files import save_plan
+from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
+from engine.types import ParamType
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "resources" / "examples"
+FIGURE3 = EXAMPLES / "figure3_debug.costar.json"
+
+
+def run_cli(*argv: str) -> tuple[int, str, str]:
+    out, err = io.StringIO(), io.StringIO()
+    code = main(list(argv), out, err)
+    return code, out.getvalue(), err.getvalue()
+
+
+def _save(tmp_path: Path, tree: NodeSpec, name: str = "plan") -> str:
+    path = tmp_path / f"{name}.costar.json"
+    save_plan(PlanSpec(tree, name), path)
+    return str(path)
+
+
+def _op(op: str, **params: Binding) -> NodeSpec:
+    return NodeSpec(NodeKind.OPERATION, op=op, params=params)
+
+
+def test_validate_valid_plan_exits_0() -> None:
+    code, out, _ = run_cli("validate", str(FIGURE3))
+    assert code == 0
+    assert "valid" in out
+
+
+def test_validate_invalid_plan_lists_problems_with_paths_and_exits_2(tmp_path: Path) -> None:
+    tree = NodeSpec(
+        NodeKind.SEQUENCE,
+        "steps",
+        children=[
+            _op("debug.pretend_move", target=Binding.reference("NOWHERE")),
+            _op("debug.no_such_thing"),
+        ],
+    )
+    code, out, _ = run_cli("validate", _save(tmp_path, tree))
+    assert code == 2
+    assert "NOWHERE" in out
+    assert "debug.no_such_thing" in out
+    assert "steps/" in out  # problems name the node's path
+
+
+def test_validate_broken_file_exits_2_naming_the_file(tmp_path: Path) -> None:
+    path = tmp_path / "broken.costar.json"
+    path.write_text('{"format": "costar-plan", "format_version": 1, "tree": {', encoding="utf-8")
+    code, _, err = run_cli("validate", str(path))
+    assert code == 2
+    assert "broken.costar.json" in err
+
+
+def test_validate_missing_file_exits_2(tmp_path: Path) -> None:
+    code, _, err = run_cli("validate", str(tmp_path / "nope.costar.json"))
+    assert code == 2
+    assert "nope.costar.json" in err
+
+
+def test_run_success_exits_0_and_verbose_prints_status_changes() -> None:
+    code, out, _ = run_cli("run", str(FIGURE3), "--rate", "200", "--verbose")
+    assert code == 0
+    assert "RUNNING -> SUCCESS" in out
+    assert "CUP_POSE" in out
+    assert "SUCCESS after" in out.strip().splitlines()[-1]
+
+
+def test_run_failure_exits_1_with_the_message(tmp_path: Path) -> None:
+    tree = _op("debug.fail", message=Binding.fixed("gripper empty", ParamType.TEXT))
+    code, out, _ = run_cli("run", _save(tmp_path, tree), "--rate", "100")
+    assert code == 1
+    assert "FAILURE" in out
+    assert "gripper empty" in out
+
+
+def test_run_invalid_plan_is_not_started_exits_2(tmp_path: Path) -> None:
+    code, _, err = run_cli("run", _save(tmp_path, _op("debug.pretend_move")))
+    assert code == 2
+    assert "not started" in err
+
+
+def test_run_timeout_exits_3(tmp_path: Path) -> None:
+    tree = _op("debug.running", ticks=Binding.fixed(10_000, ParamType.NUMBER))
+    code, out, _ = run_cli("run", _save(tmp_path, tree), "--rate", "100", "--timeout", "0.3")
+    assert code == 3
+    assert "timeout" in out
+
+
+def test_run_bad_rate_exits_2() -> None:
+    code, _, err = run_cli("run", str(FIGURE3), "--rate", "0")
+    assert code == 2
+    assert "rate" in err
+
+
+def test_run_writes_a_trace_that_trace_show_reads(tmp_path: Path) -> None:
+    trace = tmp_path / "run.trace.jsonl"
+    code, _, _ = run_cli("run", str(FIGURE3), "--rate", "200", "--trace", str(trace))
+    assert code == 0
+    code, out, _ = run_cli("trace", "show", str(trace))
+    assert code == 0
+    assert "move to CUP_POSE: IDLE -> RUNNING" in out
+    assert "run finished: SUCCESS" in out
+
+
+def test_trace_show_bad_file_exits_2(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.trace.jsonl"
+    bad.write_text("not json\n", encoding="utf-8")
+    code, _, err = run_cli("trace", "show", str(bad))
+    assert code == 2
+    assert "bad.trace.jsonl:1" in err
+
+
+def test_ops_lists_every_operation_with_parameters() -> None:
+    code, out, _ = run_cli("ops")
+    assert code == 0
+    assert "debug.running" in out and "ticks: Number" in out
+
+
+def test_ops_json_has_types_defaults_and_docs() -> None:
+    code, out, _ = run_cli("ops", "--json")
+    assert code == 0
+    ops = {entry["id"]: entry for entry in json.loads(out)}
+    running = ops["debug.running"]
+    assert running["kind"] == "action"
+    ticks = next(p for p in running["params"] if p["name"] == "ticks")
+    assert ticks["types"] == ["Number"] and ticks["default"] == 3 and ticks["doc"]
+
+
+def test_unknown_command_exits_2() -> None:
+    code, _, _ = run_cli("fly")
+    assert code == 2
+
+
+def test_ctrl_c_halts_cleanly_and_exits_3(tmp_path: Path) -> None:
+    tree = _op("debug.running", ticks=Binding.fixed(100_000, ParamType.NUMBER))
+    plan = _save(tmp_path, tree)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "capabilities.cli", "run", plan, "--verbose", "--rate", "50"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert proc.stdout is not None
+        first = proc.stdout.readline()  # the run has started once a status line is printed
+        assert "RUNNING" in first
+        proc.send_signal(signal.SIGINT)
+        rest, err = proc.communicate(timeout=20)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 3, err
+    assert "RUNNING -> IDLE" in rest  # the running action was halted
+    assert "stopped" in rest
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["run", "--help"]])
+def test_help_exits_0(argv: list[str]) -> None:
+    code, _, _ = run_cli(*argv)
+    assert code == 0

@@ -1,0 +1,57 @@
+"""Every example plan validates and runs to the result its description states."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from capabilities.base import CapabilityRegistry
+from engine.build import build_tree
+from engine.executor import run_to_end
+from engine.files import dump_plan, load_plan
+from engine.validation import has_errors, validate_plan
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "resources" / "examples"
+DEBUG_PLANS = sorted(
+    [EXAMPLES / "figure3_debug.costar.json", *(EXAMPLES / "nodes").glob("*.costar.json")]
+)
+
+
+def test_there_is_one_example_per_node_kind() -> None:
+    from engine.spec import NodeKind
+
+    kinds_used = set()
+    for path in DEBUG_PLANS:
+        kinds_used |= {node.kind for _, node in load_plan(path).walk()}
+    assert kinds_used == set(NodeKind)
+
+
+def test_examples_are_reproduced_by_their_generator() -> None:
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("make_examples", EXAMPLES / "make_examples.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    assert dump_plan(module.figure3()) == (EXAMPLES / "figure3_debug.costar.json").read_text(
+        encoding="utf-8"
+    )
+    for name, plan in module.node_examples().items():
+        assert dump_plan(plan) == (EXAMPLES / "nodes" / f"{name}.costar.json").read_text(
+            encoding="utf-8"
+        )
+
+
+@pytest.mark.parametrize("path", DEBUG_PLANS, ids=lambda p: p.stem)
+def test_example_runs_to_the_stated_result(path: Path) -> None:
+    registry = CapabilityRegistry()
+    plan = load_plan(path, aliases=registry.aliases())
+    problems = validate_plan(plan, registry)
+    assert not has_errors(problems), problems
+    stated = re.search(r"Runs to (SUCCESS|FAILURE)\.", plan.description)
+    assert stated, f"{path.name}: the description must say what it runs to"
+    result = run_to_end(build_tree(plan, registry), rate_hz=100.0, timeout=30.0)
+    assert result.reason == "finished"
+    assert result.status.value == stated.group(1)
