@@ -14,7 +14,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any, Protocol
 
-from engine.status import Status
+from engine.status import FAILURE, RUNNING, SUCCESS, Status
 from engine.types import ParamType
 
 __all__ = [
@@ -161,7 +161,7 @@ class Job:
 
     def __init__(self, on_cancel: Callable[[], None] | None = None) -> None:
         self._lock = threading.Lock()
-        self._status = Status.RUNNING
+        self._status = RUNNING
         self.message = ""
         self.outputs: dict[str, Any] = {}
         self._on_cancel = on_cancel
@@ -172,13 +172,13 @@ class Job:
         """Called by the leaf: ``wake`` runs when the job finishes, to tick again at once."""
         with self._lock:
             self._on_done = wake
-            finished = self._status is not Status.RUNNING
+            finished = self._status is not RUNNING
         if finished:
             wake()
 
     def _finish(self, status: Status, message: str, outputs: Mapping[str, Any] | None) -> None:
         with self._lock:
-            if self._status is not Status.RUNNING:
+            if self._status is not RUNNING:
                 return
             self.message = message
             if outputs:
@@ -190,15 +190,15 @@ class Job:
 
     def succeed(self, message: str = "", outputs: Mapping[str, Any] | None = None) -> None:
         """Finish with SUCCESS (first finish wins; later calls are ignored)."""
-        self._finish(Status.SUCCESS, message, outputs)
+        self._finish(SUCCESS, message, outputs)
 
     def fail(self, message: str) -> None:
         """Finish with FAILURE and a message saying why."""
-        self._finish(Status.FAILURE, message, None)
+        self._finish(FAILURE, message, None)
 
     @property
     def finished(self) -> bool:
-        return self._status is not Status.RUNNING
+        return self._status is not RUNNING
 
     def poll(self) -> Status:
         """The job's status now: RUNNING, SUCCESS or FAILURE. Must not block."""
@@ -210,8 +210,8 @@ class Job:
             if self._cancelled:
                 return
             self._cancelled = True
-            if self._status is Status.RUNNING:
-                self._status = Status.FAILURE
+            if self._status is RUNNING:
+                self._status = FAILURE
                 self.message = "halted"
             callback = self._on_cancel
         if callback is not None:

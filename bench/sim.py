@@ -1,0 +1,105 @@
+"""Headless speed of the simulated cell.
+
+Figures (all with ``speed=None``, as fast as the machine goes):
+
+- ``physics_steps_per_s``: 240 Hz physics steps per wall second with the robot loaded and
+  holding still (pybullet step + the controllers' hooks);
+- ``moving_steps_per_s``: the same while the arm runs joint moves;
+- ``pick_place_rtf``: real-time factor (simulated s / wall s) of a scripted pick-and-place
+  (moveJ + moveL + gripper), and its simulated and wall durations;
+- ``start_s``: wall time to build the cell.
+
+To add a figure (e.g. camera frames per second), write a ``measure_*(cell) -> dict`` function
+and add it to the list that ``measurements()`` returns. Run from the repository root::
+
+    .venv/bin/python bench/sim.py [--json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from collections.abc import Callable
+from typing import Any
+
+from capabilities.sim.cell import SimCell
+from capabilities.sim.testing import add_box, down_at, run
+
+Measurement = Callable[[SimCell], dict[str, Any]]
+
+
+def _steps_per_second(cell: SimCell, wall: float) -> float:
+    steps0, t0 = cell.steps(), time.perf_counter()
+    time.sleep(wall)
+    return (cell.steps() - steps0) / (time.perf_counter() - t0)
+
+
+def measure_idle_steps(cell: SimCell) -> dict[str, Any]:
+    """Physics steps per wall second with the arm holding still."""
+    return {"physics_steps_per_s": round(_steps_per_second(cell, 2.0))}
+
+
+def measure_moving_steps(cell: SimCell) -> dict[str, Any]:
+    """Physics steps per wall second while the arm moves back and forth."""
+    home = list(cell.robot.home_joints())
+    away = list(home)
+    away[0] += 1.0
+    steps0, t0 = cell.steps(), time.perf_counter()
+    for q in (away, home, away, home):
+        run(cell.robot.move_joints(q))
+    return {"moving_steps_per_s": round((cell.steps() - steps0) / (time.perf_counter() - t0))}
+
+
+def measure_pick_place(cell: SimCell) -> dict[str, Any]:
+    """Real-time factor of a scripted pick-and-place of a box."""
+    robot, gripper = cell.robot, cell.gripper
+    top = cell.table_top_z
+    add_box(cell, (0.04, 0.04, 0.05), (0.5, 0.1))
+    cell.wait_sim(0.2)
+    sim0, wall0 = cell.time(), time.perf_counter()
+    run(robot.move_pose_joint_space(down_at(0.5, 0.1, top + 0.15)))
+    run(robot.move_linear(down_at(0.5, 0.1, top + 0.03)))
+    run(gripper.close())
+    run(robot.move_linear(down_at(0.5, 0.1, top + 0.15)))
+    run(robot.move_pose_joint_space(down_at(0.4, -0.2, top + 0.15)))
+    run(robot.move_linear(down_at(0.4, -0.2, top + 0.032)))
+    run(gripper.open())
+    run(robot.move_linear(down_at(0.4, -0.2, top + 0.15)))
+    sim_s, wall_s = cell.time() - sim0, time.perf_counter() - wall0
+    return {
+        "pick_place_sim_s": round(sim_s, 2),
+        "pick_place_wall_s": round(wall_s, 3),
+        "pick_place_rtf": round(sim_s / wall_s, 1),
+    }
+
+
+def measurements() -> list[Measurement]:
+    """The measurements run, in order, on one cell. Extend this list to add figures."""
+    return [measure_idle_steps, measure_moving_steps, measure_pick_place]
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run every measurement and print the figures (``--json`` for one JSON object)."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    args = parser.parse_args(argv)
+    t0 = time.perf_counter()
+    cell = SimCell(speed=None)
+    cell.start()
+    results: dict[str, Any] = {"start_s": round(time.perf_counter() - t0, 3)}
+    try:
+        for measure in measurements():
+            results.update(measure(cell))
+    finally:
+        cell.close()
+    if args.json:
+        print(json.dumps(results, indent=2))
+    else:
+        for key, value in results.items():
+            print(f"{key:24s} {value}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

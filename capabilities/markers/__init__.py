@@ -1,0 +1,18 @@
+"""The ``markers`` capability: ArUco markers in camera images (paper IV-B's AR tracking).
+
+Detects markers in a camera's image (OpenCV), gives marker and object poses in the world
+frame, and calibrates a camera's extrinsics from markers of known pose.
+"""
+
+from __future__ import annotations
+
+from capabilities.base import Capability
+from capabilities.markers.errors import MarkerError
+from capabilities.markers.operations import build_capability
+
+__all__ = ["MarkerError", "capability"]
+
+
+def capability() -> Capability:
+    """Entry point of the ``costar.capabilities`` group."""
+    return build_capability()

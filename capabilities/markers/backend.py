@@ -1,0 +1,43 @@
+"""What the markers capability needs from a cell."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any, Protocol
+
+import numpy as np
+
+from engine.types import Pose
+
+__all__ = ["CameraDevice", "FrameLike", "MarkerLayout", "camera_interface"]
+
+
+class FrameLike(Protocol):
+    rgb: np.ndarray
+    K: np.ndarray
+    T_world_camera: Pose
+    stamp: float
+
+
+class CameraDevice(Protocol):
+    """An RGB-D camera: ``capture`` blocks the caller (call it from a worker thread)."""
+
+    name: str
+    on_wrist: bool
+
+    def capture(self) -> FrameLike: ...
+
+    def extrinsics(self) -> Pose: ...
+
+    def set_extrinsics(self, pose: Pose) -> None: ...
+
+
+class MarkerLayout(Protocol):
+    """The cell's marker configuration (``scene_layout``): sizes and table markers."""
+
+    def __getitem__(self, key: str) -> Mapping[int, Any]: ...
+
+
+def camera_interface(name: str) -> str:
+    """The interface name of a camera ("shoulder" -> "rgbd:shoulder")."""
+    return f"rgbd:{name}"

@@ -1,0 +1,223 @@
+"""Operations of the markers capability.
+
+``detect_markers`` looks once through a camera (on a worker thread: rendering or grabbing a
+frame takes tens of milliseconds) and stores what it saw in the cell's world model: marker
+poses, and the pose of every object that carries a seen marker. The queries and conditions
+then read the world model, so they answer at once.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from capabilities.base import Capability, CapabilityEnv
+from capabilities.markers.backend import CameraDevice, camera_interface
+from capabilities.markers.calibration import calibrate_extrinsics
+from capabilities.markers.detection import (
+    MarkerObservation,
+    detect_markers,
+    marker_pose_world,
+    object_pose_from_marker,
+)
+from capabilities.world_model import Detection, WorldModel
+from engine.operations import (
+    Direction,
+    Job,
+    OperationCall,
+    OperationFailed,
+    OperationKind,
+    OperationManifest,
+    PortSpec,
+    StartResult,
+)
+from engine.types import ObjectModel, ParamType, Pose
+
+__all__ = ["build_capability"]
+
+CAP = "markers"
+CAMERAS = ("shoulder", "wrist")
+# A detection whose pose is ambiguous (a marker seen almost face-on) is kept but trusted less.
+MIN_CONFIDENCE = 0.05
+
+
+def _camera_port(default: str = "shoulder") -> PortSpec:
+    return PortSpec("camera", (ParamType.TEXT,), default=default, doc="which camera looks",
+                    choices=CAMERAS)  # fmt: skip
+
+
+def _object_port() -> PortSpec:
+    return PortSpec("object", (ParamType.OBJECT,), doc="the object (by its model name)")
+
+
+class _Env:
+    """The interfaces every markers operation uses, taken from the cell once."""
+
+    def __init__(self, env: CapabilityEnv) -> None:
+        self.env = env
+        self.world: WorldModel = env.interface("world")
+        self.workers = env.interface("workers")
+        self.layout = env.interface("scene_layout")
+        self.library = env.interface("objects")
+
+    def camera(self, name: str) -> CameraDevice:
+        if name not in CAMERAS:
+            raise OperationFailed(f"unknown camera {name!r}; cameras: {', '.join(CAMERAS)}")
+        return self.env.interface(camera_interface(name))
+
+    def markers_on_objects(self) -> dict[int, tuple[str, Pose]]:
+        """marker id -> (object model name, marker pose in the object frame)."""
+        found: dict[int, tuple[str, Pose]] = {}
+        for name in self.library.names():
+            for marker in self.library.get(name).markers:
+                found[marker.marker_id] = (name, marker.pose)
+        return found
+
+
+def _object_detections(
+    seen: Mapping[int, tuple[MarkerObservation, Pose]],
+    carriers: Mapping[int, tuple[str, Pose]],
+    stamp: float,
+    source: str,
+) -> list[Detection]:
+    """One detection per object: from its most confident visible marker."""
+    best: dict[str, Detection] = {}
+    for marker_id, (observation, world_pose) in seen.items():
+        if marker_id not in carriers or observation.confidence < MIN_CONFIDENCE:
+            continue
+        name, in_object = carriers[marker_id]
+        pose = object_pose_from_marker(world_pose, in_object)
+        candidate = Detection(name, pose, observation.confidence, stamp, source, f"marker {marker_id}")
+        if name not in best or candidate.confidence > best[name].confidence:
+            best[name] = candidate
+    return list(best.values())
+
+
+class DetectMarkers:
+    def __init__(self, env: _Env) -> None:
+        self._env = env
+
+    def start(self, call: OperationCall) -> StartResult:
+        camera = self._env.camera(str(call.args["camera"]))
+        env = self._env
+
+        def look() -> dict[str, Any]:
+            frame = camera.capture()
+            sizes = env.layout["marker_sizes"]
+            observations = detect_markers(frame.rgb, frame.K, sizes)
+            seen = {o.marker_id: (o, marker_pose_world(o, frame.T_world_camera)) for o in observations}
+            env.world.set_markers({k: pose for k, (_, pose) in seen.items()}, frame.stamp)
+            source = f"markers:{camera.name}"
+            objects = _object_detections(seen, env.markers_on_objects(), frame.stamp, source)
+            env.world.replace(source, objects)
+            call.log(f"{camera.name} camera: markers {sorted(seen) or 'none'}; "
+                     f"objects {sorted(d.object_class for d in objects) or 'none'}")  # fmt: skip
+            return {"count": float(len(seen))} if "count" in call.outputs else {}
+
+        job: Job = env.workers.submit(look, f"detect markers ({camera.name} camera)")
+        return job
+
+
+class MarkerPose:
+    def __init__(self, env: _Env) -> None:
+        self._env = env
+
+    def start(self, call: OperationCall) -> StartResult:
+        marker_id = int(call.args["marker_id"])
+        found = self._env.world.marker(marker_id)
+        if found is None:
+            raise OperationFailed(f"marker {marker_id} has not been seen")
+        call.write("pose", found[0])
+        return True
+
+
+def _best(env: _Env, model: Any) -> Detection | None:
+    name = model.name if isinstance(model, ObjectModel) else str(model)
+    return env.world.best(name)
+
+
+class ObjectPose:
+    def __init__(self, env: _Env) -> None:
+        self._env = env
+
+    def start(self, call: OperationCall) -> StartResult:
+        detection = _best(self._env, call.args["object"])
+        if detection is None:
+            raise OperationFailed(f"{call.args['object'].name} has not been seen")
+        call.write("pose", detection.pose)
+        return True
+
+
+class ObjectFound:
+    def __init__(self, env: _Env) -> None:
+        self._env = env
+
+    def start(self, call: OperationCall) -> StartResult:
+        return _best(self._env, call.args["object"]) is not None
+
+
+class CalibrateCamera:
+    """Finds a fixed camera's pose from the table markers of known pose."""
+
+    def __init__(self, env: _Env) -> None:
+        self._env = env
+
+    def start(self, call: OperationCall) -> StartResult:
+        camera = self._env.camera(str(call.args["camera"]))
+        if camera.on_wrist:
+            raise OperationFailed("the wrist camera is calibrated by hand-eye calibration, not here")
+        env = self._env
+        max_rms = float(call.args["max_error_px"])
+
+        def calibrate() -> dict[str, Any]:
+            frame = camera.capture()
+            known: Mapping[int, Pose] = env.layout["fixed_markers"]
+            observations = detect_markers(frame.rgb, frame.K, env.layout["marker_sizes"])
+            pose, report = calibrate_extrinsics([observations], known, frame.K)
+            if report.rms_px > max_rms:
+                raise OperationFailed(f"calibration error {report.rms_px:.2f} px is above {max_rms:g} px")
+            camera.set_extrinsics(pose)
+            call.log(f"{camera.name} camera calibrated from markers {sorted(report.inliers)}: "
+                     f"{report.rms_px:.3f} px")  # fmt: skip
+            return {}
+
+        job: Job = env.workers.submit(calibrate, f"calibrate the {camera.name} camera")
+        return job
+
+
+def build_capability() -> Capability:
+    cap = Capability(
+        CAP,
+        "Finds ArUco markers in camera images; object poses and camera calibration from them.",
+        requires=("world", "workers", "scene_layout", "objects", "rgbd:shoulder"),
+    )
+
+    def op(op_id: str, kind: OperationKind, doc: str, *ports: PortSpec) -> OperationManifest:
+        return OperationManifest(f"{CAP}.{op_id}", kind, doc, CAP, ports)
+
+    def maker(cls: type) -> Any:
+        return lambda env: cls(_Env(env))
+
+    cap.add(op("detect_markers", OperationKind.ACTION,
+               "Looks through a camera and remembers every marker and marked object it sees.",
+               _camera_port(),
+               PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="how many markers were seen")),
+            maker(DetectMarkers))  # fmt: skip
+    cap.add(op("marker_pose", OperationKind.QUERY, "The pose of a marker last seen.",
+               PortSpec("marker_id", (ParamType.NUMBER,), doc="the marker's id"),
+               PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where it is")),
+            maker(MarkerPose))  # fmt: skip
+    cap.add(op("object_pose", OperationKind.QUERY, "The pose of an object, from its marker.",
+               _object_port(),
+               PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the object is")),
+            maker(ObjectPose))  # fmt: skip
+    cap.add(op("object_found", OperationKind.CONDITION, "True when the object's marker was seen.",
+               _object_port()),
+            maker(ObjectFound))  # fmt: skip
+    cap.add(op("calibrate_camera", OperationKind.ACTION,
+               "Finds a fixed camera's pose from the table markers of known pose.",
+               _camera_port(),
+               PortSpec("max_error_px", (ParamType.NUMBER,), default=1.5, unit="px",
+                        doc="refuse a calibration worse than this")),
+            maker(CalibrateCamera))  # fmt: skip
+    return cap

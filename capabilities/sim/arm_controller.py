@@ -1,0 +1,242 @@
+"""The arm's joint controller; runs on the physics thread only.
+
+It plays a trajectory through pybullet's POSITION_CONTROL motors (target position plus
+feed-forward velocity, forces well above gravity load) so the arm is a physical body that
+pushes objects, and finishes a move once the joints have settled on the target. Stopping
+slows trajectory time down to zero, so a stopped arm stays on its path.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+import pybullet
+
+from capabilities.sim.commands import CommandHandle
+from capabilities.sim.freedrive import Freedrive
+from capabilities.sim.kinematics import UR5Kinematics
+from capabilities.sim.trajectory import CartesianTrajectory, JointTrajectory, PathError, plan_linear
+from capabilities.sim.transforms import rotation_angle
+
+__all__ = ["ArmController"]
+
+Trajectory = JointTrajectory | CartesianTrajectory
+_FORCES = (330.0, 330.0, 150.0, 56.0, 56.0, 56.0)  # 2x the UR5's rated joint torques (N m)
+_POSITION_GAIN = 0.6
+_VELOCITY_GAIN = 1.0
+_SETTLED_RAD = 5e-5
+_SETTLE_TIMEOUT = 0.5  # s after the trajectory ends
+_MAX_STOP_TIME = 0.15  # s: a stop always completes well within 0.2 s
+_TOL_M = 1e-3
+_TOL_RAD = math.radians(0.5)
+
+
+@dataclass
+class _Motion:
+    trajectory: Trajectory
+    handle: CommandHandle
+    elapsed: float = 0.0  # trajectory time
+    rate: float = 1.0  # trajectory seconds per simulated second
+    stop_step: float = 0.0  # rate decrease per step while stopping
+    stop_handles: list[CommandHandle] = field(default_factory=list)
+    stop_reason: str = ""
+    settle: float = 0.0
+
+
+class ArmController:
+    """Plays joint trajectories on the UR5's motors, handles stop and freedrive."""
+
+    def __init__(
+        self,
+        client: int,
+        body: int,
+        joints: tuple[int, ...],
+        kin: UR5Kinematics,
+        dt: float,
+        tcp: Callable[[], np.ndarray],
+    ) -> None:
+        self._client = client
+        self._body = body
+        self._joints = joints
+        self._kin = kin
+        self._dt = dt
+        self._tcp = tcp
+        self.q_actual: tuple[float, ...] = tuple(
+            s[0] for s in pybullet.getJointStates(body, joints, physicsClientId=client)
+        )
+        self.qd_actual: tuple[float, ...] = (0.0,) * 6
+        self.q_cmd = np.asarray(self.q_actual)
+        self._motion: _Motion | None = None
+        self.freedrive = Freedrive(kin, dt, tcp)
+        self._command(self.q_cmd, np.zeros(6))
+
+    @property
+    def busy(self) -> bool:
+        """True while a move or a stop is under way."""
+        return self._motion is not None
+
+    # ---------------------------------------------------------------- commands (physics thread)
+
+    def start_joint_move(
+        self, handle: CommandHandle, q: np.ndarray, speed: float, accel: float
+    ) -> None:
+        """Begin a moveJ from the commanded joints to ``q``."""
+        if self._refuse(handle):
+            return
+        self._begin(_Motion(JointTrajectory(self.q_cmd, q, speed, accel), handle))
+
+    def start_linear_move(
+        self, handle: CommandHandle, target: np.ndarray, speed: float, accel: float
+    ) -> None:
+        """Begin a moveL of the TCP to the world matrix ``target``."""
+        if self._refuse(handle):
+            return
+        try:
+            traj = plan_linear(self._kin, self.q_cmd, self._tcp(), target, speed, accel, self._dt)
+        except PathError as exc:
+            handle.resolve(False, str(exc))
+            return
+        self._begin(_Motion(traj, handle))
+
+    def stop(self, handle: CommandHandle | None, decel: float, reason: str = "stopped") -> None:
+        """Decelerate the current move to a halt; ``handle`` finishes when the arm stands."""
+        motion = self._motion
+        if motion is None:
+            if handle is not None:
+                handle.resolve(True, "not moving")
+            return
+        if handle is not None:
+            motion.stop_handles.append(handle)
+        if motion.stop_step > 0:
+            return
+        motion.stop_reason = reason
+        _, qd = motion.trajectory.sample(motion.elapsed)
+        speed = float(np.max(np.abs(qd))) * motion.rate
+        stop_time = min(speed / max(decel, 1e-6), _MAX_STOP_TIME)
+        motion.stop_step = motion.rate * self._dt / max(stop_time, self._dt)
+
+    def cancel(self, handle: CommandHandle) -> None:
+        """Stop the move of ``handle`` if it is the current one."""
+        if self._motion is not None and self._motion.handle is handle:
+            self.stop(None, 4.0, f"{handle.name} cancelled")
+        else:
+            handle.resolve(False, f"{handle.name} cancelled")
+
+    def set_freedrive(self, on: bool) -> None:
+        """Enter or leave freedrive; entering halts any move at once."""
+        if on:
+            if self._motion is not None:
+                self._finish_motion(False, "interrupted by freedrive")
+            self.q_cmd = np.asarray(self.q_actual)
+            self.freedrive.start(self.q_cmd)
+        else:
+            self.freedrive.stop()
+            self.q_cmd = np.asarray(self.q_actual)  # hold where the hand left it
+            self._command(self.q_cmd, np.zeros(6))
+
+    def shutdown(self, message: str) -> None:
+        """Fail every unfinished handle (the physics thread has ended)."""
+        motion, self._motion = self._motion, None
+        if motion is not None:
+            motion.handle.resolve(False, message)
+            for handle in motion.stop_handles:
+                handle.resolve(False, message)
+        self.freedrive.stop()
+
+    # ---------------------------------------------------------------- stepping
+
+    def pre_step(self, _t: float) -> None:
+        """Send this step's motor targets."""
+        if self.freedrive.active:
+            self.q_cmd, qd = self.freedrive.step(self.q_cmd, np.asarray(self.q_actual))
+            self._command(self.q_cmd, qd)
+            return
+        motion = self._motion
+        if motion is None:
+            return
+        if motion.stop_step > 0:
+            motion.rate = max(0.0, motion.rate - motion.stop_step)
+        motion.elapsed += self._dt * motion.rate
+        q, qd = motion.trajectory.sample(motion.elapsed)
+        self.q_cmd = q
+        self._command(q, qd * motion.rate)
+
+    def post_step(self, _t: float) -> None:
+        """Read the joints and finish moves that have arrived or stopped."""
+        states = pybullet.getJointStates(self._body, self._joints, physicsClientId=self._client)
+        self.q_actual = tuple(s[0] for s in states)
+        self.qd_actual = tuple(s[1] for s in states)
+        motion = self._motion
+        if motion is None:
+            return
+        if motion.stop_step > 0 and motion.rate <= 0.0:
+            self._finish_motion(False, motion.stop_reason)
+            return
+        if motion.elapsed >= motion.trajectory.duration:
+            self._settle(motion)
+
+    # ---------------------------------------------------------------- internals
+
+    def _refuse(self, handle: CommandHandle) -> bool:
+        if handle.cancel_requested:
+            handle.resolve(False, f"{handle.name} cancelled")
+            return True
+        if self.freedrive.active:
+            handle.resolve(False, f"{handle.name} refused: freedrive is active")
+            return True
+        return False
+
+    def _begin(self, motion: _Motion) -> None:
+        if self._motion is not None:
+            # A new move replaces the running one, like a new command on a UR controller.
+            self._finish_motion(False, f"preempted by {motion.handle.name}")
+        self._motion = motion
+
+    def _settle(self, motion: _Motion) -> None:
+        motion.settle += self._dt
+        error = float(np.max(np.abs(np.asarray(self.q_actual) - self.q_cmd)))
+        if error < _SETTLED_RAD:
+            self._finish_motion(True, "reached")
+        elif motion.settle >= _SETTLE_TIMEOUT:
+            self._finish_motion(*self._arrival_check())
+
+    def _arrival_check(self) -> tuple[bool, str]:
+        tcp = self._tcp()
+        want = self._kin.tcp_matrix(self.q_cmd, tcp)
+        have = self._kin.tcp_matrix(self.q_actual, tcp)
+        dist = float(np.linalg.norm(want[:3, 3] - have[:3, 3]))
+        angle = rotation_angle(want[:3, :3].T @ have[:3, :3])
+        if dist <= _TOL_M and angle <= _TOL_RAD:
+            return True, "reached"
+        return False, (
+            f"blocked: the TCP stopped {dist * 1000:.1f} mm and {math.degrees(angle):.2f} deg "
+            "from the target (a collision?)"
+        )
+
+    def _finish_motion(self, ok: bool, message: str) -> None:
+        motion = self._motion
+        self._motion = None
+        if motion is None:
+            return
+        if not ok:
+            self.q_cmd = motion.trajectory.sample(motion.elapsed)[0]
+        self._command(self.q_cmd, np.zeros(6))
+        motion.handle.resolve(ok, message)
+        for stop_handle in motion.stop_handles:
+            stop_handle.resolve(True, "stopped")
+
+    def _command(self, q: np.ndarray, qd: np.ndarray) -> None:
+        pybullet.setJointMotorControlArray(
+            self._body,
+            self._joints,
+            pybullet.POSITION_CONTROL,
+            targetPositions=[float(v) for v in q],
+            targetVelocities=[float(v) for v in qd],
+            forces=_FORCES,
+            positionGains=[_POSITION_GAIN] * 6,
+            velocityGains=[_VELOCITY_GAIN] * 6,
+            physicsClientId=self._client,
+        )

@@ -1,0 +1,177 @@
+"""SimCell: the pybullet robot cell (UR5, parallel gripper, suction tool, table).
+
+pybullet runs in DIRECT mode on one physics thread stepping at 240 Hz; every public object
+here (robot, gripper, suction, ground_truth) sends its work there. ``speed=1.0`` paces the
+simulation in real time (GUI), ``speed=None`` runs as fast as possible (CLI, tests).
+``time()`` (simulated seconds) is the clock anything that waits should use.
+
+Example::
+
+    with SimCell() as cell:
+        cell.robot.move_linear(pose).wait()
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from types import TracebackType
+from typing import TypeVar
+
+import numpy as np
+
+from capabilities.sim.arm_controller import ArmController
+from capabilities.sim.config import DEFAULT_CONFIG_PATH, CellConfig
+from capabilities.sim.errors import SimError
+from capabilities.sim.gripper import GripperController, SimGripper
+from capabilities.sim.ground_truth import GroundTruth
+from capabilities.sim.kinematics import UR5Kinematics
+from capabilities.sim.physics_thread import PhysicsThread, StepHook
+from capabilities.sim.robot import SimRobot
+from capabilities.sim.suction import SimSuctionTool, SuctionController
+from capabilities.sim.transforms import matrix_to_pose, pose_to_matrix
+from capabilities.sim.world import World, build_world
+from engine.types import Pose
+
+__all__ = ["SimCell"]
+
+T = TypeVar("T")
+TIME_STEP = 1.0 / 240.0
+
+
+class SimCell:
+    """The simulated cell. Call ``start()`` (or use it as a context manager) before use.
+
+    Attributes (after start):
+        robot, gripper, suction: the devices.
+        ground_truth: exact world state, for tests and scores only.
+        robot_body_id, table_top_z, world: for the scene and camera helpers.
+    """
+
+    def __init__(self, config: CellConfig | None = None, speed: float | None = None) -> None:
+        if config is None:
+            config = (
+                CellConfig.load(DEFAULT_CONFIG_PATH)
+                if Path(DEFAULT_CONFIG_PATH).is_file()
+                else CellConfig()
+            )
+        self.config = config
+        self.kinematics = UR5Kinematics(config.robot_base)
+        self._physics = PhysicsThread(self._build, speed, TIME_STEP)
+        self._tcp_matrices = {k: pose_to_matrix(v) for k, v in config.tcp_offsets.items()}
+        self._world: World | None = None
+        self._arm: ArmController | None = None
+        self._gripper: GripperController | None = None
+        self._suction: SuctionController | None = None
+
+    # ---------------------------------------------------------------- lifecycle
+
+    def start(self) -> None:
+        """Build the world and start stepping.
+
+        Raises:
+            SimError: building the world failed (missing robot model, bad config).
+        """
+        self._physics.start()
+        assert self._world and self._arm and self._gripper and self._suction
+        world = self._world
+        self.world = world
+        self.robot_body_id = world.robot
+        self.table_top_z = world.table_top_z
+        self.robot = SimRobot(
+            self._physics, self._arm, self.kinematics, self.config.home_joints,
+            self.tcp_offset, world.robot, world.flange_link,
+        )  # fmt: skip
+        self.gripper = SimGripper(self._physics, self._gripper)
+        self.suction = SimSuctionTool(
+            self._physics, self._suction, self._suction_in_hand,
+            self.config.holster_pose, self.config.handle_grasp,
+            (self.config.tcp_offsets["gripper"], self.config.tcp_offsets["suction"]),
+        )  # fmt: skip
+        self.ground_truth = GroundTruth(self._physics, world, self._gripper, self._suction)
+
+    def close(self) -> None:
+        """Stop the physics thread and disconnect pybullet; unfinished commands fail. Idempotent."""
+        self._physics.stop()
+        # The physics thread has ended: no race with it any more.
+        for part in (self._arm, self._gripper, self._suction):
+            if part is not None:
+                part.shutdown("the simulated cell was closed")
+
+    def __enter__(self) -> SimCell:
+        self.start()
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()
+
+    # ---------------------------------------------------------------- services
+
+    @property
+    def speed(self) -> float | None:
+        """Real-time factor (None: as fast as possible)."""
+        return self._physics.speed
+
+    @property
+    def time_step(self) -> float:
+        """Seconds per physics step."""
+        return self._physics.time_step
+
+    def time(self) -> float:
+        """Simulated seconds since start."""
+        return self._physics.time()
+
+    def steps(self) -> int:
+        """Physics steps taken since start."""
+        return self._physics.steps
+
+    def call(self, fn: Callable[[int], T]) -> T:
+        """Run ``fn(pybullet_client_id)`` on the physics thread and return its result."""
+        return self._physics.call(fn)
+
+    def wait_sim(self, seconds: float) -> None:
+        """Block until simulated time has advanced by ``seconds`` (tests, CLI)."""
+        if not self._physics.wait_sim(seconds, timeout=max(60.0, seconds * 10)):
+            raise SimError(f"simulated time did not advance by {seconds} s")
+
+    def add_step_hook(self, pre: StepHook | None = None, post: StepHook | None = None) -> None:
+        """Run callbacks on the physics thread before/after every step, with the sim time."""
+        self._physics.call(lambda _c: self._physics.add_hooks(pre, post))
+
+    def tcp_offset(self) -> Pose:
+        """The TCP of the tool in use, in the flange frame."""
+        return matrix_to_pose(self._tcp_matrix())
+
+    # ---------------------------------------------------------------- physics thread
+
+    def _suction_in_hand(self) -> bool:
+        return (
+            self._gripper is not None
+            and self._world is not None
+            and self._gripper.attached == self._world.suction_tool
+        )
+
+    def _tcp_matrix(self) -> np.ndarray:
+        return self._tcp_matrices["suction" if self._suction_in_hand() else "gripper"]
+
+    def _build(self, client: int) -> None:
+        world = build_world(client, self.config)
+        self._world = world
+        self._arm = ArmController(
+            client, world.robot, world.arm_joints, self.kinematics, TIME_STEP, self._tcp_matrix
+        )
+        self._gripper = GripperController(
+            client, world.robot, world.gripper_link, world.finger_joints
+        )
+        self._suction = SuctionController(
+            client, world.suction_tool, world.robot, self._suction_in_hand
+        )
+        arm, gripper, suction = self._arm, self._gripper, self._suction
+        self._physics.add_hooks(pre=arm.pre_step, post=arm.post_step)
+        self._physics.add_hooks(pre=gripper.pre_step, post=lambda _t: gripper.post_step(TIME_STEP))
+        self._physics.add_hooks(pre=suction.pre_step)

@@ -1,0 +1,147 @@
+"""The parallel gripper on the flange: two prismatic fingers driven by force-limited motors.
+
+``GripperController`` lives on the physics thread; ``SimGripper`` is what other threads call.
+When the fingers close on an object and both touch it, the object is fixed to the gripper
+body (see ``tools.attach``); opening releases it. ``is_holding`` is judged like a real
+gripper's position sensor: closed, yet the fingers stopped apart.
+"""
+
+from __future__ import annotations
+
+import pybullet
+
+from capabilities.sim.commands import CommandHandle
+from capabilities.sim.physics_thread import PhysicsThread
+from capabilities.sim.robot import post_command
+from capabilities.sim.tools import attach, detach, is_dynamic
+
+__all__ = ["GripperController", "SimGripper", "OPEN_POSITION"]
+
+OPEN_POSITION = 0.0425  # m per finger: 85 mm stroke
+_FORCE = 60.0  # N per finger
+_SPEED = 0.15  # m/s per finger
+_HOLD_GAP = 0.002  # m: closed with a larger gap means an object is between the fingers
+_STALLED = 1e-4  # m/s
+_MIN_TIME = 0.05  # s before a stalled finger counts as done
+
+
+class GripperController:
+    """Finger motors, grasp attachment and the gap sensor (physics thread only)."""
+
+    def __init__(self, client: int, robot: int, body_link: int, fingers: tuple[int, int]) -> None:
+        self._client = client
+        self._robot = robot
+        self._body_link = body_link
+        self._fingers = fingers
+        self.closed = False
+        self.gap = 2 * OPEN_POSITION
+        self.attached: int | None = None
+        self._constraint: int | None = None
+        self._handle: CommandHandle | None = None
+        self._elapsed = 0.0
+        for finger in fingers:
+            pybullet.resetJointState(robot, finger, OPEN_POSITION, physicsClientId=client)
+        self._drive(OPEN_POSITION)
+
+    @property
+    def moving(self) -> bool:
+        """True while an open or close command runs."""
+        return self._handle is not None
+
+    def command(self, handle: CommandHandle, close: bool) -> None:
+        """Start closing or opening; ``handle`` finishes when the fingers stop."""
+        if self._handle is not None:
+            self._handle.resolve(False, f"{self._handle.name} preempted by {handle.name}")
+        self.closed = close
+        self._handle, self._elapsed = handle, 0.0
+        if not close:
+            self.release()
+        self._drive(0.0 if close else OPEN_POSITION)
+
+    def shutdown(self, message: str) -> None:
+        """Fail an unfinished command (the physics thread has ended)."""
+        handle, self._handle = self._handle, None
+        if handle is not None:
+            handle.resolve(False, message)
+
+    def release(self) -> None:
+        """Drop whatever is attached."""
+        if self._constraint is not None:
+            detach(self._client, self._constraint)
+        self._constraint, self.attached = None, None
+
+    def pre_step(self, _t: float) -> None:
+        """Attach an object both closing fingers touch."""
+        if self.closed and self.attached is None:
+            body = self._grasped_body()
+            if body is not None:
+                self._constraint = attach(self._client, self._robot, self._body_link, body)
+                self.attached = body
+
+    def post_step(self, dt: float) -> None:
+        """Update the gap sensor and finish a command whose fingers have stopped."""
+        states = pybullet.getJointStates(self._robot, self._fingers, physicsClientId=self._client)
+        self.gap = float(states[0][0] + states[1][0])
+        if self._handle is None:
+            return
+        self._elapsed += dt
+        target = 0.0 if self.closed else OPEN_POSITION
+        arrived = all(abs(s[0] - target) < 5e-4 for s in states)
+        stalled = self._elapsed > _MIN_TIME and all(abs(s[1]) < _STALLED for s in states)
+        if arrived or stalled:
+            handle, self._handle = self._handle, None
+            handle.resolve(True, f"gap {self.gap * 1000:.1f} mm")
+
+    def _grasped_body(self) -> int | None:
+        touching = []
+        for finger in self._fingers:
+            points = pybullet.getContactPoints(
+                bodyA=self._robot, linkIndexA=finger, physicsClientId=self._client
+            )
+            touching.append({p[2] for p in points if p[2] != self._robot})
+        for body in touching[0] & touching[1]:
+            if is_dynamic(self._client, body):
+                return int(body)
+        return None
+
+    def _drive(self, position: float) -> None:
+        for finger in self._fingers:
+            pybullet.setJointMotorControl2(
+                self._robot,
+                finger,
+                pybullet.POSITION_CONTROL,
+                targetPosition=position,
+                force=_FORCE,
+                maxVelocity=_SPEED,
+                physicsClientId=self._client,
+            )
+
+
+class SimGripper:
+    """The parallel gripper as other threads see it."""
+
+    def __init__(self, physics: PhysicsThread, controller: GripperController) -> None:
+        self._physics = physics
+        self._ctl = controller
+
+    def close(self) -> CommandHandle:
+        """Close the fingers (until they meet or stall on an object)."""
+        handle = CommandHandle("gripper_close")
+        return post_command(self._physics, handle, lambda: self._ctl.command(handle, True))
+
+    def open(self) -> CommandHandle:
+        """Open the fingers fully, releasing what they hold."""
+        handle = CommandHandle("gripper_open")
+        return post_command(self._physics, handle, lambda: self._ctl.command(handle, False))
+
+    def is_closed(self) -> bool:
+        """True after a close command (the gripper's closed state)."""
+        return self._ctl.closed
+
+    def gap(self) -> float:
+        """Distance between the finger pads (m), from the finger position sensors."""
+        return self._ctl.gap
+
+    def is_holding(self) -> bool:
+        """Closed but the fingers stopped apart: something is between them."""
+        return self._ctl.closed and not self._ctl.moving and self._ctl.gap > _HOLD_GAP

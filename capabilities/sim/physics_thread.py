@@ -1,0 +1,236 @@
+"""The one thread that touches pybullet: it drains a command queue and steps the world.
+
+Every other thread talks to pybullet through ``call`` (run a function here and get its
+result) or ``post`` (fire and forget). Step hooks registered by the cell's controllers run
+before each ``stepSimulation`` (control) and after it (sensing). Simulated time advances by
+``time_step`` per step; with a speed factor the loop is paced against the wall clock,
+without one it runs as fast as it can.
+"""
+
+from __future__ import annotations
+
+import heapq
+import itertools
+import logging
+import queue
+import threading
+import time
+from collections.abc import Callable
+from concurrent.futures import Future
+from typing import Any, TypeVar
+
+import pybullet
+
+from capabilities.sim.errors import SimError
+
+__all__ = ["PhysicsThread", "StepHook"]
+
+T = TypeVar("T")
+StepHook = Callable[[float], None]
+_log = logging.getLogger(__name__)
+
+
+class PhysicsThread:
+    """Owns a pybullet DIRECT client and steps it on its own thread.
+
+    Args:
+        setup: run on the physics thread right after connecting, with the client id
+            (builds the world); an exception there makes ``start`` raise.
+        speed: real-time factor (1.0 real time); None runs as fast as possible.
+        time_step: seconds per physics step (1/240 by default).
+    """
+
+    def __init__(
+        self,
+        setup: Callable[[int], None],
+        speed: float | None = None,
+        time_step: float = 1.0 / 240.0,
+    ) -> None:
+        if speed is not None and not speed > 0:
+            raise SimError(f"speed must be above 0 or None, got {speed}")
+        self._setup = setup
+        self.speed = speed
+        self.time_step = time_step
+        self.client = -1
+        self.steps = 0
+        self._time = 0.0
+        self._queue: queue.SimpleQueue[tuple[Callable[[int], Any], Future[Any]] | None]
+        self._queue = queue.SimpleQueue()
+        self._pre_hooks: list[StepHook] = []
+        self._post_hooks: list[StepHook] = []
+        self._timers: list[tuple[float, int, threading.Event]] = []
+        self._timer_ids = itertools.count()
+        self._timer_lock = threading.Lock()
+        self._ready = threading.Event()
+        self._stopping = threading.Event()
+        self._setup_error: BaseException | None = None
+        self._thread = threading.Thread(target=self._run, name="sim-physics", daemon=True)
+
+    # ------------------------------------------------------------------ lifecycle
+
+    def start(self) -> None:
+        """Start the thread and wait until the world is built."""
+        self._thread.start()
+        self._ready.wait()
+        if self._setup_error is not None:
+            self._thread.join()
+            raise SimError(f"building the simulated cell failed: {self._setup_error}") from (
+                self._setup_error
+            )
+
+    def stop(self) -> None:
+        """Stop stepping, disconnect pybullet and join the thread. Idempotent."""
+        if not self._thread.is_alive():
+            return
+        self._stopping.set()
+        self._queue.put(None)
+        self._thread.join()
+
+    @property
+    def running(self) -> bool:
+        """True while the thread steps the world."""
+        return self._thread.is_alive() and not self._stopping.is_set()
+
+    def in_thread(self) -> bool:
+        """True when called from the physics thread itself."""
+        return threading.current_thread() is self._thread
+
+    # ------------------------------------------------------------------ commands
+
+    def time(self) -> float:
+        """Simulated seconds since start."""
+        return self._time
+
+    def post(self, fn: Callable[[int], T]) -> Future[T]:
+        """Queue ``fn(client)`` to run on the physics thread before the next step."""
+        future: Future[T] = Future()
+        if not self.running:
+            future.set_exception(SimError("the simulated cell is not running"))
+            return future
+        self._queue.put((fn, future))
+        return future
+
+    def call(self, fn: Callable[[int], T], timeout: float | None = 60.0) -> T:
+        """Run ``fn(client)`` on the physics thread and return its result (inline if here)."""
+        if self.in_thread():
+            return fn(self.client)
+        return self.post(fn).result(timeout)
+
+    def add_hooks(self, pre: StepHook | None = None, post: StepHook | None = None) -> None:
+        """Register per-step callbacks (call on the physics thread or before ``start``)."""
+        if pre is not None:
+            self._pre_hooks.append(pre)
+        if post is not None:
+            self._post_hooks.append(post)
+
+    def wait_sim(self, seconds: float, timeout: float | None = None) -> bool:
+        """Block until simulated time has advanced by ``seconds``; False on a real-time timeout."""
+        if self.in_thread():
+            raise SimError("wait_sim would block the physics thread")
+        event = threading.Event()
+        with self._timer_lock:
+            heapq.heappush(self._timers, (self._time + seconds, next(self._timer_ids), event))
+        return event.wait(timeout)
+
+    # ------------------------------------------------------------------ loop
+
+    def _run(self) -> None:
+        try:
+            self.client = pybullet.connect(pybullet.DIRECT)
+            pybullet.setTimeStep(self.time_step, physicsClientId=self.client)
+            self._setup(self.client)
+        except Exception as exc:
+            self._setup_error = exc
+            self._stopping.set()
+            self._ready.set()
+            self._disconnect()
+            return
+        self._ready.set()
+        try:
+            self._loop()
+        finally:
+            self._fail_pending()
+            self._disconnect()
+
+    def _loop(self) -> None:
+        wall_start = time.perf_counter()
+        sim_start = self._time
+        while not self._stopping.is_set():
+            self._drain()
+            self._step_once()
+            if self.speed is not None:
+                ahead = (self._time - sim_start) / self.speed - (time.perf_counter() - wall_start)
+                if ahead > 0.002:
+                    self._idle(ahead)
+            elif self.steps % 64 == 0:
+                time.sleep(0)  # let other Python threads have the GIL now and then
+
+    def _idle(self, seconds: float) -> None:
+        """Sleep while ahead of the wall clock, but wake for queued commands."""
+        try:
+            item = self._queue.get(timeout=seconds)
+        except queue.Empty:
+            return
+        if item is None:
+            return
+        self._execute(*item)
+
+    def _drain(self) -> None:
+        while True:
+            try:
+                item = self._queue.get_nowait()
+            except queue.Empty:
+                return
+            if item is None:
+                return
+            self._execute(*item)
+
+    def _execute(self, fn: Callable[[int], Any], future: Future[Any]) -> None:
+        if not future.set_running_or_notify_cancel():
+            return
+        try:
+            future.set_result(fn(self.client))
+        except BaseException as exc:
+            future.set_exception(exc)
+
+    def _step_once(self) -> None:
+        self._run_hooks(self._pre_hooks)
+        pybullet.stepSimulation(physicsClientId=self.client)
+        self.steps += 1
+        self._time = self.steps * self.time_step
+        self._run_hooks(self._post_hooks)
+        self._fire_timers()
+
+    def _run_hooks(self, hooks: list[StepHook]) -> None:
+        for hook in hooks:
+            try:
+                hook(self._time)
+            except Exception:
+                _log.exception("step hook %r raised", hook)
+
+    def _fire_timers(self) -> None:
+        if not self._timers:
+            return
+        with self._timer_lock:
+            while self._timers and self._timers[0][0] <= self._time + 1e-9:
+                heapq.heappop(self._timers)[2].set()
+
+    def _fail_pending(self) -> None:
+        while True:
+            try:
+                item = self._queue.get_nowait()
+            except queue.Empty:
+                break
+            if item is not None and item[1].set_running_or_notify_cancel():
+                item[1].set_exception(SimError("the simulated cell was closed"))
+        with self._timer_lock:
+            for _, _, event in self._timers:
+                event.set()
+            self._timers.clear()
+
+    def _disconnect(self) -> None:
+        if self.client >= 0:
+            try:
+                pybullet.disconnect(physicsClientId=self.client)
+            except pybullet.error:
+                _log.warning("pybullet disconnect failed")

@@ -1,0 +1,180 @@
+"""The simulated cell as capabilities see it: a SimCell, a scene, cameras, interfaces.
+
+``interfaces()`` maps interface names to backends: ``arm``, ``gripper``, ``suction``,
+``freedrive`` (the devices of the SimCell), ``rgbd:shoulder`` and ``rgbd:wrist`` (cameras
+whose ``capture()`` renders on the physics thread), ``world`` (the cell's world model) and
+``workers`` (a thread pool for blocking work such as perception). The clock is simulated
+time. Ground truth stays on ``ground_truth`` and ``scene`` for tests and scores.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping
+from pathlib import Path
+from types import TracebackType
+from typing import Any
+
+import numpy as np
+
+from capabilities.jobs import WorkerPool
+from capabilities.sim.cameras import (
+    CameraConfig,
+    FixedMount,
+    LinkMount,
+    RGBDFrame,
+    SimCamera,
+    shoulder_camera,
+    wrist_camera,
+)
+from capabilities.sim.cell import SimCell
+from capabilities.sim.config import CellConfig
+from capabilities.sim.scene import SceneState, default_scene_path, load_scene
+from capabilities.world_model import WorldModel
+from engine.types import Pose
+
+__all__ = ["SimCameraDevice", "SimCellSession"]
+
+
+class SimCameraDevice:
+    """A camera interface: ``capture()`` blocks the calling thread (never the engine's)
+    while the physics thread renders a frame stamped with simulated time.
+
+    The frame carries the extrinsics the cell *believes* (its configuration, or the result of
+    a calibration), not the simulator's true camera pose: a displaced camera stays wrong
+    until it is calibrated, as on a real cell. A wrist camera's believed pose is the robot's
+    flange pose composed with the believed hand-eye transform.
+    """
+
+    def __init__(self, cell: SimCell, camera: SimCamera) -> None:
+        self._cell = cell
+        self.camera = camera
+        self.name = camera.name
+        mount = camera.mount
+        self.on_wrist = isinstance(mount, LinkMount)
+        self._believed: Pose = mount.T_link_camera if isinstance(mount, LinkMount) else mount.T_world_camera
+
+    @property
+    def intrinsics(self) -> np.ndarray:
+        return self.camera.intrinsics()
+
+    def extrinsics(self) -> Pose:
+        """The camera (OpenCV frame) in the world, as the cell believes it is now."""
+        if self.on_wrist:
+            return self._cell.robot.flange_pose().compose(self._believed)
+        return self._believed
+
+    def set_extrinsics(self, pose: Pose) -> None:
+        """Store a calibration: the world pose (fixed camera) or the flange pose (wrist)."""
+        self._believed = pose
+
+    def capture(self) -> RGBDFrame:
+        def render(client: int) -> RGBDFrame:
+            frame = self.camera.capture(client, stamp=self._cell.time())
+            return dataclasses.replace(frame, T_world_camera=self.extrinsics())
+
+        return self._cell.call(render)
+
+    def displace_for_test(self, true_pose: Pose) -> None:
+        """TEST ONLY: physically move a fixed camera (its believed pose stays as it was)."""
+        if self.on_wrist:
+            raise ValueError("only a fixed camera can be displaced")
+        self.camera = SimCamera(self.camera.name, self.camera.config, FixedMount(true_pose))
+
+
+class SimCellSession:
+    """A running simulated cell with its scene; a context manager.
+
+    Args:
+        scene: a scene name in ``resources/scenes`` or a path.
+        seed: randomisation seed of the scene.
+        speed: 1.0 real time (GUI); None as fast as possible (CLI, tests).
+        config: the cell configuration (default ``resources/cells/sim_default.json``).
+        camera_size: (width, height) of both cameras.
+    """
+
+    name = "sim"
+
+    def __init__(
+        self,
+        scene: str | Path = "cup_to_bin",
+        seed: int = 0,
+        speed: float | None = None,
+        config: CellConfig | None = None,
+        camera_size: tuple[int, int] = (320, 240),
+    ) -> None:
+        self.sim = SimCell(config, speed)
+        self.world_model = WorldModel()
+        self.workers = WorkerPool(2, "costar-sim-worker")
+        self.sim.start()
+        try:
+            path = Path(scene) if Path(str(scene)).suffix == ".json" else default_scene_path(str(scene))
+            holster = self.sim.config.holster_pose.position
+            self.scene: SceneState = self.sim.call(
+                lambda client: load_scene(
+                    client, path, seed, table_top_z=self.sim.table_top_z, make_table=False,
+                    keep_out=((holster[0], holster[1], 0.12),),
+                )
+            )  # fmt: skip
+            width, height = camera_size
+            shoulder = shoulder_camera(CameraConfig(width=width, height=height))
+            wrist = wrist_camera(
+                self.sim.robot_body_id, self.sim.robot.flange_link(),
+                CameraConfig(width=width, height=height, near=0.05, far=2.0),
+            )  # fmt: skip
+            self.cameras = {
+                "shoulder": SimCameraDevice(self.sim, shoulder),
+                "wrist": SimCameraDevice(self.sim, wrist),
+            }
+        except BaseException:
+            self.close()
+            raise
+
+    @property
+    def ground_truth(self) -> Any:
+        """GROUND TRUTH of the devices, for tests and scores only."""
+        return self.sim.ground_truth
+
+    def truth_pose(self, name: str) -> Pose:
+        """GROUND TRUTH of an object's pose, for tests and scores only."""
+        return self.sim.call(lambda client: self.scene.truth_pose(client, name))
+
+    def interfaces(self) -> Mapping[str, Any]:
+        return {
+            "arm": self.sim.robot,
+            "gripper": self.sim.gripper,
+            "suction": self.sim.suction,
+            "freedrive": self.sim.robot,
+            "rgbd:shoulder": self.cameras["shoulder"],
+            "rgbd:wrist": self.cameras["wrist"],
+            "world": self.world_model,
+            "workers": self.workers,
+            "scene_layout": self.scene_layout(),
+            "objects": self.scene.library,
+        }
+
+    def scene_layout(self) -> dict[str, Any]:
+        """What a worker configures about the cell (not ground truth of movable objects):
+        marker sizes, which object carries which marker, and the table markers' poses."""
+        return {
+            "marker_sizes": self.scene.marker_sizes(),
+            "fixed_markers": {m.marker_id: m.pose for m in self.scene.fixed_markers.values()},
+        }
+
+    def clock(self) -> float:
+        return self.sim.time()
+
+    def close(self) -> None:
+        self.workers.close()
+        self.sim.close()
+
+    def __enter__(self) -> SimCellSession:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()

@@ -1,0 +1,134 @@
+"""Builds the cell's fixed world on the physics thread: floor, robot stand, table, robot,
+holster and suction tool.
+
+Layout (default config): the world frame's origin is the UR base, on a stand whose top is
+flush with the table top (z = 0); the table (0.8 x 1.2 m) spans x 0.15..0.95 in front of the
+robot; the floor is 0.75 m below. Scene objects are added later by the scene helper.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import pybullet
+
+from capabilities.sim.config import CellConfig
+from capabilities.sim.kinematics import UR5_JOINT_NAMES
+from capabilities.sim.robot_model import ROBOTS_DIR, robot_urdf_path
+from engine.types import Pose
+
+__all__ = ["World", "build_world"]
+
+# base_link of the URDF is the UR "base" frame turned 180 degrees about z (and back).
+_BASE_LINK_IN_BASE = Pose((0.0, 0.0, 0.0), (0.0, 0.0, 1.0, 0.0))
+_TOOL_IN_HOLSTER = Pose((0.0, 0.0, 0.01))  # the tool's cup tip rests on the 10 mm plate
+
+
+@dataclass(frozen=True)
+class World:
+    """Body ids and link indices of the fixed world."""
+
+    robot: int
+    arm_joints: tuple[int, ...]
+    flange_link: int
+    gripper_link: int
+    finger_joints: tuple[int, int]
+    table: int
+    stand: int
+    floor: int
+    holster: int
+    suction_tool: int
+    table_top_z: float
+
+
+def _box(
+    client: int,
+    half: tuple[float, float, float],
+    center: tuple[float, float, float],
+    rgba: tuple[float, ...],
+) -> int:
+    shape = pybullet.createCollisionShape(
+        pybullet.GEOM_BOX, halfExtents=half, physicsClientId=client
+    )
+    visual = pybullet.createVisualShape(
+        pybullet.GEOM_BOX, halfExtents=half, rgbaColor=rgba, physicsClientId=client
+    )
+    return int(
+        pybullet.createMultiBody(0.0, shape, visual, basePosition=center, physicsClientId=client)
+    )
+
+
+def _static_world(client: int, config: CellConfig) -> tuple[int, int, int]:
+    table = config.table
+    floor_z = table.top_z - table.size[2]
+    plane = pybullet.createCollisionShape(pybullet.GEOM_PLANE, physicsClientId=client)
+    floor = int(
+        pybullet.createMultiBody(0.0, plane, basePosition=(0, 0, floor_z), physicsClientId=client)
+    )
+    half = (table.size[0] / 2, table.size[1] / 2, table.size[2] / 2)
+    table_id = _box(
+        client,
+        half,
+        (table.center[0], table.center[1], table.top_z - half[2]),
+        (0.78, 0.7, 0.58, 1),
+    )
+    base = config.robot_base.position
+    stand_h = max(base[2] - floor_z, 0.01)
+    stand_half = (config.stand_size[0] / 2, config.stand_size[1] / 2, stand_h / 2)
+    stand = _box(client, stand_half, (base[0], base[1], base[2] - stand_h / 2), (0.3, 0.3, 0.33, 1))
+    return floor, table_id, stand
+
+
+def _load_robot(client: int, config: CellConfig) -> tuple[int, dict[str, int]]:
+    base_link = config.robot_base.compose(_BASE_LINK_IN_BASE)
+    robot = pybullet.loadURDF(
+        str(robot_urdf_path()),
+        basePosition=base_link.position,
+        baseOrientation=base_link.orientation,
+        useFixedBase=True,
+        physicsClientId=client,
+    )
+    joints: dict[str, int] = {}
+    for i in range(pybullet.getNumJoints(robot, physicsClientId=client)):
+        info = pybullet.getJointInfo(robot, i, physicsClientId=client)
+        joints[info[1].decode()] = i
+        joints["link:" + info[12].decode()] = i
+    return int(robot), joints
+
+
+def build_world(client: int, config: CellConfig) -> World:
+    """Create every fixed body of the cell (physics thread only)."""
+    pybullet.setGravity(0, 0, -9.81, physicsClientId=client)
+    floor, table, stand = _static_world(client, config)
+    robot, index = _load_robot(client, config)
+    arm = tuple(index[name] for name in UR5_JOINT_NAMES)
+    for joint, value in zip(arm, config.home_joints, strict=True):
+        pybullet.resetJointState(robot, joint, value, physicsClientId=client)
+    holster = config.holster_pose
+    holster_id = pybullet.loadURDF(
+        str(ROBOTS_DIR / "holster.urdf"),
+        basePosition=holster.position,
+        baseOrientation=holster.orientation,
+        useFixedBase=True,
+        physicsClientId=client,
+    )
+    tool_pose = holster.compose(_TOOL_IN_HOLSTER)
+    tool = pybullet.loadURDF(
+        str(ROBOTS_DIR / "suction_tool.urdf"),
+        basePosition=tool_pose.position,
+        baseOrientation=tool_pose.orientation,
+        physicsClientId=client,
+    )
+    return World(
+        robot=robot,
+        arm_joints=arm,
+        flange_link=index["link:tool0"],
+        gripper_link=index["link:gripper_body"],
+        finger_joints=(index["left_finger_joint"], index["right_finger_joint"]),
+        table=table,
+        stand=stand,
+        floor=floor,
+        holster=int(holster_id),
+        suction_tool=int(tool),
+        table_top_z=config.table.top_z,
+    )

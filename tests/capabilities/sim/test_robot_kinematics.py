@@ -1,0 +1,91 @@
+"""The UR5 kinematics agree with pybullet's model of the robot."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pybullet
+
+from capabilities.sim.cell import SimCell
+from capabilities.sim.config import CellConfig
+from capabilities.sim.kinematics import UR5_JOINT_NAMES, UR5Kinematics
+from capabilities.sim.robot_model import build_robot_urdf, find_ur5_urdf, robot_urdf_path
+from capabilities.sim.testing import angle_between, distance
+from engine.types import Pose
+
+
+def _pybullet_flange_poses(cell: SimCell, configs: list[np.ndarray]) -> list[Pose]:
+    """tool0 poses of a second copy of the robot, placed like the cell's, at each config."""
+    base_link = cell.config.robot_base.compose(Pose((0, 0, 0), (0, 0, 1, 0)))
+
+    def measure(client: int) -> list[Pose]:
+        body = pybullet.loadURDF(
+            str(robot_urdf_path()), base_link.position, base_link.orientation, useFixedBase=True,
+            physicsClientId=client,
+        )  # fmt: skip
+        pybullet.setCollisionFilterGroupMask(body, -1, 0, 0, physicsClientId=client)
+        names = {}
+        for i in range(pybullet.getNumJoints(body, physicsClientId=client)):
+            info = pybullet.getJointInfo(body, i, physicsClientId=client)
+            names[info[1].decode()] = i
+            names[info[12].decode()] = i
+        poses = []
+        for q in configs:
+            for name, value in zip(UR5_JOINT_NAMES, q, strict=True):
+                pybullet.resetJointState(body, names[name], float(value), physicsClientId=client)
+            state = pybullet.getLinkState(
+                body, names["tool0"], computeForwardKinematics=True, physicsClientId=client
+            )
+            poses.append(Pose(state[4], state[5]))
+        pybullet.removeBody(body, physicsClientId=client)
+        return poses
+
+    return cell.call(measure)
+
+
+def test_forward_kinematics_matches_pybullet_below_a_tenth_of_a_millimetre(cell: SimCell) -> None:
+    rng = np.random.default_rng(7)
+    configs = [rng.uniform(-math.pi, math.pi, 6) for _ in range(25)]
+    measured = _pybullet_flange_poses(cell, configs)
+    for q, pose in zip(configs, measured, strict=True):
+        mine = cell.kinematics.forward(q)
+        assert distance(mine, pose) < 1e-4
+        assert angle_between(mine, pose) < math.radians(0.01)
+
+
+def test_inverse_kinematics_round_trips_through_pybullet(cell: SimCell) -> None:
+    rng = np.random.default_rng(11)
+    configs = [rng.uniform(-math.pi, math.pi, 6) for _ in range(25)]
+    measured = _pybullet_flange_poses(cell, configs)
+    for q, pose in zip(configs, measured, strict=True):
+        solution = cell.kinematics.inverse(pose, near=q)
+        assert solution is not None
+        assert np.allclose(solution, q, atol=1e-6)
+        again = cell.kinematics.forward(solution)
+        assert distance(again, pose) < 1e-4
+
+
+def test_robot_state_agrees_with_pybullet_link_state(cell: SimCell) -> None:
+    assert distance(cell.robot.flange_pose(), cell.ground_truth.flange_pose()) < 1e-4
+    tcp = cell.robot.tcp_pose()
+    expected = cell.robot.flange_pose().compose(cell.config.tcp_offsets["gripper"])
+    assert distance(tcp, expected) < 1e-9
+
+
+def test_inverse_kinematics_picks_the_solution_nearest_the_given_joints() -> None:
+    kin = UR5Kinematics(CellConfig().robot_base)
+    q = (0.3, -1.2, 1.4, -1.8, -1.5, 0.2)
+    pose = kin.forward(q)
+    shifted = (0.3 - 2 * math.pi, -1.2, 1.4, -1.8, -1.5, 0.2 - 2 * math.pi)
+    solution = kin.inverse(pose, near=shifted)
+    assert solution is not None
+    assert np.allclose(solution, shifted, atol=1e-6)
+    assert kin.inverse(Pose((3.0, 0.0, 0.5)), near=q) is None
+
+
+def test_robot_urdf_has_resolved_meshes_and_the_gripper() -> None:
+    text = build_robot_urdf(find_ur5_urdf(), "<fragment><link name='gripper_body'/></fragment>")
+    assert "package://" not in text
+    assert 'name="world"' not in text
+    assert "gripper_body" in text
