@@ -10,12 +10,13 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator, Mapping
 from typing import Any
 
+from engine.errors import EngineError
 from engine.types import ParamType, check_value
 
 __all__ = ["Blackboard", "BlackboardError", "MISSING"]
 
 
-class BlackboardError(Exception):
+class BlackboardError(EngineError):
     """A read of a missing entry, or a write of the wrong type."""
 
 
@@ -25,6 +26,8 @@ class _Missing:
 
 
 MISSING: Any = _Missing()
+# get()'s "no default given": apart from MISSING, so that get(key, MISSING) returns MISSING.
+_NO_DEFAULT: Any = object()
 
 WriteListener = Callable[[str, Any, str], None]
 
@@ -62,10 +65,13 @@ class Blackboard:
         for listener in self._listeners:
             listener(key, value, writer)
 
-    def get(self, key: str, default: Any = MISSING) -> Any:
-        """The value of ``key``; raises BlackboardError when missing and no default is given."""
+    def get(self, key: str, default: Any = _NO_DEFAULT) -> Any:
+        """The value of ``key``; raises BlackboardError when missing and no default is given.
+
+        ``get(key, MISSING)`` returns MISSING for a missing key (a check without a try).
+        """
         value = self._values.get(key, default)
-        if value is MISSING:
+        if value is _NO_DEFAULT:
             raise BlackboardError(f"parameter {key!r} has no value yet")
         return value
 

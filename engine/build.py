@@ -9,7 +9,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from engine.blackboard import Blackboard
+from engine.blackboard import Blackboard, BlackboardError
 from engine.composites import (
     Parallel,
     ParallelPolicy,
@@ -29,7 +29,8 @@ from engine.decorators import (
     Retry,
     Timeout,
 )
-from engine.kinds import KIND_CONFIG
+from engine.errors import EngineError
+from engine.kinds import KIND_CONFIG, check_config
 from engine.leaves import OperationLeaf, Wait
 from engine.node import Node
 from engine.operations import Direction, OperationNotFound, OperationSource
@@ -51,7 +52,7 @@ _SIMPLE: dict[NodeKind, type[Node]] = {
 }
 
 
-class BuildError(Exception):
+class BuildError(EngineError):
     """A spec node could not be turned into a runtime node."""
 
     def __init__(self, path: str, message: str) -> None:
@@ -60,6 +61,10 @@ class BuildError(Exception):
 
 
 def _settings(spec: NodeSpec) -> dict[str, Any]:
+    # The same check as validation: a Repeat without a count must not become an endless loop.
+    problems = check_config(spec.kind, spec.config)
+    if problems:
+        raise ValueError(problems[0][1])
     values = {f.name: f.default for f in KIND_CONFIG.get(spec.kind, ())}
     values.update({k: v for k, v in spec.config.items() if v is not None})
     return values
@@ -93,6 +98,10 @@ def _operation_leaf(spec: NodeSpec, ctx: TreeContext, source: OperationSource, p
         operation = source.create(spec.op)
     except OperationNotFound as exc:
         raise BuildError(path, f"unknown operation {spec.op!r}") from exc
+    except Exception as exc:  # a capability's factory failed: a build error, never a crash
+        raise BuildError(
+            path, f"cannot create operation {spec.op!r}: {type(exc).__name__}: {exc}"
+        ) from exc
     fixed: dict[str, Any] = {}
     refs: dict[str, str] = {}
     outputs: dict[str, str] = {}
@@ -123,7 +132,10 @@ def _build_node(spec: NodeSpec, ctx: TreeContext, source: OperationSource, path:
             _build_node(child, ctx, source, f"{path}/{child.label}[{index}]")
             for index, child in enumerate(spec.children)
         ]
-        if children or not isinstance(node, (OperationLeaf, Wait)):
+        if isinstance(node, (OperationLeaf, Wait)):
+            if children:
+                raise BuildError(path, f"a {spec.kind.value} node cannot have children")
+        else:
             node.set_children(children)
     except BuildError:
         raise
@@ -154,7 +166,10 @@ def build_tree(
     for decl in plan.parameters:
         board.declare(decl.name, decl.type)
         if decl.value is not None:
-            board.set(decl.name, decl.value, "plan")
+            try:
+                board.set(decl.name, decl.value, "plan")
+            except BlackboardError as exc:
+                raise BuildError(f"parameters/{decl.name}", str(exc)) from exc
     ctx = TreeContext(board, clock) if clock is not None else TreeContext(board)
     top = _build_node(plan.tree, ctx, source, plan.tree.label)
     root = Root(ctx, ROOT_ID, plan.name or "root", plan.run_policy)

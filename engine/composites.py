@@ -178,9 +178,7 @@ class ReactiveSequence(Node):
     def update(self) -> Status:
         children = self.children
         for index, child in enumerate(children):
-            if child.is_condition and child.status is not RUNNING:
-                child.reset()
-            status = child.tick()
+            status = child.recheck() if child.is_condition else child.tick()
             if status is SUCCESS:
                 continue
             _halt_after(children, index)
@@ -199,9 +197,7 @@ class ReactiveSelector(Node):
     def update(self) -> Status:
         children = self.children
         for index, child in enumerate(children):
-            if child.is_condition and child.status is not RUNNING:
-                child.reset()
-            status = child.tick()
+            status = child.recheck() if child.is_condition else child.tick()
             if status is FAILURE:
                 continue
             _halt_after(children, index)

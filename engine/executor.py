@@ -150,12 +150,16 @@ class Executor:
         with self._cond:
             if self._state is ExecutorState.PAUSED:
                 self._paused = False
+                self._steps = 0  # steps not taken yet are void once running again
                 self._state = ExecutorState.RUNNING
                 self._cond.notify()
 
     def step(self) -> None:
-        """One tick while paused."""
+        """One tick while paused; ignored otherwise (a step asked for while running must not
+        turn into a surprise tick after a later pause)."""
         with self._cond:
+            if self._state is not ExecutorState.PAUSED:
+                return
             self._steps += 1
             self._cond.notify()
 

@@ -93,6 +93,30 @@ class Node:
 
     halt = reset
 
+    def recheck(self) -> Status:
+        """Evaluate a finished condition afresh (reset + tick) for reactive composites.
+
+        Listeners hear only of real changes: a condition that held and still holds makes no
+        SUCCESS -> IDLE -> SUCCESS noise every tick.
+        """
+        if self.status is RUNNING:
+            return self.tick()
+        nodes = list(self.iterate())
+        before = [node.status for node in nodes]
+        ctx = self.ctx
+        sink = ctx.status_sink
+        ctx.status_sink = None
+        try:
+            self.reset()
+            status = self.tick()
+        finally:
+            ctx.status_sink = sink
+        if sink is not None:
+            for node, old in zip(nodes, before, strict=True):
+                if node.status is not old:
+                    sink(node, old, node.status)
+        return status
+
     def on_halt(self) -> None:
         """The node was RUNNING and is being reset: stop the work it started."""
 

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TextIO
 
+from engine.errors import EngineError
 from engine.events import (
     BlackboardWritten,
     Event,
@@ -31,7 +32,7 @@ TRACE_FORMAT = "costar-trace"
 TRACE_VERSION = 1
 
 
-class TraceError(Exception):
+class TraceError(EngineError):
     """A trace file cannot be read; the message names the file and line."""
 
 
@@ -146,7 +147,7 @@ def read_trace(path: str | os.PathLike[str]) -> Trace:
         lines = path.read_text(encoding="utf-8").splitlines()
     except OSError as exc:
         raise TraceError(f"{path}: cannot read: {exc.strerror or exc}") from exc
-    records: list[dict[str, Any]] = []
+    records: list[tuple[int, dict[str, Any]]] = []  # (line number in the file, record)
     for number, line in enumerate(lines, start=1):
         if not line.strip():
             continue
@@ -156,18 +157,19 @@ def read_trace(path: str | os.PathLike[str]) -> Trace:
             raise TraceError(f"{path}:{number}: not JSON ({exc.msg})") from exc
         if not isinstance(record, dict):
             raise TraceError(f"{path}:{number}: expected a JSON object")
-        records.append(record)
-    if not records or records[0].get("format") != TRACE_FORMAT:
-        raise TraceError(f"{path}:1: expected a header with format {TRACE_FORMAT!r}")
-    version = records[0].get("format_version")
+        records.append((number, record))
+    first, header = records[0] if records else (1, {})
+    if header.get("format") != TRACE_FORMAT:
+        raise TraceError(f"{path}:{first}: expected a header with format {TRACE_FORMAT!r}")
+    version = header.get("format_version")
     if version != TRACE_VERSION:
         raise TraceError(
-            f"{path}:1: format_version {version!r} is not supported (only {TRACE_VERSION})"
+            f"{path}:{first}: format_version {version!r} is not supported (only {TRACE_VERSION})"
         )
-    for number, record in enumerate(records[1:], start=2):
+    for number, record in records[1:]:
         if "event" not in record:
             raise TraceError(f"{path}:{number}: expected an 'event' field")
-    return Trace(records[0], records[1:])
+    return Trace(header, [record for _, record in records[1:]])
 
 
 def format_timeline(trace: Trace) -> Iterable[str]:

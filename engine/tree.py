@@ -13,7 +13,7 @@ from collections.abc import Iterator
 from engine.blackboard import Blackboard
 from engine.context import TreeContext
 from engine.node import Node
-from engine.status import FAILURE, RUNNING, SUCCESS, Status
+from engine.status import FAILURE, IDLE, RUNNING, SUCCESS, Status
 
 __all__ = ["RunPolicy", "Root", "BehaviorTree"]
 
@@ -83,6 +83,12 @@ class BehaviorTree:
     def reset(self) -> None:
         """Halt what runs and put every node back to IDLE."""
         self.root.reset()
+        # A tick cut short by an exception can leave a RUNNING node under a parent that is
+        # still IDLE (its update never returned), and resetting an IDLE node does nothing:
+        # sweep for such nodes so that their work is halted too.
+        for node in self.root.iterate():
+            if node.status is not IDLE:
+                node.reset()
 
     def iterate(self) -> Iterator[Node]:
         return self.root.iterate()

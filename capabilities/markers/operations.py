@@ -14,6 +14,7 @@ from typing import Any
 from capabilities.base import Capability, CapabilityEnv
 from capabilities.markers.backend import CameraDevice, camera_interface
 from capabilities.markers.calibration import calibrate_extrinsics
+from capabilities.markers.depth import refine_with_depth
 from capabilities.markers.detection import (
     MarkerObservation,
     detect_markers,
@@ -105,6 +106,8 @@ class DetectMarkers:
             frame = camera.capture()
             sizes = env.layout["marker_sizes"]
             observations = detect_markers(frame.rgb, frame.K, sizes)
+            if getattr(frame, "depth", None) is not None:
+                observations = [refine_with_depth(o, frame.depth, frame.K) for o in observations]
             seen = {o.marker_id: (o, marker_pose_world(o, frame.T_world_camera)) for o in observations}
             env.world.set_markers({k: pose for k, (_, pose) in seen.items()}, frame.stamp)
             source = f"markers:{camera.name}"

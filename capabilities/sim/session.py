@@ -90,7 +90,9 @@ class SimCellSession:
         seed: randomisation seed of the scene.
         speed: 1.0 real time (GUI); None as fast as possible (CLI, tests).
         config: the cell configuration (default ``resources/cells/sim_default.json``).
-        camera_size: (width, height) of both cameras.
+        shoulder_size: (width, height) of the shoulder camera (it looks from 1.5 m: a 4 cm
+            marker needs 640x480 to be read).
+        wrist_size: (width, height) of the wrist camera.
     """
 
     name = "sim"
@@ -101,7 +103,8 @@ class SimCellSession:
         seed: int = 0,
         speed: float | None = None,
         config: CellConfig | None = None,
-        camera_size: tuple[int, int] = (320, 240),
+        shoulder_size: tuple[int, int] = (640, 480),
+        wrist_size: tuple[int, int] = (320, 240),
     ) -> None:
         self.sim = SimCell(config, speed)
         self.world_model = WorldModel()
@@ -116,11 +119,10 @@ class SimCellSession:
                     keep_out=((holster[0], holster[1], 0.12),),
                 )
             )  # fmt: skip
-            width, height = camera_size
-            shoulder = shoulder_camera(CameraConfig(width=width, height=height))
+            shoulder = shoulder_camera(CameraConfig(width=shoulder_size[0], height=shoulder_size[1]))
             wrist = wrist_camera(
                 self.sim.robot_body_id, self.sim.robot.flange_link(),
-                CameraConfig(width=width, height=height, near=0.05, far=2.0),
+                CameraConfig(width=wrist_size[0], height=wrist_size[1], near=0.05, far=2.0),
             )  # fmt: skip
             self.cameras = {
                 "shoulder": SimCameraDevice(self.sim, shoulder),
