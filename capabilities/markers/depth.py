@@ -34,7 +34,9 @@ def _inner_pixels(corners: NDArray[np.float64], shape: tuple[int, int]) -> NDArr
     return np.column_stack((rows, cols))
 
 
-def _fit_plane(points: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+def _fit_plane(
+    points: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
     """(point on plane, unit normal) fitted by least squares after dropping outliers."""
     for _ in range(3):
         if len(points) < MIN_POINTS:

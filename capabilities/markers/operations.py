@@ -88,7 +88,9 @@ def _object_detections(
             continue
         name, in_object = carriers[marker_id]
         pose = object_pose_from_marker(world_pose, in_object)
-        candidate = Detection(name, pose, observation.confidence, stamp, source, f"marker {marker_id}")
+        candidate = Detection(
+            name, pose, observation.confidence, stamp, source, f"marker {marker_id}"
+        )
         if name not in best or candidate.confidence > best[name].confidence:
             best[name] = candidate
     return list(best.values())
@@ -108,7 +110,9 @@ class DetectMarkers:
             observations = detect_markers(frame.rgb, frame.K, sizes)
             if getattr(frame, "depth", None) is not None:
                 observations = [refine_with_depth(o, frame.depth, frame.K) for o in observations]
-            seen = {o.marker_id: (o, marker_pose_world(o, frame.T_world_camera)) for o in observations}
+            seen = {
+                o.marker_id: (o, marker_pose_world(o, frame.T_world_camera)) for o in observations
+            }
             env.world.set_markers({k: pose for k, (_, pose) in seen.items()}, frame.stamp)
             source = f"markers:{camera.name}"
             objects = _object_detections(seen, env.markers_on_objects(), frame.stamp, source)
@@ -168,7 +172,9 @@ class CalibrateCamera:
     def start(self, call: OperationCall) -> StartResult:
         camera = self._env.camera(str(call.args["camera"]))
         if camera.on_wrist:
-            raise OperationFailed("the wrist camera is calibrated by hand-eye calibration, not here")
+            raise OperationFailed(
+                "the wrist camera is calibrated by hand-eye calibration, not here"
+            )
         env = self._env
         max_rms = float(call.args["max_error_px"])
 
@@ -178,7 +184,9 @@ class CalibrateCamera:
             observations = detect_markers(frame.rgb, frame.K, env.layout["marker_sizes"])
             pose, report = calibrate_extrinsics([observations], known, frame.K)
             if report.rms_px > max_rms:
-                raise OperationFailed(f"calibration error {report.rms_px:.2f} px is above {max_rms:g} px")
+                raise OperationFailed(
+                    f"calibration error {report.rms_px:.2f} px is above {max_rms:g} px"
+                )
             camera.set_extrinsics(pose)
             call.log(f"{camera.name} camera calibrated from markers {sorted(report.inliers)}: "
                      f"{report.rms_px:.3f} px")  # fmt: skip
