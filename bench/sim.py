@@ -7,7 +7,11 @@ Figures (all with ``speed=None``, as fast as the machine goes):
 - ``moving_steps_per_s``: the same while the arm runs joint moves;
 - ``pick_place_rtf``: real-time factor (simulated s / wall s) of a scripted pick-and-place
   (moveJ + moveL + gripper), and its simulated and wall durations;
-- ``start_s``: wall time to build the cell.
+- ``start_s``: wall time to build the cell;
+- ``camera_fps_320x240`` / ``camera_fps_640x480``: shoulder camera frames per wall second
+  (render + depth conversion), in a client of their own;
+- ``cup_to_bin_rtf``: real-time factor of a headless run of the paper's Figure 3 plan
+  (resources/examples/cup_to_bin.costar.json) through the engine on the simulated cell.
 
 To add a figure (e.g. camera frames per second), write a ``measure_*(cell) -> dict`` function
 and add it to the list that ``measurements()`` returns. Run from the repository root::
@@ -74,9 +78,44 @@ def measure_pick_place(cell: SimCell) -> dict[str, Any]:
     }
 
 
+def measure_cameras(cell: SimCell) -> dict[str, Any]:
+    """Camera frames per second at both sizes (rendered in a client of their own)."""
+    from capabilities.sim.cameras import camera_fps
+
+    return {
+        "camera_fps_320x240": round(camera_fps((320, 240), frames=20), 1),
+        "camera_fps_640x480": round(camera_fps((640, 480), frames=10), 1),
+    }
+
+
+def measure_cup_to_bin(seed: int = 0) -> dict[str, Any]:
+    """Real-time factor of the cup-to-bin plan run by the engine on a fresh simulated cell."""
+    from pathlib import Path
+
+    from capabilities.base import CapabilityRegistry
+    from capabilities.sim.session import SimCellSession
+    from engine.build import build_tree
+    from engine.executor import run_to_end
+    from engine.files import load_plan
+
+    plan_path = Path(__file__).resolve().parents[1] / "resources/examples/cup_to_bin.costar.json"
+    with SimCellSession("cup_to_bin", seed=seed) as session:
+        registry = CapabilityRegistry(cell=session)
+        tree = build_tree(load_plan(plan_path), registry, clock=session.clock)
+        sim0, wall0 = session.clock(), time.perf_counter()
+        result = run_to_end(tree, rate_hz=50.0, timeout=120.0)
+        sim_s, wall_s = session.clock() - sim0, time.perf_counter() - wall0
+    return {
+        "cup_to_bin_status": result.status.value,
+        "cup_to_bin_sim_s": round(sim_s, 2),
+        "cup_to_bin_wall_s": round(wall_s, 3),
+        "cup_to_bin_rtf": round(sim_s / wall_s, 1),
+    }
+
+
 def measurements() -> list[Measurement]:
     """The measurements run, in order, on one cell. Extend this list to add figures."""
-    return [measure_idle_steps, measure_moving_steps, measure_pick_place]
+    return [measure_idle_steps, measure_moving_steps, measure_pick_place, measure_cameras]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -93,6 +132,7 @@ def main(argv: list[str] | None = None) -> int:
             results.update(measure(cell))
     finally:
         cell.close()
+    results.update(measure_cup_to_bin())
     if args.json:
         print(json.dumps(results, indent=2))
     else:

@@ -20,6 +20,7 @@ from engine.operations import (
     Operation,
     OperationManifest,
     OperationNotFound,
+    OperationSource,
 )
 
 __all__ = [
@@ -74,6 +75,9 @@ class CapabilityEnv:
     cell: Cell
     capability: str
     settings: Mapping[str, Any] = field(default_factory=dict)
+    # The registry the operation was made by, for operations that run other operations
+    # (timing.wait_until checks a named condition).
+    operations: OperationSource | None = None
 
     def interface(self, name: str) -> Any:
         """The backend behind an interface; raises CapabilityError when the cell lacks it."""
@@ -215,7 +219,9 @@ class CapabilityRegistry:
 
     def create(self, op_id: str) -> Operation:
         capability, op = self._lookup(op_id)
-        env = CapabilityEnv(self.cell, capability.name, self._settings.get(capability.name, {}))
+        env = CapabilityEnv(
+            self.cell, capability.name, self._settings.get(capability.name, {}), operations=self
+        )
         return op.factory(env)
 
     def aliases(self) -> Mapping[str, str]:

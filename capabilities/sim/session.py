@@ -52,7 +52,9 @@ class SimCameraDevice:
         self.name = camera.name
         mount = camera.mount
         self.on_wrist = isinstance(mount, LinkMount)
-        self._believed: Pose = mount.T_link_camera if isinstance(mount, LinkMount) else mount.T_world_camera
+        self._believed: Pose = (
+            mount.T_link_camera if isinstance(mount, LinkMount) else mount.T_world_camera
+        )
 
     @property
     def intrinsics(self) -> np.ndarray:
@@ -111,7 +113,11 @@ class SimCellSession:
         self.workers = WorkerPool(2, "costar-sim-worker")
         self.sim.start()
         try:
-            path = Path(scene) if Path(str(scene)).suffix == ".json" else default_scene_path(str(scene))
+            path = (
+                Path(scene)
+                if Path(str(scene)).suffix == ".json"
+                else default_scene_path(str(scene))
+            )
             holster = self.sim.config.holster_pose.position
             self.scene: SceneState = self.sim.call(
                 lambda client: load_scene(
@@ -119,7 +125,9 @@ class SimCellSession:
                     keep_out=((holster[0], holster[1], 0.12),),
                 )
             )  # fmt: skip
-            shoulder = shoulder_camera(CameraConfig(width=shoulder_size[0], height=shoulder_size[1]))
+            shoulder = shoulder_camera(
+                CameraConfig(width=shoulder_size[0], height=shoulder_size[1])
+            )
             wrist = wrist_camera(
                 self.sim.robot_body_id, self.sim.robot.flange_link(),
                 CameraConfig(width=wrist_size[0], height=wrist_size[1], near=0.05, far=2.0),
@@ -158,8 +166,14 @@ class SimCellSession:
     def scene_layout(self) -> dict[str, Any]:
         """What a worker configures about the cell (not ground truth of movable objects):
         marker sizes, which object carries which marker, and the table markers' poses."""
+        # Every marker the object library knows, not only those on objects present now: an
+        # object handed in later must be recognised by its marker too.
+        sizes = {m.marker_id: m.size for m in self.scene.fixed_markers.values()}
+        library = self.scene.library
+        for name in library.names():
+            sizes.update({m.marker_id: m.size for m in library.get(name).markers})
         return {
-            "marker_sizes": self.scene.marker_sizes(),
+            "marker_sizes": sizes,
             "fixed_markers": {m.marker_id: m.pose for m in self.scene.fixed_markers.values()},
         }
 

@@ -173,3 +173,25 @@ def test_ctrl_c_halts_cleanly_and_exits_3(tmp_path: Path) -> None:
 def test_help_exits_0(argv: list[str]) -> None:
     code, _, _ = run_cli(*argv)
     assert code == 0
+
+
+EXPECTED_OPS = {
+    "motion.move_to", "motion.move_joints", "motion.move_relative", "motion.go_home", "motion.stop",
+    "motion.current_pose", "motion.current_joints", "motion.is_moving", "motion.is_stopped",
+    "motion.is_home", "gripper.open", "gripper.close", "gripper.is_closed", "gripper.is_holding",
+    "tool.unholster", "tool.holster", "tool.suction_on", "tool.suction_off", "tool.has_part",
+    "markers.detect_markers", "markers.marker_pose", "markers.object_pose", "markers.object_found",
+    "markers.calibrate_camera", "freedrive.start", "freedrive.stop", "freedrive.record_waypoint",
+    "timing.wait", "timing.wait_until",
+}  # fmt: skip
+
+
+def test_ops_lists_every_robot_operation_with_reasons_when_no_cell() -> None:
+    code, out, _ = run_cli("ops", "--json")
+    assert code == 0
+    ops = {entry["id"]: entry for entry in json.loads(out)}
+    assert set(ops) >= EXPECTED_OPS
+    move = ops["motion.move_to"]
+    assert not move["available"] and "arm" in move["reason"]
+    assert {p["name"] for p in move["params"]} >= {"target", "mode", "speed"}
+    assert ops["timing.wait"]["available"]

@@ -55,3 +55,40 @@ def test_example_runs_to_the_stated_result(path: Path) -> None:
     result = run_to_end(build_tree(plan, registry), rate_hz=100.0, timeout=30.0)
     assert result.reason == "finished"
     assert result.status.value == stated.group(1)
+
+
+def test_cell_examples_are_reproduced_by_their_generator() -> None:
+    import importlib.util
+
+    from capabilities.waypoints import WaypointLibrary, waypoints_path_for
+
+    spec = importlib.util.spec_from_file_location("make_cell_examples", EXAMPLES / "make_cell_examples.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    plan_path = EXAMPLES / "cup_to_bin.costar.json"
+    assert dump_plan(module.cup_to_bin()) == plan_path.read_text(encoding="utf-8")
+    stored = WaypointLibrary.load(waypoints_path_for(plan_path))
+    assert list(stored) == module.waypoints()
+
+
+def test_cell_examples_validate_on_the_sim_cell_interfaces() -> None:
+    """Validated against the registry of a cell with the simulated cell's interfaces."""
+    registry = CapabilityRegistry(cell=_InterfacesOnly())
+    plan = load_plan(EXAMPLES / "cup_to_bin.costar.json", aliases=registry.aliases())
+    problems = validate_plan(plan, registry)
+    assert not has_errors(problems), problems
+
+
+class _InterfacesOnly:
+    """A cell that has the simulated cell's interfaces but no simulator (validation only)."""
+
+    name = "sim-like"
+
+    def interfaces(self) -> dict[str, object]:
+        names = ("arm", "gripper", "suction", "freedrive", "rgbd:shoulder", "rgbd:wrist", "world",
+                 "workers", "scene_layout", "objects")  # fmt: skip
+        return {name: object() for name in names}
+
+    def clock(self) -> float:
+        return 0.0

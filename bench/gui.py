@@ -1,0 +1,201 @@
+"""The canvas with a 1000-node plan: time to open until painted, and frame time under status load.
+
+Figures (all in one offscreen QApplication, view 1280 x 800):
+
+- ``open_1000_s``: ``PlanDocument.open`` of a saved 1000-node plan (file read, parse,
+  ``plan_reset``, the canvas building every node and link, fitting the tree in view) until
+  the end of the first paint of the canvas (``view.grab()``).
+- ``frame_ms_median`` / ``frame_ms_p99``: a 30 Hz QTimer calls ``set_statuses`` with all
+  1000 nodes changing status each time (as the runtime bridge would in the worst case), and
+  each frame is timed from the call until the viewport's next paint event has finished (the
+  event loop runs the scene's update processing and the paint). The whole tree is in view
+  (the worst case: every node is repainted, as boxes at that zoom). ``*_zoom100`` figures
+  are the same at 100 % zoom (full detail, only the nodes on screen are painted).
+- ``ngqt_create_node_1000_s``: the peer, NodeGraphQt's own ``NodeGraph.create_node`` with
+  its defaults, 1000 times, in the same process (nodes with one input and one output port).
+
+Run from the repository root::
+
+    .venv/bin/python bench/gui.py [--json] [--frames 90]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import random
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+if __package__ in (None, ""):  # run as a script: make the repository importable
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+
+from PySide6.QtCore import QEvent, QEventLoop, QObject, QRectF, QTimer
+from PySide6.QtWidgets import QApplication
+
+from engine.files import save_plan
+from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
+from engine.status import Status
+from engine.types import ParamType
+
+__all__ = ["build_plan", "measure_open", "measure_frames", "measure_ngqt_create", "main"]
+
+_COMPOSITES = (NodeKind.SEQUENCE, NodeKind.SELECTOR, NodeKind.PARALLEL)
+_OPS = ("motion.move_to", "perception.detect_object", "gripper.close", "predicates.is_free")
+
+
+def build_plan(count: int = 1000, seed: int = 1) -> PlanSpec:
+    """A plan of ``count`` nodes: composites (about 30 %) and operation leaves with two
+    parameters each (a reference and a fixed value), attached at random composites."""
+    rnd = random.Random(seed)
+    root = NodeSpec(NodeKind.SEQUENCE, name="bench root")
+    composites = [root]
+    for _ in range(count - 1):
+        parent = rnd.choice(composites)
+        if rnd.random() < 0.3:
+            node = NodeSpec(rnd.choice(_COMPOSITES))
+            composites.append(node)
+        else:
+            node = NodeSpec(
+                NodeKind.OPERATION,
+                op=rnd.choice(_OPS),
+                params={
+                    "target": Binding.reference("CUP_POSE"),
+                    "object": Binding.fixed("CUP", ParamType.TEXT),
+                },
+            )
+        parent.children.append(node)
+    return PlanSpec(tree=root, name="bench")
+
+
+class _PaintCounter(QObject):
+    """Counts paint events of a widget (the end of a frame)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.count = 0
+
+    def eventFilter(self, watched: QObject, event: QEvent) -> bool:
+        if event.type() == QEvent.Type.Paint:
+            self.count += 1
+        return False
+
+
+def measure_open(app: QApplication, path: Path) -> tuple[float, Any, Any]:
+    """Seconds from ``document.open`` to the end of the first paint; (seconds, doc, view)."""
+    from instructor_app.canvas import CanvasView
+    from instructor_app.document.model import PlanDocument
+
+    document = PlanDocument()
+    view = CanvasView(document)
+    view.resize(1280, 800)
+    view.show()
+    app.processEvents()
+    start = time.perf_counter()
+    document.open(path)
+    view.grab()
+    return time.perf_counter() - start, document, view
+
+
+def measure_frames(app: QApplication, view: Any, ids: list[str], frames: int) -> list[float]:
+    """Frame times (ms) of a 30 Hz timer that changes the status of every node."""
+    counter = _PaintCounter()
+    viewport = view.viewer.viewport()
+    viewport.installEventFilter(counter)
+    cycle = (Status.RUNNING, Status.SUCCESS, Status.FAILURE, Status.IDLE)
+    times: list[float] = []
+    loop = QEventLoop()
+
+    def frame() -> None:
+        status = cycle[len(times) % len(cycle)]
+        before = counter.count
+        start = time.perf_counter()
+        view.set_statuses({node_id: status for node_id in ids})
+        while counter.count == before:  # until the viewport has painted the change
+            app.processEvents(QEventLoop.ProcessEventsFlag.AllEvents, 5)
+        times.append((time.perf_counter() - start) * 1000.0)
+        if len(times) >= frames:
+            loop.quit()
+
+    timer = QTimer()
+    timer.setInterval(33)
+    timer.timeout.connect(frame)
+    timer.start()
+    loop.exec()
+    timer.stop()
+    viewport.removeEventFilter(counter)
+    return times
+
+
+def measure_ngqt_create(count: int = 1000) -> float:
+    """Seconds for NodeGraphQt's plain ``create_node`` (defaults) ``count`` times."""
+    from NodeGraphQt import BaseNode, NodeGraph
+
+    class PeerNode(BaseNode):  # type: ignore[misc]
+        __identifier__ = "bench.peer"
+        NODE_NAME = "node"
+
+        def __init__(self) -> None:
+            super().__init__()
+            self.add_input("parent")
+            self.add_output("children")
+
+    graph = NodeGraph()
+    graph.register_node(PeerNode)
+    start = time.perf_counter()
+    for index in range(count):
+        graph.create_node("bench.peer.PeerNode", pos=(index * 10.0, 0.0))
+    return time.perf_counter() - start
+
+
+def _percentile(values: list[float], fraction: float) -> float:
+    ordered = sorted(values)
+    return ordered[min(len(ordered) - 1, round(fraction * (len(ordered) - 1)))]
+
+
+def run_bench(frames: int) -> dict[str, float]:
+    app = QApplication.instance() or QApplication([])
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "bench.costar.json"
+        save_plan(build_plan(1000), path)
+        open_s, document, view = measure_open(app, path)
+    ids = [node.id for _, node in document.plan.walk()]
+    fit = measure_frames(app, view, ids, frames)
+    root = view.item(ids[0]).sceneBoundingRect()
+    view.viewer.show_rect(QRectF(root.center().x() - 640, root.top() - 40, 1280, 800))
+    zoom100 = measure_frames(app, view, ids, frames)
+    view.clear_statuses()
+    return {
+        "open_1000_s": round(open_s, 3),
+        "frame_ms_median": round(statistics.median(fit), 2),
+        "frame_ms_p99": round(_percentile(fit, 0.99), 2),
+        "frame_ms_median_zoom100": round(statistics.median(zoom100), 2),
+        "frame_ms_p99_zoom100": round(_percentile(zoom100, 0.99), 2),
+        "ngqt_create_node_1000_s": round(measure_ngqt_create(1000), 3),
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Print the figures (``--json``: one JSON object)."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.add_argument("--frames", type=int, default=90, help="frames per measurement")
+    args = parser.parse_args(argv)
+    results = run_bench(args.frames)
+    if args.json:
+        print(json.dumps(results, indent=2))
+    else:
+        for key, value in results.items():
+            print(f"{key:26s} {value}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

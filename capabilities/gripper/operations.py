@@ -1,0 +1,82 @@
+"""Operations of the gripper capability: open, close, is_closed, is_holding."""
+
+from __future__ import annotations
+
+from capabilities.base import Capability, CapabilityEnv
+from capabilities.gripper.backend import GRIPPER, GripperBackend
+from capabilities.jobs import job_from_handle
+from engine.operations import OperationCall, OperationKind, OperationManifest, StartResult
+
+__all__ = ["build_gripper_capability"]
+
+CAP = "gripper"
+
+
+def _m(op: str, kind: OperationKind, doc: str) -> OperationManifest:
+    return OperationManifest(f"{CAP}.{op}", kind, doc, CAP)
+
+
+OPEN = _m("open", OperationKind.ACTION, "Opens the gripper fully, releasing what it holds.")
+CLOSE = _m(
+    "close",
+    OperationKind.ACTION,
+    "Closes the gripper until the fingers meet or stop on an object (see gripper.is_holding).",
+)
+IS_CLOSED = _m("is_closed", OperationKind.CONDITION, "True when the gripper is closed.")
+IS_HOLDING = _m(
+    "is_holding", OperationKind.CONDITION, "True when the closed gripper holds something."
+)
+
+
+class Open:
+    """gripper.open: a Job until the fingers stop."""
+
+    def __init__(self, gripper: GripperBackend) -> None:
+        self._gripper = gripper
+
+    def start(self, call: OperationCall) -> StartResult:
+        return job_from_handle(self._gripper.open(), "open the gripper")
+
+
+class Close:
+    """gripper.close: a Job until the fingers stop (on an object or each other)."""
+
+    def __init__(self, gripper: GripperBackend) -> None:
+        self._gripper = gripper
+
+    def start(self, call: OperationCall) -> StartResult:
+        return job_from_handle(self._gripper.close(), "close the gripper")
+
+
+class IsClosed:
+    """gripper.is_closed."""
+
+    def __init__(self, gripper: GripperBackend) -> None:
+        self._gripper = gripper
+
+    def start(self, call: OperationCall) -> StartResult:
+        return self._gripper.is_closed()
+
+
+class IsHolding:
+    """gripper.is_holding."""
+
+    def __init__(self, gripper: GripperBackend) -> None:
+        self._gripper = gripper
+
+    def start(self, call: OperationCall) -> StartResult:
+        return self._gripper.is_holding()
+
+
+def build_gripper_capability() -> Capability:
+    """The gripper capability (requires ``gripper``)."""
+    cap = Capability(CAP, "Opens and closes the parallel gripper.", requires=(GRIPPER,))
+
+    def gripper(env: CapabilityEnv) -> GripperBackend:
+        return env.interface(GRIPPER)  # type: ignore[no-any-return]
+
+    cap.add(OPEN, lambda env: Open(gripper(env)))
+    cap.add(CLOSE, lambda env: Close(gripper(env)))
+    cap.add(IS_CLOSED, lambda env: IsClosed(gripper(env)))
+    cap.add(IS_HOLDING, lambda env: IsHolding(gripper(env)))
+    return cap

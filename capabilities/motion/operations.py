@@ -1,0 +1,218 @@
+"""Operations of the motion capability: moves, stop, pose and joint queries, conditions.
+
+Every move returns a Job bound to the cell's command handle: the engine polls it, and halting
+the node cancels the command, which stops the arm. Targets that cannot be reached fail the
+node with a message that says "unreachable" and the pose in mm; nothing here raises through
+the tick except :class:`OperationFailed`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+from capabilities.base import Capability, CapabilityEnv, CapabilityError
+from capabilities.jobs import job_from_handle
+from capabilities.motion import manifests as mf
+from capabilities.motion.backend import ARM, WORLD, ArmBackend, WorldBackend
+from capabilities.motion.geometry import format_pose_mm
+from capabilities.motion.symmetry import SymmetryTable
+from capabilities.motion.targets import TargetResolver
+from engine.operations import OperationCall, OperationFailed, StartResult
+from engine.types import JointConfig, Pose
+
+__all__ = ["build_motion_capability", "scale"]
+
+_MAX_SCALE = 2.0
+
+
+def scale(call: OperationCall, port: str) -> float:
+    """A speed or acceleration fraction from a port, checked to be in (0, 2]."""
+    value = call.args.get(port, 1.0)
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise OperationFailed(f"{port} must be a number, not {value!r}")
+    if not 0 < value <= _MAX_SCALE or not math.isfinite(value):
+        raise OperationFailed(f"{port} must be above 0 and at most {_MAX_SCALE:g}, not {value}")
+    return float(value)
+
+
+def _joint_move(arm: ArmBackend, q: Sequence[float], call: OperationCall, describe: str) -> Any:
+    handle = arm.move_joints(
+        q, mf.JOINT_SPEED * scale(call, "speed"), mf.JOINT_ACCEL * scale(call, "accel")
+    )
+    return job_from_handle(handle, describe)
+
+
+def _linear_move(arm: ArmBackend, pose: Pose, call: OperationCall, describe: str) -> Any:
+    handle = arm.move_linear(
+        pose, mf.LINEAR_SPEED * scale(call, "speed"), mf.LINEAR_ACCEL * scale(call, "accel")
+    )
+    return job_from_handle(handle, describe)
+
+
+class MoveTo:
+    """motion.move_to: a pose or a waypoint in any frame, by a joint or a linear move."""
+
+    def __init__(self, arm: ArmBackend, resolver: TargetResolver) -> None:
+        self._arm = arm
+        self._resolver = resolver
+
+    def start(self, call: OperationCall) -> StartResult:
+        mode = str(call.args.get("mode", "joint"))
+        if mode not in ("joint", "linear"):
+            raise OperationFailed(f"mode must be 'joint' or 'linear', not {mode!r}")
+        current = self._arm.tcp_pose()
+        target = self._resolver.resolve(call.args["target"], call.args.get("reference"), current)
+        if target.joints is not None:
+            return _joint_move(
+                self._arm, target.joints.positions, call, f"move to {target.describe}"
+            )
+        for index, pose in enumerate(target.poses):
+            q = self._arm.inverse_kinematics(pose)
+            if q is None:
+                continue
+            if index:
+                call.log(f"symmetric equivalent {index} of {target.describe} is used")
+            describe = f"move to {target.describe}"
+            if mode == "linear":
+                return _linear_move(self._arm, pose, call, describe)
+            return _joint_move(self._arm, q, call, describe)
+        tried = (
+            f" (none of {len(target.poses)} symmetric equivalents)" if len(target.poses) > 1 else ""
+        )
+        raise OperationFailed(
+            f"unreachable: {target.describe}: tool pose {format_pose_mm(target.poses[0])}{tried}"
+        )
+
+
+class MoveJoints:
+    """motion.move_joints: a joint move to a JointConfig."""
+
+    def __init__(self, arm: ArmBackend) -> None:
+        self._arm = arm
+
+    def start(self, call: OperationCall) -> StartResult:
+        target = call.args["target"]
+        if not isinstance(target, JointConfig):
+            raise OperationFailed(f"target must be joint positions, not {type(target).__name__}")
+        return _joint_move(self._arm, target.positions, call, "move_joints")
+
+
+class MoveRelative:
+    """motion.move_relative: a straight-line offset in the world or the tool frame."""
+
+    def __init__(self, arm: ArmBackend) -> None:
+        self._arm = arm
+
+    def start(self, call: OperationCall) -> StartResult:
+        offset = (float(call.args["dx"]), float(call.args["dy"]), float(call.args["dz"]))
+        frame = str(call.args.get("frame", "world"))
+        now = self._arm.tcp_pose()
+        if frame == "world":
+            x, y, z = now.position
+            target = Pose((x + offset[0], y + offset[1], z + offset[2]), now.orientation)
+        elif frame == "tool":
+            target = now.compose(Pose(offset))
+        else:
+            raise OperationFailed(f"frame must be 'world' or 'tool', not {frame!r}")
+        if self._arm.inverse_kinematics(target) is None:
+            raise OperationFailed(f"unreachable: pose {format_pose_mm(target)}")
+        mm = ", ".join(f"{v * 1000:.1f}" for v in offset)
+        return _linear_move(self._arm, target, call, f"move by ({mm}) mm in the {frame} frame")
+
+
+class GoHome:
+    """motion.go_home: a joint move to the configured home."""
+
+    def __init__(self, arm: ArmBackend) -> None:
+        self._arm = arm
+
+    def start(self, call: OperationCall) -> StartResult:
+        return _joint_move(self._arm, self._arm.home_joints(), call, "go home")
+
+
+class Stop:
+    """motion.stop: decelerate to a halt; SUCCESS when standing."""
+
+    def __init__(self, arm: ArmBackend) -> None:
+        self._arm = arm
+
+    def start(self, call: OperationCall) -> StartResult:
+        return job_from_handle(self._arm.stop(), "stop")
+
+
+class CurrentPose:
+    """motion.current_pose: writes the TCP pose."""
+
+    def __init__(self, arm: ArmBackend) -> None:
+        self._arm = arm
+
+    def start(self, call: OperationCall) -> StartResult:
+        call.write("pose", self._arm.tcp_pose())
+        return True
+
+
+class CurrentJoints:
+    """motion.current_joints: writes the joint positions."""
+
+    def __init__(self, arm: ArmBackend) -> None:
+        self._arm = arm
+
+    def start(self, call: OperationCall) -> StartResult:
+        call.write("joints", JointConfig(self._arm.joint_positions()))
+        return True
+
+
+class IsMoving:
+    """motion.is_moving (or, with ``negate``, motion.is_stopped)."""
+
+    def __init__(self, arm: ArmBackend, negate: bool = False) -> None:
+        self._arm = arm
+        self._negate = negate
+
+    def start(self, call: OperationCall) -> StartResult:
+        return self._arm.is_moving() != self._negate
+
+
+class IsHome:
+    """motion.is_home: every joint within ``tolerance`` rad of home."""
+
+    def __init__(self, arm: ArmBackend) -> None:
+        self._arm = arm
+
+    def start(self, call: OperationCall) -> StartResult:
+        tolerance = float(call.args.get("tolerance", 0.01))
+        now, home = self._arm.joint_positions(), self._arm.home_joints()
+        return max(abs(a - b) for a, b in zip(now, home, strict=True)) <= tolerance
+
+
+def _world(env: CapabilityEnv) -> WorldBackend | None:
+    try:
+        return env.interface(WORLD)  # type: ignore[no-any-return]
+    except CapabilityError:
+        return None  # relative waypoints then need their reference bound
+
+
+def build_motion_capability(symmetries: SymmetryTable | None = None) -> Capability:
+    """The motion capability (requires ``arm``; reads ``world`` when the cell has one)."""
+    table = symmetries if symmetries is not None else SymmetryTable()
+    cap = Capability(
+        mf.CAP, "Moves the robot arm: poses, waypoints, joints, home.", requires=(ARM,)
+    )
+    m = mf.MANIFESTS
+
+    def arm(env: CapabilityEnv) -> ArmBackend:
+        return env.interface(ARM)  # type: ignore[no-any-return]
+
+    cap.add(m["move_to"], lambda env: MoveTo(arm(env), TargetResolver(_world(env), table)))
+    cap.add(m["move_joints"], lambda env: MoveJoints(arm(env)))
+    cap.add(m["move_relative"], lambda env: MoveRelative(arm(env)))
+    cap.add(m["go_home"], lambda env: GoHome(arm(env)))
+    cap.add(m["stop"], lambda env: Stop(arm(env)))
+    cap.add(m["current_pose"], lambda env: CurrentPose(arm(env)))
+    cap.add(m["current_joints"], lambda env: CurrentJoints(arm(env)))
+    cap.add(m["is_moving"], lambda env: IsMoving(arm(env)))
+    cap.add(m["is_stopped"], lambda env: IsMoving(arm(env), negate=True))
+    cap.add(m["is_home"], lambda env: IsHome(arm(env)))
+    return cap

@@ -1,0 +1,156 @@
+"""timing: wait on the cell's clock; wait_until polls a condition of the same registry."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping
+from typing import Any
+
+import pytest
+
+from capabilities.base import Capability, CapabilityRegistry, NullCell
+from capabilities.debug import capability as debug
+from capabilities.sim.session import SimCellSession
+from capabilities.timing import capability as timing
+from engine.build import build_tree
+from engine.operations import OperationKind, OperationManifest
+from engine.spec import NodeKind, NodeSpec, PlanSpec
+from engine.status import Status
+from engine.tree import BehaviorTree
+from tests.capabilities.motion.plans import build, down_at, op, registry_for, run_plan, sim_steps
+
+
+class ProbeCell:
+    """A cell with a hand-set clock and one flag that a condition reads."""
+
+    name = "probe"
+
+    def __init__(self) -> None:
+        self.now = 0.0
+        self.flag = False
+
+    def interfaces(self) -> Mapping[str, Any]:
+        return {"probe": self}
+
+    def clock(self) -> float:
+        return self.now
+
+
+def _probe() -> Capability:
+    cap = Capability("probe", "a flag", requires=("probe",))
+    manifest = OperationManifest("probe.is_set", OperationKind.CONDITION, "the flag", "probe")
+
+    class IsSet:
+        def __init__(self, cell: ProbeCell) -> None:
+            self.cell = cell
+
+        def start(self, call: object) -> bool:
+            return self.cell.flag
+
+    cap.add(manifest, lambda env: IsSet(env.interface("probe")))
+    return cap
+
+
+def _tree(cell: Any, node: NodeSpec) -> BehaviorTree:
+    registry = CapabilityRegistry([timing(), debug(), _probe()], cell=cell)
+    return build_tree(PlanSpec(node, "t"), registry, clock=cell.clock)
+
+
+def test_wait_counts_seconds_on_the_cells_clock() -> None:
+    cell = ProbeCell()
+    tree = _tree(cell, op("timing.wait", seconds=1.5))
+    assert tree.tick() is Status.RUNNING
+    cell.now = 1.49
+    assert tree.tick() is Status.RUNNING
+    cell.now = 1.5
+    assert tree.tick() is Status.SUCCESS
+
+
+def test_wait_until_succeeds_when_the_condition_turns_true() -> None:
+    cell = ProbeCell()
+    tree = _tree(cell, op("timing.wait_until", condition="probe.is_set", timeout=2.0))
+    assert tree.tick() is Status.RUNNING
+    cell.now, cell.flag = 1.0, True
+    assert tree.tick() is Status.SUCCESS
+
+
+def test_wait_until_fails_after_the_timeout() -> None:
+    cell = ProbeCell()
+    node = op("timing.wait_until", "until", condition="probe.is_set", timeout=2.0)
+    tree = _tree(cell, node)
+    assert tree.tick() is Status.RUNNING
+    cell.now = 1.99
+    assert tree.tick() is Status.RUNNING
+    cell.now = 2.0
+    assert tree.tick() is Status.FAILURE
+    assert tree.nodes[node.id].message == "timed out after 2 s waiting for probe.is_set"
+
+
+def test_wait_until_checks_once_per_tick_with_the_condition_defaults() -> None:
+    cell = ProbeCell()
+    tree = _tree(cell, op("timing.wait_until", condition="debug.succeed_after"))
+    assert [tree.tick() for _ in range(3)] == [Status.RUNNING, Status.RUNNING, Status.SUCCESS]
+
+
+@pytest.mark.parametrize(
+    ("condition", "expected"),
+    [
+        ("no.such_op", "there is no operation 'no.such_op'"),
+        ("debug.succeed", "debug.succeed is an action, not a condition"),
+        ("debug.check_param", "debug.check_param needs value, expected"),
+        ("", "needs the id of a condition operation"),
+    ],
+)
+def test_wait_until_refuses_what_it_cannot_run(condition: str, expected: str) -> None:
+    node = op("timing.wait_until", "until", condition=condition)
+    tree = _tree(ProbeCell(), node)
+    assert tree.tick() is Status.FAILURE
+    assert expected in tree.nodes[node.id].message
+
+
+def test_wait_until_finds_conditions_of_its_own_registry() -> None:
+    from capabilities.debug import capability as debug
+
+    registry = CapabilityRegistry([timing(), debug()], cell=NullCell())
+    node = op("timing.wait_until", condition="debug.succeed_after")
+    tree = build_tree(PlanSpec(node, "t"), registry)
+    assert [tree.tick() for _ in range(3)] == [Status.RUNNING, Status.RUNNING, Status.SUCCESS]
+
+
+# ---------------------------------------------------------------- on the simulated cell
+
+
+@pytest.fixture
+def session() -> Iterator[SimCellSession]:
+    with SimCellSession("empty") as cell:
+        yield cell
+
+
+@pytest.mark.sim
+def test_wait_on_the_simulated_clock(session: SimCellSession) -> None:
+    tree = build(session, op("timing.wait", seconds=2.0))
+    start = session.clock()
+    assert tree.tick() is Status.RUNNING
+    for _ in sim_steps(session, 0.1, 3.0):
+        before = session.clock()
+        status = tree.tick()
+        if status is Status.SUCCESS:
+            assert session.clock() >= start + 2.0
+            return
+        assert status is Status.RUNNING and before < start + 2.0 + 1e-9
+    pytest.fail("the wait did not end")
+
+
+@pytest.mark.sim
+def test_wait_until_the_arm_moves_in_parallel_with_a_move(session: SimCellSession) -> None:
+    registry = registry_for(session)
+    parallel = NodeSpec(
+        NodeKind.PARALLEL,
+        config={"success": "all", "failure": "any"},
+        children=[
+            op("motion.move_to", target=down_at(0.4, -0.2, 0.25), speed=0.3),  # long enough to see
+            op("timing.wait_until", "until moving", condition="motion.is_moving", timeout=5.0),
+        ],
+    )
+    run = run_plan(session, parallel, registry)
+    assert run.status is Status.SUCCESS, run.failure()
+    assert run.messages()["until moving"] == "motion.is_moving became true"
