@@ -1,38 +1,184 @@
 """``costar-instructor``: the desktop application.
 
-The canvas, palette and inspector arrive with the Instructor issue; until then this entry
-point checks that the plan given (if any) loads and says what to use meanwhile.
+``costar-instructor [PLAN] [--cell sim|none] [--seed N] [--run] [--screenshot PNG]``
+
+Without ``--screenshot`` it opens the window and runs the event loop. With it, it renders the
+main window to a PNG and exits, after the run finished when ``--run`` is given, so that a
+picture can be taken on a machine without a screen (``QT_QPA_PLATFORM=offscreen`` is set
+when there is no display). Exit codes: 0 ok; 1 the run was refused or did not succeed (with
+``--screenshot --run``); 2 bad arguments or an unreadable plan (with ``--screenshot``);
+3 the run did not finish within ``--timeout`` (the picture is still written).
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import sys
+import tempfile
 from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
 
-__all__ = ["main"]
+from PySide6.QtCore import QEventLoop, QSettings, QTimer
+from PySide6.QtWidgets import QApplication, QWidget
+
+from engine.status import Status
+from instructor_app.document.model import DocumentError
+from instructor_app.main_window import Dialogs, MainWindow
+from instructor_app.runtime.controller import RunOutcome
+from instructor_app.runtime.session import CellSession
+from instructor_app.settings import APPLICATION, ORGANIZATION, AppSettings
+
+__all__ = [
+    "main",
+    "HeadlessDialogs",
+    "EXIT_OK",
+    "EXIT_RUN_FAILED",
+    "EXIT_BAD_INPUT",
+    "EXIT_TIMEOUT",
+]
+
+EXIT_OK, EXIT_RUN_FAILED, EXIT_BAD_INPUT, EXIT_TIMEOUT = 0, 1, 2, 3
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="costar-instructor",
+        description="Teach a robot a task by composing a behavior tree.",
+    )
+    parser.add_argument("plan", nargs="?", help="a plan file (*.costar.json) to open")
+    parser.add_argument("--cell", choices=("sim", "none"), default="sim",
+                        help="the cell to work with (default: sim, the simulated cell)")  # fmt: skip
+    parser.add_argument("--seed", type=int, default=0, help="scene seed of the simulated cell")
+    parser.add_argument("--run", action="store_true", help="run the plan once it is open")
+    parser.add_argument("--screenshot", metavar="PNG",
+                        help="render the window to PNG and exit (after the run with --run)")  # fmt: skip
+    parser.add_argument("--timeout", type=float, default=120.0,
+                        help="with --screenshot --run: give up after this many seconds (exit 3)")  # fmt: skip
+    return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="costar-instructor", description=__doc__)
-    parser.add_argument("plan", nargs="?", help="a plan file (*.costar.json) to open")
-    args = parser.parse_args(argv)
-    print(
-        "CoSTAR Instructor: the graphical editor is not built yet (it comes with the Instructor issue)."
+    """Run the Instructor; returns the exit code."""
+    try:
+        args = _parser().parse_args(argv)
+    except SystemExit as exc:  # argparse exits on --help (0) and on bad arguments (2)
+        return int(exc.code or 0)
+    if args.screenshot and not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
+        os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+    app = QApplication.instance() or QApplication(
+        [sys.argv[0] if sys.argv else "costar-instructor"]
     )
-    print(
-        "Meanwhile, plans run from the command line: costar validate PLAN, costar run PLAN, costar ops."
-    )
-    if args.plan:
-        from engine.files import PlanFileError, load_plan
+    app.setOrganizationName(ORGANIZATION)
+    app.setApplicationName(APPLICATION)
+    if args.screenshot:
+        return _screenshot(args)
+    return _interactive(args)
 
+
+def _interactive(args: argparse.Namespace) -> int:
+    session = CellSession(args.cell, seed=args.seed, speed=1.0)  # real time on screen
+    failures: list[str] = []
+    session.cell_failed.connect(failures.append)
+    session.open()
+    try:
+        window = MainWindow(session)
+        window.show()
+        for message in failures:  # the window did not exist yet when the cell failed
+            print(f"error: {message}", file=sys.stderr)
+            window.views.log.append(f"{message}; using no cell", "error")
+            window.show_message(f"{message}; using no cell")
+        QTimer.singleShot(0, window.offer_recoveries)
+        if args.plan:
+            QTimer.singleShot(
+                0, lambda: window.open_plan(args.plan) and args.run and window.controller.run()
+            )
+        return QApplication.exec()
+    finally:
+        session.close()
+
+
+def _screenshot(args: argparse.Namespace) -> int:
+    # As fast as possible when running for a picture; real time otherwise (nothing moves).
+    session = CellSession(args.cell, seed=args.seed, speed=None if args.run else 1.0)
+    session.cell_failed.connect(lambda message: print(f"error: {message}", file=sys.stderr))
+    session.open()
+    with tempfile.TemporaryDirectory(prefix="costar-shot-") as scratch:
+        # A throwaway settings file and recovery folder: a picture never touches the user's.
+        settings = AppSettings(QSettings(str(Path(scratch, "s.ini")), QSettings.Format.IniFormat))
+        window = MainWindow(session, settings, HeadlessDialogs(), Path(scratch, "recovery"))
         try:
-            plan = load_plan(args.plan)
-        except PlanFileError as exc:
-            print(f"error: {exc}", file=sys.stderr)
-            return 2
-        print(f"{args.plan}: {plan.name or 'plan'} loads ({sum(1 for _ in plan.walk())} nodes).")
-    return 0
+            if args.plan:
+                try:
+                    window.document.open(args.plan)
+                except DocumentError as exc:
+                    print(f"error: {exc}", file=sys.stderr)
+                    return EXIT_BAD_INPUT
+            window.resize(1400, 900)
+            window.show()
+            code = _run_for_picture(window, args.timeout) if args.run else EXIT_OK
+            _grab(window, Path(args.screenshot))
+            return code
+        finally:
+            window.controller.shutdown()
+            window.autosaver.stop()
+            window.hide()
+            window.deleteLater()
+            session.close()
+
+
+def _run_for_picture(window: MainWindow, timeout: float) -> int:
+    controller = window.controller
+    loop = QEventLoop()
+    outcome: list[RunOutcome] = []
+    refused: list[Any] = []
+
+    def finished(result: object) -> None:
+        assert isinstance(result, RunOutcome)
+        outcome.append(result)
+        loop.quit()
+
+    controller.run_finished.connect(finished)
+    controller.run_refused.connect(refused.extend)
+    timer = QTimer()
+    timer.setSingleShot(True)
+    timer.timeout.connect(loop.quit)
+    timer.start(int(timeout * 1000))
+    if not controller.run():
+        for problem in refused:
+            print(problem, file=sys.stderr)
+        return EXIT_RUN_FAILED
+    loop.exec()
+    if not outcome:
+        print(f"error: the run did not finish within {timeout:g} s", file=sys.stderr)
+        return EXIT_TIMEOUT
+    print(f"run ended: {outcome[0].status.value} after {outcome[0].event.tick} ticks")
+    return EXIT_OK if outcome[0].status is Status.SUCCESS else EXIT_RUN_FAILED
+
+
+def _grab(window: MainWindow, path: Path) -> None:
+    if window.views.validation.pending():  # the problems list shows the plan as it is
+        window.views.validation.revalidate()
+    window.views.canvas.fit_all()
+    QApplication.processEvents()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if not window.grab().save(str(path), "PNG"):
+        raise OSError(f"could not write {path}")
+    print(f"wrote {path}")
+
+
+class HeadlessDialogs(Dialogs):
+    """No person to ask: never save, never restore, errors go to stderr."""
+
+    def ask_save_changes(self, parent: QWidget, name: str) -> str:
+        return "discard"
+
+    def ask_restore(self, parent: QWidget, description: str) -> bool:
+        return False
+
+    def error(self, parent: QWidget, title: str, text: str) -> None:
+        print(f"error: {title}: {text}", file=sys.stderr)
 
 
 if __name__ == "__main__":

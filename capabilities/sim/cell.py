@@ -143,6 +143,10 @@ class SimCell:
         """Run callbacks on the physics thread before/after every step, with the sim time."""
         self._physics.call(lambda _c: self._physics.add_hooks(pre, post))
 
+    def remove_step_hook(self, pre: StepHook | None = None, post: StepHook | None = None) -> None:
+        """Stop callbacks added by :meth:`add_step_hook`."""
+        self._physics.call(lambda _c: self._physics.remove_hooks(pre, post))
+
     def tcp_offset(self) -> Pose:
         """The TCP of the tool in use, in the flange frame."""
         return matrix_to_pose(self._tcp_matrix())

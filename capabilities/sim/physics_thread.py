@@ -123,6 +123,13 @@ class PhysicsThread:
         if post is not None:
             self._post_hooks.append(post)
 
+    def remove_hooks(self, pre: StepHook | None = None, post: StepHook | None = None) -> None:
+        """Take hooks out again (call on the physics thread); unknown ones are ignored."""
+        if pre is not None and pre in self._pre_hooks:
+            self._pre_hooks.remove(pre)
+        if post is not None and post in self._post_hooks:
+            self._post_hooks.remove(post)
+
     def wait_sim(self, seconds: float, timeout: float | None = None) -> bool:
         """Block until simulated time has advanced by ``seconds``; False on a real-time timeout."""
         if self.in_thread():

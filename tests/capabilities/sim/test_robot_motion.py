@@ -33,8 +33,13 @@ def test_move_linear_reaches_the_target_on_a_straight_line(cell: SimCell) -> Non
     start = robot.tcp_pose()
     target = down_at(0.6, -0.1, 0.1, yaw=0.5)
     samples: list[tuple[float, ...]] = []
-    cell.add_step_hook(post=lambda _t: samples.append(robot.tcp_pose().position))
+
+    def record(_t: float) -> None:
+        samples.append(robot.tcp_pose().position)
+
+    cell.add_step_hook(post=record)
     run(robot.move_linear(target, speed=0.3))
+    cell.remove_step_hook(post=record)  # else the list grows while it is read below
     assert distance(robot.tcp_pose(), target) < TOL_M
     assert angle_between(robot.tcp_pose(), target) < TOL_RAD
     a, b = np.array(start.position), np.array(target.position)

@@ -1,0 +1,135 @@
+"""How a plan node looks on the canvas: colours, symbols and text (the paper's Figure 3).
+
+Logic nodes are white (composites) or grey (decorators) and carry their symbol: sequence
+"->", selector "?", parallel "|A|"; decorators are named. Operation leaves are coloured by
+the operation's kind (action, query, condition) and show the operation id and their bound
+parameters: references bare (CUP_POSE), fixed values in quotes ("CUP"). Run statuses
+recolour the node body. Colours are plain RGB tuples here; the items turn them into QColors.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from engine.operations import OperationKind
+from engine.spec import Binding, Category, NodeKind, NodeSpec
+from engine.status import Status
+
+__all__ = [
+    "RGB",
+    "NodeLook",
+    "STATUS_COLOURS",
+    "look_of",
+    "default_title",
+    "binding_text",
+]
+
+RGB = tuple[int, int, int]
+
+STATUS_COLOURS: dict[Status, RGB] = {
+    Status.IDLE: (176, 176, 176),
+    Status.RUNNING: (255, 190, 40),
+    Status.SUCCESS: (96, 192, 96),
+    Status.FAILURE: (226, 84, 72),
+}
+
+_COMPOSITE_FILL: RGB = (250, 250, 250)
+_DECORATOR_FILL: RGB = (214, 214, 214)
+_WAIT_FILL: RGB = (205, 214, 228)
+_OPERATION_FILL: dict[OperationKind, RGB] = {
+    OperationKind.ACTION: (160, 196, 244),
+    OperationKind.QUERY: (206, 180, 240),
+    OperationKind.CONDITION: (170, 226, 220),
+}
+
+_SYMBOLS: dict[NodeKind, str] = {
+    NodeKind.SEQUENCE: "->",
+    NodeKind.SELECTOR: "?",
+    NodeKind.PARALLEL: "|A|",
+    NodeKind.REACTIVE_SEQUENCE: "R->",
+    NodeKind.REACTIVE_SELECTOR: "R?",
+}
+
+_MAX_PARAM_LINES = 4
+
+
+@dataclass(frozen=True)
+class NodeLook:
+    """What a node item draws.
+
+    Attributes:
+        title: the editable label (the user's name, else the kind or operation id).
+        symbol: the logic symbol ("->", "?", "|A|") or "" for leaves and decorators.
+        subtitle: a second line: the operation id under a user name, a decorator's
+            settings, a Wait's seconds.
+        lines: bound parameters, one per line (at most a few, then "...").
+        fill: body colour when no status is shown.
+        header: colour of the band that keeps the category visible under a status colour.
+        leaf: whether the node takes no children (no child port).
+    """
+
+    title: str
+    symbol: str
+    subtitle: str
+    lines: tuple[str, ...]
+    fill: RGB
+    header: RGB
+    leaf: bool
+
+
+def default_title(node: NodeSpec) -> str:
+    """The label shown when the user gave no name."""
+    if node.kind is NodeKind.OPERATION:
+        return node.op or "operation"
+    return node.kind.value.replace("_", " ").capitalize()
+
+
+def binding_text(binding: Binding) -> str:
+    """A parameter as the paper writes it: a reference bare, a fixed value in quotes."""
+    if binding.is_ref:
+        return str(binding.ref)
+    value = binding.value
+    if isinstance(value, str):
+        return f'"{value}"'
+    if isinstance(value, bool | int | float):
+        return f'"{value:g}"' if isinstance(value, float) else f'"{value}"'
+    name = getattr(value, "name", None)  # waypoints and object models carry a name
+    if isinstance(name, str) and name:
+        return f'"{name}"'
+    return f"<{binding.type.value if binding.type is not None else 'value'}>"
+
+
+def _config_text(node: NodeSpec) -> str:
+    if not node.config:
+        return ""
+    return ", ".join(f"{key} {value}" for key, value in sorted(node.config.items()))
+
+
+def _param_lines(node: NodeSpec) -> tuple[str, ...]:
+    lines = [f"{port}: {binding_text(binding)}" for port, binding in node.params.items()]
+    if len(lines) > _MAX_PARAM_LINES:
+        lines = [*lines[: _MAX_PARAM_LINES - 1], f"... {len(lines) - _MAX_PARAM_LINES + 1} more"]
+    return tuple(lines)
+
+
+def look_of(node: NodeSpec, op_kind: OperationKind | None = None) -> NodeLook:
+    """The look of ``node``; ``op_kind`` is its operation's kind when known."""
+    title = node.name or default_title(node)
+    category = node.category
+    if category is Category.COMPOSITE:
+        symbol = _SYMBOLS.get(node.kind, "")
+        return NodeLook(
+            title, symbol, _config_text(node), (), _COMPOSITE_FILL, (120, 120, 120), False
+        )
+    if category is Category.DECORATOR:
+        subtitle = _config_text(node)
+        if node.name:
+            subtitle = f"{default_title(node)} {subtitle}".strip()
+        return NodeLook(title, "", subtitle, (), _DECORATOR_FILL, (120, 120, 120), False)
+    if node.kind is NodeKind.WAIT:
+        return NodeLook(title, "", _config_text(node), (), _WAIT_FILL, _WAIT_FILL, True)
+    fill = _OPERATION_FILL.get(
+        op_kind or OperationKind.ACTION, _OPERATION_FILL[OperationKind.ACTION]
+    )
+    subtitle = (node.op or "") if node.name else ""
+    return NodeLook(title, "", subtitle, _param_lines(node), fill, fill, True)

@@ -1,0 +1,268 @@
+"""CanvasView: the plan drawn as a top-down behavior tree (a NodeGraphQt view of the document).
+
+The view mirrors the document (``GraphMirror``) and turns user gestures on the canvas into
+document edits (``CanvasActions`` and the slots here); it never changes the plan otherwise,
+so undo and redo are the document's.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+
+from PySide6.QtCore import QMimeData, QPoint, QPointF, QRectF, Signal
+from PySide6.QtGui import QAction
+from PySide6.QtWidgets import QVBoxLayout, QWidget
+
+from engine.operations import OperationKind
+from engine.spec import NodeKind, NodeLayout
+from engine.status import Status
+from instructor_app.canvas import ngqt_fast
+from instructor_app.canvas.actions import CanvasActions, NodeFactory, default_node_factory
+from instructor_app.canvas.items import CHILD_PORT, PARENT_PORT, TreeNodeItem
+from instructor_app.canvas.sync import GraphMirror, has_position
+from instructor_app.canvas.viewer import PALETTE_MIME, CanvasViewer
+from instructor_app.document.model import DocumentError, PlanDocument
+from instructor_app.document.tree_ops import can_have_child
+
+__all__ = ["CanvasView", "PALETTE_MIME"]
+
+
+class CanvasView(QWidget):
+    """The canvas: a view of ``document``'s plan tree.
+
+    Signals:
+        selection_changed(list): ids of the selected nodes (after any change).
+        node_double_clicked(str): a node was double-clicked (not on its title).
+        message(str): something the user should read (an edit was refused, and why).
+    """
+
+    selection_changed = Signal(list)
+    node_double_clicked = Signal(str)
+    message = Signal(str)
+
+    def __init__(self, document: PlanDocument, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.document = document
+        self.viewer = CanvasViewer(self)
+        self.graph = ngqt_fast.TreeGraph(self.viewer, self)
+        self.mirror = GraphMirror(document, self.graph)
+        self.commands = CanvasActions(document, self, self.selected_ids)
+        self._selection: list[str] = []
+        self._statused: set[str] = set()
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.addWidget(self.viewer)
+        self._connect()
+        self.mirror.rebuild()
+        self.fit_all()
+
+    def _connect(self) -> None:
+        doc = self.document
+        doc.plan_reset.connect(self._on_reset)
+        doc.node_inserted.connect(self.mirror.inserted)
+        doc.node_removed.connect(self.mirror.removed)
+        doc.node_moved.connect(self.mirror.moved)
+        doc.node_changed.connect(self.mirror.changed)
+        doc.layout_changed.connect(lambda ids: self.mirror.relayout())
+        doc.plan_changed.connect(self.commands.update_enabled)
+        viewer = self.viewer
+        viewer.scene().selectionChanged.connect(self._on_selection)
+        viewer.node_double_clicked.connect(self.node_double_clicked)
+        viewer.node_name_changed.connect(self._on_renamed)
+        viewer.moved_nodes.connect(self._on_nodes_moved)
+        viewer.connection_changed.connect(self._on_connection_changed)
+        viewer.palette_dropped.connect(self._on_palette_dropped)
+        viewer.context_requested.connect(self._on_context_menu)
+        self.commands.message.connect(self.message)
+
+    # ------------------------------------------------------------------ public API
+
+    def set_node_factory(self, factory: NodeFactory | None) -> None:
+        """How palette drops and "Add child" make nodes: ``factory(kind, op) -> NodeSpec``."""
+        self.commands.node_factory = factory or default_node_factory
+
+    def set_operation_kinds(self, kinds: Mapping[str, OperationKind]) -> None:
+        """Operation id -> kind, so that leaves get their action/query/condition colour."""
+        table = dict(kinds)
+        self.mirror.op_kind = table.get
+        self.mirror.restyle()
+
+    def set_statuses(self, mapping: Mapping[str, Status]) -> None:
+        """Recolour the named nodes only (cheap: one item update each, no relayout)."""
+        nodes = self.mirror.nodes
+        for node_id, status in mapping.items():
+            node = nodes.get(node_id)
+            if node is not None:
+                node.item.set_status(status)
+                self._statused.add(node_id)
+
+    def clear_statuses(self) -> None:
+        """Back to the category colours."""
+        nodes = self.mirror.nodes
+        for node_id in self._statused:
+            node = nodes.get(node_id)
+            if node is not None:
+                node.item.set_status(None)
+        self._statused.clear()
+
+    def status_of(self, node_id: str) -> Status | None:
+        """The status the node shows (None: none)."""
+        return self.mirror.nodes[node_id].item.status
+
+    def selected_ids(self) -> list[str]:
+        return [
+            item.id
+            for item in self.viewer.scene().selectedItems()
+            if isinstance(item, TreeNodeItem)
+        ]
+
+    def select(self, node_id: str) -> None:
+        """Select only ``node_id`` (expanding nothing; a hidden node is not selectable)."""
+        node = self.mirror.nodes.get(node_id)
+        scene = self.viewer.scene()
+        scene.blockSignals(True)  # one selection_changed, not one per deselected node
+        try:
+            scene.clearSelection()
+            if node is not None:
+                node.item.setSelected(True)
+        finally:
+            scene.blockSignals(False)
+        self._on_selection()
+
+    def center_on(self, node_id: str) -> None:
+        node = self.mirror.nodes.get(node_id)
+        if node is not None:
+            item = node.item
+            self.viewer.centre_on(item.mapToScene(item.shape_rect().center()))
+
+    def fit_all(self) -> None:
+        """Zoom so that the whole tree shows."""
+        rect = QRectF()
+        for node in self.mirror.nodes.values():
+            if node.item.isVisible():
+                rect = rect.united(node.item.sceneBoundingRect())
+        if not rect.isNull():
+            self.viewer.show_rect(rect.adjusted(-40, -40, 40, 40))
+
+    def item(self, node_id: str) -> TreeNodeItem:
+        """The graphics item of a node (tests, the failing-node display)."""
+        return self.mirror.nodes[node_id].item
+
+    def node_count(self) -> int:
+        return len(self.mirror.nodes)
+
+    def action(self, name: str) -> QAction:
+        """One of the canvas's QActions by role: delete, cut, copy, paste, duplicate,
+        move_left, move_right, toggle_collapse, auto_layout (``actions()`` lists them)."""
+        return self.commands.actions[name]
+
+    # ------------------------------------------------------------------ document -> view
+
+    def _on_reset(self) -> None:
+        self._statused.clear()
+        self.mirror.rebuild()
+        self.fit_all()
+
+    def _on_selection(self) -> None:
+        ids = self.selected_ids()
+        if ids != self._selection:
+            self._selection = ids
+            self.commands.update_enabled()
+            self.selection_changed.emit(list(ids))
+
+    # ------------------------------------------------------------------ user gestures -> document
+
+    def _on_renamed(self, node_id: str, name: str) -> None:
+        try:
+            spec = self.document.node(node_id)
+            # The title shows the kind or operation when unnamed; keeping it is no rename.
+            if name != spec.label or spec.name:
+                self.document.rename(node_id, name)
+        except DocumentError as exc:
+            self.message.emit(str(exc))
+        self.mirror.changed(node_id)
+
+    def _on_nodes_moved(self, moved: dict[object, list[float]]) -> None:
+        items = [item for item in moved if isinstance(item, TreeNodeItem)]
+        if len(items) == 1:
+            body = items[0].mapToScene(items[0].shape_rect().center())
+            target = self.viewer.node_item_at(body, exclude=items[0])
+            if target is not None:
+                self._reparent(items[0].id, target.id)
+                return
+        layouts: dict[str, NodeLayout | None] = {}
+        for item in items:
+            old = self.document.plan.layout.get(item.id)
+            layouts[item.id] = NodeLayout(
+                item.pos().x(), item.pos().y(), old is not None and old.collapsed
+            )
+        if layouts:
+            self.document.set_layout(layouts, "Move nodes" if len(layouts) > 1 else "Move node")
+
+    def _reparent(self, node_id: str, parent_id: str) -> None:
+        """Make ``node_id`` the last child of ``parent_id`` (a drag onto a node, a new link);
+        its hand-placed position goes with the same undo step."""
+        doc = self.document
+        try:
+            current_parent, _, _ = doc.locate(node_id)
+            index = len(doc.node(parent_id).children) - (1 if current_parent == parent_id else 0)
+            stack = doc.undo_stack
+            stack.beginMacro(f"Move {doc.node(node_id).label}")
+            try:
+                doc.move_node(node_id, parent_id, index)
+                placed = doc.plan.layout.get(node_id)
+                if has_position(placed):
+                    keep = NodeLayout(collapsed=True) if placed and placed.collapsed else None
+                    doc.set_layout({node_id: keep}, "Place automatically")
+            finally:
+                stack.endMacro()
+        except DocumentError as exc:
+            self.message.emit(str(exc))
+        self.mirror.restore_link(node_id)
+        self.mirror.relayout()
+
+    def _on_connection_changed(self, disconnected: list, connected: list) -> None:  # type: ignore[type-arg]
+        touched = {port.node.id for pair in disconnected + connected for port in pair}
+        for first, second in connected:
+            child, parent = (first, second) if first.name == PARENT_PORT else (second, first)
+            if child.name == PARENT_PORT and parent.name == CHILD_PORT:
+                self._reparent(child.node.id, parent.node.id)
+                break
+        else:
+            if disconnected:
+                self.message.emit("every node needs its parent: drag the link onto another node")
+        for node_id in touched:  # the viewer may have deleted pipes of refused changes
+            if node_id in self.mirror.nodes:
+                self.mirror.restore_link(node_id)
+
+    def _on_palette_dropped(self, mime: QMimeData, scene_pos: QPointF) -> None:
+        try:
+            data = json.loads(bytes(mime.data(PALETTE_MIME).data()).decode("utf-8"))
+            kind = NodeKind(data["kind"])
+            op = data.get("op")
+        except (ValueError, KeyError, TypeError) as exc:
+            self.message.emit(f"cannot drop this item: {exc}")
+            return
+        target = self.viewer.node_item_at(scene_pos)
+        try:
+            if target is not None:
+                if not can_have_child(self.document.node(target.id)):
+                    raise DocumentError(
+                        f"{self.document.node(target.id).label!r} cannot take a child"
+                    )
+                self.select(self.commands.add_child(target.id, kind, op))
+            elif self.document.plan.tree is None:
+                node_id = self.document.add_node(self.commands.node_factory(kind, op))
+                self.select(node_id)
+                self.fit_all()
+            else:
+                raise DocumentError("drop the node onto the node that should hold it")
+        except DocumentError as exc:
+            self.message.emit(str(exc))
+
+    def _on_context_menu(self, node_id: str, global_pos: QPoint) -> None:
+        if node_id and node_id not in self.selected_ids():
+            self.select(node_id)
+        menu = self.commands.context_menu(node_id or None, self)
+        menu.exec(global_pos)

@@ -1,0 +1,23 @@
+"""Parameter type -> editor widget, and the rows of the inspector built from them."""
+
+from __future__ import annotations
+
+from instructor_app.inspectors.base import EditorContext, InspectorError, ParamEditor
+from instructor_app.inspectors.factory import (
+    EDITOR_TYPES,
+    concrete_types,
+    default_value,
+    editor_for,
+)
+from instructor_app.inspectors.units import format_value
+
+__all__ = [
+    "EDITOR_TYPES",
+    "EditorContext",
+    "InspectorError",
+    "ParamEditor",
+    "concrete_types",
+    "default_value",
+    "editor_for",
+    "format_value",
+]

@@ -1,0 +1,120 @@
+"""What the UI shows versus what the plan stores: mm and degrees on screen, m and rad inside.
+
+Pure functions (no Qt), so the conversions are tested on their own. Orientation is shown
+as roll, pitch, yaw about the fixed world axes x, y, z (R = Rz(yaw) Ry(pitch) Rx(roll)), the
+convention of ROS and of the UR teach pendant's RPY view.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+from engine.types import JointConfig, ObjectModel, Pose, Region, Waypoint
+
+__all__ = [
+    "DisplayUnit",
+    "display_unit",
+    "rpy_to_quaternion",
+    "quaternion_to_rpy",
+    "pose_to_display",
+    "pose_from_display",
+    "format_value",
+]
+
+
+@dataclass(frozen=True)
+class DisplayUnit:
+    """How a stored SI unit is shown: ``shown = stored * factor``, with ``suffix``."""
+
+    suffix: str
+    factor: float
+    decimals: int
+
+    def to_display(self, value: float) -> float:
+        return value * self.factor
+
+    def from_display(self, value: float) -> float:
+        return value / self.factor
+
+
+_DEG = 180.0 / math.pi
+_UNITS: dict[str, DisplayUnit] = {
+    "m": DisplayUnit("mm", 1000.0, 2),
+    "m/s": DisplayUnit("mm/s", 1000.0, 2),
+    "m/s^2": DisplayUnit("mm/s²", 1000.0, 2),
+    "rad": DisplayUnit("°", _DEG, 3),
+    "rad/s": DisplayUnit("°/s", _DEG, 3),
+    "rad/s^2": DisplayUnit("°/s²", _DEG, 3),
+}
+
+
+def display_unit(si_unit: str) -> DisplayUnit:
+    """The on-screen unit of an SI unit; units the UI keeps as they are get factor 1."""
+    if si_unit in _UNITS:
+        return _UNITS[si_unit]
+    return DisplayUnit(si_unit, 1.0, 3 if si_unit else 4)
+
+
+def rpy_to_quaternion(roll: float, pitch: float, yaw: float) -> tuple[float, float, float, float]:
+    """Fixed-axis roll, pitch, yaw (rad) to a unit quaternion (x, y, z, w)."""
+    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
+    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
+    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
+    return (
+        sr * cp * cy - cr * sp * sy,
+        cr * sp * cy + sr * cp * sy,
+        cr * cp * sy - sr * sp * cy,
+        cr * cp * cy + sr * sp * sy,
+    )
+
+
+def quaternion_to_rpy(q: tuple[float, float, float, float]) -> tuple[float, float, float]:
+    """A unit quaternion (x, y, z, w) to fixed-axis roll, pitch, yaw (rad)."""
+    x, y, z, w = q
+    roll = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+    # Clamped: rounding can push the sine just past 1 at pitch = +-90 degrees.
+    pitch = math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x))))
+    yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    return roll, pitch, yaw
+
+
+def pose_to_display(pose: Pose) -> tuple[float, ...]:
+    """(x, y, z in mm, roll, pitch, yaw in degrees)."""
+    position = tuple(v * 1000.0 for v in pose.position)
+    angles = tuple(a * _DEG for a in quaternion_to_rpy(pose.orientation))
+    return position + angles
+
+
+def pose_from_display(values: tuple[float, ...]) -> Pose:
+    """The inverse of :func:`pose_to_display`."""
+    x, y, z, roll, pitch, yaw = values
+    q = rpy_to_quaternion(roll / _DEG, pitch / _DEG, yaw / _DEG)
+    return Pose((x / 1000.0, y / 1000.0, z / 1000.0), q)
+
+
+def _mm(values: tuple[float, ...]) -> str:
+    return ", ".join(f"{v * 1000.0:.1f}" for v in values)
+
+
+def format_value(value: Any) -> str:
+    """A value as a person reads it: poses and regions in mm and degrees, joints in degrees."""
+    if isinstance(value, Pose):
+        shown = pose_to_display(value)
+        angles = ", ".join(f"{a:.1f}" for a in shown[3:])
+        return f"({_mm(value.position)}) mm, rpy ({angles})°"
+    if isinstance(value, JointConfig):
+        return "(" + ", ".join(f"{p * _DEG:.1f}" for p in value.positions) + ")°"
+    if isinstance(value, Region):
+        return f"centre ({_mm(value.center)}) mm, radius {value.radius * 1000.0:.1f} mm"
+    if isinstance(value, ObjectModel):
+        return value.name
+    if isinstance(value, Waypoint):
+        where = value.frame.value + (f" {value.reference}" if value.reference else "")
+        return f"{value.name} ({where})"
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(format_value(v) for v in value) + "]"
+    return str(value)

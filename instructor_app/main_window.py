@@ -1,0 +1,508 @@
+"""MainWindow: wires the document, the canvas, the panels and the run together.
+
+It implements none of their logic: the canvas edits and shows the plan, the panels their
+part, the RunController runs it. What is here: menus, the toolbar, docks, files (new, open,
+save, recent, recovery), and the signal wiring, which lives in :meth:`_wire_views` and
+:meth:`_wire_run` so that an API change of a panel is adjusted in one place.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from PySide6.QtCore import Qt
+from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
+from PySide6.QtWidgets import (
+    QComboBox,
+    QDockWidget,
+    QFileDialog,
+    QLabel,
+    QMainWindow,
+    QMessageBox,
+    QWidget,
+)
+
+from engine.spec import NodeKind
+from instructor_app.document.autosave import DEFAULT_INTERVAL_MS, Autosaver, offer_recoveries
+from instructor_app.document.model import DocumentError, PlanDocument
+from instructor_app.node_factory import PaletteItem, make_node, manifest_or_none, readable
+from instructor_app.runtime.controller import FINISHED, IDLE, RunController
+from instructor_app.runtime.run_view import (
+    FailureButton,
+    RunActions,
+    RunningNodesPanel,
+    RunPresenter,
+)
+from instructor_app.runtime.session import CellSession
+from instructor_app.settings import AppSettings, RecentFilesMenu
+
+__all__ = ["Dialogs", "MainWindow", "Views", "make_views", "APP_TITLE", "PLAN_FILTER"]
+
+APP_TITLE = "CoSTAR Instructor"
+PLAN_FILTER = "CoSTAR plans (*.costar.json);;JSON files (*.json);;All files (*)"
+SAVE, DISCARD, CANCEL = "save", "discard", "cancel"
+CANVAS_ACTIONS = (
+    "cut", "copy", "paste", "duplicate", "delete",
+    "move_left", "move_right", "toggle_collapse", "auto_layout",
+)  # fmt: skip
+
+
+@dataclass
+class Views:
+    """The canvas and panels the window shows; the one place that knows their APIs."""
+
+    canvas: Any
+    canvas_actions: dict[str, QAction]
+    palette: Any
+    inspector: Any
+    validation: Any
+    blackboard: Any
+    log: Any
+
+    def set_registry(self, registry: Any) -> None:
+        """Another cell: every view that shows operations rebuilds from its registry."""
+        for view in (self.palette, self.inspector, self.validation):
+            view.set_registry(registry)
+        self.canvas.set_operation_kinds({m.id: m.kind for m in registry.manifests()})
+        library = registry.cell.interfaces().get("objects")
+        self.inspector.set_object_names(library.names() if library is not None else [])
+
+
+def _item_for(kind: NodeKind, op: str | None) -> PaletteItem:
+    """The palette item of a canvas drop or "Add child" (the canvas passes kind and op)."""
+    label = readable(op or kind.value)
+    return PaletteItem(kind, op, label, "", "")
+
+
+def make_views(document: PlanDocument, session: CellSession, parent: QWidget) -> Views:
+    """Create the canvas and the panels for ``document`` on the session's cell."""
+    from instructor_app.canvas import CanvasView
+    from instructor_app.panels import (
+        BlackboardPanel,
+        InspectorPanel,
+        LogPanel,
+        PalettePanel,
+        ValidationPanel,
+    )
+
+    registry = session.registry
+    canvas = CanvasView(document, parent)
+    canvas.set_node_factory(
+        lambda kind, op: make_node(_item_for(kind, op), manifest_or_none(session.registry, op))
+    )
+    actions = {name: canvas.action(name) for name in CANVAS_ACTIONS}
+    views = Views(
+        canvas,
+        actions,
+        PalettePanel(registry, parent),
+        InspectorPanel(document, registry, parent),
+        ValidationPanel(document, registry, parent),
+        BlackboardPanel(parent),
+        LogPanel(parent=parent),
+    )
+    views.set_registry(registry)
+    return views
+
+
+class Dialogs:
+    """The window's questions and messages. Tests replace it, or patch :meth:`make_box`."""
+
+    def make_box(self, parent: QWidget) -> QMessageBox:
+        return QMessageBox(parent)
+
+    def ask_save_changes(self, parent: QWidget, name: str) -> str:
+        """ "save", "discard" or "cancel"."""
+        box = self.make_box(parent)
+        box.setIcon(QMessageBox.Icon.Warning)
+        box.setWindowTitle(APP_TITLE)
+        box.setText(f"Save the changes to {name}?")
+        box.setInformativeText("Your changes are lost if you don't save them.")
+        buttons = QMessageBox.StandardButton
+        box.setStandardButtons(buttons.Save | buttons.Discard | buttons.Cancel)
+        box.setDefaultButton(buttons.Save)
+        answer = box.exec()
+        return {buttons.Save: SAVE, buttons.Discard: DISCARD}.get(buttons(answer), CANCEL)
+
+    def ask_restore(self, parent: QWidget, description: str) -> bool:
+        buttons = QMessageBox.StandardButton
+        answer = QMessageBox.question(
+            parent,
+            APP_TITLE,
+            f"The Instructor did not close properly. Restore the unsaved plan?\n\n{description}",
+            buttons.Yes | buttons.No,
+            buttons.Yes,
+        )
+        return answer == buttons.Yes
+
+    def error(self, parent: QWidget, title: str, text: str) -> None:
+        QMessageBox.critical(parent, title, text)
+
+    def open_path(self, parent: QWidget, folder: str) -> str:
+        return QFileDialog.getOpenFileName(parent, "Open plan", folder, PLAN_FILTER)[0]
+
+    def save_path(self, parent: QWidget, suggested: str) -> str:
+        return QFileDialog.getSaveFileName(parent, "Save plan as", suggested, PLAN_FILTER)[0]
+
+    def about(self, parent: QWidget, text: str) -> None:
+        QMessageBox.about(parent, f"About {APP_TITLE}", text)
+
+
+class MainWindow(QMainWindow):
+    """The Instructor's window.
+
+    Args:
+        session: the cell in use and its registry (opened by the caller).
+        settings: recent files and window layout (default: the user's settings).
+        dialogs: questions and messages (tests pass scripted ones).
+        recovery_folder: where autosave writes (default: AppDataLocation/recovery).
+        autosave_interval_ms: how often a dirty plan is autosaved.
+        rate_hz: the executor's tick rate.
+    """
+
+    def __init__(
+        self,
+        session: CellSession,
+        settings: AppSettings | None = None,
+        dialogs: Dialogs | None = None,
+        recovery_folder: Path | None = None,
+        autosave_interval_ms: int = DEFAULT_INTERVAL_MS,
+        rate_hz: float = 20.0,
+        parent: QWidget | None = None,
+    ) -> None:
+        super().__init__(parent)
+        self.setObjectName("MainWindow")
+        self.session = session
+        self.settings = settings if settings is not None else AppSettings()
+        self.dialogs = dialogs if dialogs is not None else Dialogs()
+        self.document = PlanDocument(self)
+        self.autosaver = Autosaver(self.document, recovery_folder, autosave_interval_ms, self)
+        self.controller = RunController(self.document, session, rate_hz=rate_hz, parent=self)
+        self.views: Views = make_views(self.document, session, self)
+        self.run_actions = RunActions(self.controller, self)
+        self.running_panel = RunningNodesPanel(self._node_path, self)
+        self.failure_button = FailureButton(self._node_label, self)
+        self.selection: list[str] = []
+        self._build_layout()
+        self.actions_by_name: dict[str, QAction] = {}
+        self._build_menus()
+        self._wire_views()
+        self._wire_run()
+        self._restore_window()
+        self._update_title()
+
+    # ------------------------------------------------------------------ layout
+
+    def _build_layout(self) -> None:
+        self.setCentralWidget(self.views.canvas)
+        self.docks: dict[str, QDockWidget] = {}
+        area = Qt.DockWidgetArea
+        self._dock("palette", "Palette", self.views.palette, area.LeftDockWidgetArea)
+        self._dock("inspector", "Inspector", self.views.inspector, area.RightDockWidgetArea)
+        bottom = [
+            ("validation", "Problems", self.views.validation),
+            ("log", "Log", self.views.log),
+            ("blackboard", "Blackboard", self.views.blackboard),
+            ("running", "Running nodes", self.running_panel),
+        ]
+        for name, title, widget in bottom:
+            self._dock(name, title, widget, area.BottomDockWidgetArea)
+        first = self.docks["validation"]
+        for name, _, _ in bottom[1:]:
+            self.tabifyDockWidget(first, self.docks[name])
+        first.raise_()
+        self.resizeDocks([first], [180], Qt.Orientation.Vertical)
+        self.resizeDocks(
+            [self.docks["palette"], self.docks["inspector"]], [240, 320], Qt.Orientation.Horizontal
+        )
+        self.cell_label = QLabel(" Cell: ")
+        self.cell_combo = QComboBox(self)
+        self.cell_combo.setObjectName("CellCombo")
+        self.cell_combo.setToolTip("The cell plans run on: the simulated cell, or none (no robot)")
+        self.cell_combo.addItems(list(self.session.cell_names()))
+        self.cell_combo.setCurrentText(self.session.name)
+        self.problems_label = QLabel("")
+        # permanent: a temporary status message would hide a normal status-bar widget
+        self.statusBar().addPermanentWidget(self.failure_button)
+        self.statusBar().addPermanentWidget(self.problems_label)
+
+    def _dock(self, name: str, title: str, widget: QWidget, area: Qt.DockWidgetArea) -> None:
+        dock = QDockWidget(title, self)
+        dock.setObjectName(f"{name}_dock")  # saveState needs names
+        dock.setWidget(widget)
+        self.addDockWidget(area, dock)
+        self.docks[name] = dock
+
+    def _action(self, name: str, text: str, slot: Any, shortcut: str = "") -> QAction:
+        action = QAction(text, self)
+        action.setObjectName(name)
+        if shortcut:
+            action.setShortcut(QKeySequence(shortcut))
+        action.triggered.connect(slot)
+        self.actions_by_name[name] = action
+        return action
+
+    def _build_menus(self) -> None:
+        bar = self.menuBar()
+        files = bar.addMenu("&File")
+        files.addAction(self._action("new", "&New", self.new_plan, "Ctrl+N"))
+        files.addAction(self._action("open", "&Open…", lambda: self.open_plan(), "Ctrl+O"))
+        self.recent_menu = RecentFilesMenu(self.settings, self.open_plan, self)
+        files.addMenu(self.recent_menu)
+        files.addSeparator()
+        files.addAction(self._action("save", "&Save", self.save_plan, "Ctrl+S"))
+        files.addAction(self._action("save_as", "Save &As…", self.save_plan_as, "Ctrl+Shift+S"))
+        files.addSeparator()
+        files.addAction(self._action("quit", "&Quit", self.close, "Ctrl+Q"))
+        self._build_edit_menus()
+        bar.addMenu("&Run").addActions(self.run_actions.all())
+        help_menu = bar.addMenu("&Help")
+        help_menu.addAction(self._action("about", f"&About {APP_TITLE}", self._about))
+        toolbar = self.addToolBar("Run")
+        toolbar.setObjectName("run_toolbar")
+        toolbar.addActions(self.run_actions.all())
+        toolbar.addSeparator()
+        toolbar.addWidget(self.cell_label)
+        toolbar.addWidget(self.cell_combo)
+
+    def _build_edit_menus(self) -> None:
+        edit = self.menuBar().addMenu("&Edit")
+        stack = self.document.undo_stack
+        undo, redo = stack.createUndoAction(self, "&Undo"), stack.createRedoAction(self, "&Redo")
+        undo.setShortcuts(QKeySequence.keyBindings(QKeySequence.StandardKey.Undo))
+        redo.setShortcuts([QKeySequence("Ctrl+Shift+Z"), QKeySequence("Ctrl+Y")])
+        self.actions_by_name.update(undo=undo, redo=redo)
+        edit.addActions([undo, redo])
+        edit.addSeparator()
+        for name in ("cut", "copy", "paste", "duplicate", "delete"):
+            self._add_canvas_action(edit, name)
+        view = self.menuBar().addMenu("&View")
+        for dock in self.docks.values():
+            view.addAction(dock.toggleViewAction())
+        view.addSeparator()
+        for name in ("auto_layout", "toggle_collapse", "move_left", "move_right"):
+            self._add_canvas_action(view, name)
+        view.addAction(self._action("fit", "&Fit to Window", self.views.canvas.fit_all, "Ctrl+0"))
+
+    def _add_canvas_action(self, menu: Any, name: str) -> None:
+        action = self.views.canvas_actions[name]
+        self.actions_by_name[name] = action
+        menu.addAction(action)
+
+    # ------------------------------------------------------------------ wiring
+
+    def _wire_views(self) -> None:
+        views, document = self.views, self.document
+        views.canvas.selection_changed.connect(self._on_selection)
+        views.canvas.message.connect(self.show_message)
+        views.palette.item_activated.connect(self.add_palette_item)
+        views.validation.node_selected.connect(self.select_node)
+        views.validation.summary_changed.connect(self._on_summary)
+        views.validation.summary_changed.connect(
+            lambda *_: views.inspector.set_problems(views.validation.problems())
+        )
+        self.running_panel.node_selected.connect(self.select_node)
+        self.failure_button.node_selected.connect(self.select_node)
+        self.session.registry_changed.connect(self._on_registry)
+        self.session.cell_changed.connect(self._on_cell_changed)
+        self.session.cell_failed.connect(lambda message: self.dialogs.error(self, "Cell", message))
+        self.cell_combo.activated.connect(
+            lambda index: self.switch_cell(self.cell_combo.itemText(index))
+        )
+        document.dirty_changed.connect(lambda _: self._update_title())
+        document.path_changed.connect(lambda _: self._update_title())
+        document.plan_reset.connect(self._on_plan_reset)
+        views.validation.revalidate()  # its first summary came before these connections
+
+    def _wire_run(self) -> None:
+        controller, views = self.controller, self.views
+        controller.statuses_changed.connect(views.canvas.set_statuses)
+        controller.blackboard_written.connect(views.blackboard.set_value)
+        controller.log_message.connect(views.log.append)
+        controller.running_nodes_changed.connect(self.running_panel.set_nodes)
+        controller.failure_changed.connect(self.failure_button.show_failure)
+        controller.run_state_changed.connect(
+            lambda state: self.cell_combo.setEnabled(state in (IDLE, FINISHED))
+        )
+        self.run_presenter = RunPresenter(
+            controller, views.canvas, views.blackboard, views.log, self.show_message, self
+        )
+        self.run_presenter.problems_shown.connect(lambda: self.docks["validation"].raise_())
+
+    # ------------------------------------------------------------------ editing
+
+    def show_message(self, text: str, timeout_ms: int = 8000) -> None:
+        self.statusBar().showMessage(text, timeout_ms)
+
+    def select_node(self, node_id: str) -> None:
+        """Select a node on the canvas and bring it into view."""
+        if node_id and self.document.plan.find(node_id) is not None:
+            self.views.canvas.select(node_id)
+            self.views.canvas.center_on(node_id)
+
+    def add_palette_item(self, item: Any) -> str | None:
+        """Add the palette item's node under the selected node (as root when the plan is
+        empty); returns the new node's id, or None with a status-bar message."""
+        if not item.available:
+            self.show_message(f"{item.label} cannot be used on this cell: {item.reason}")
+            return None
+        node = make_node(item, manifest_or_none(self.session.registry, item.op))
+        plan = self.document.plan
+        parent_id = self.selection[0] if self.selection else None
+        if plan.tree is not None and parent_id is None:
+            parent_id = plan.tree.id
+        try:
+            new_id = self.document.add_node(node, parent_id)
+        except DocumentError as exc:
+            self.show_message(f"Cannot add {node.label} here: {exc}. Select a composite node.")
+            return None
+        self.views.canvas.select(new_id)
+        return new_id
+
+    def _on_selection(self, node_ids: list[str]) -> None:
+        self.selection = list(node_ids)
+        self.views.inspector.show_node(node_ids[0] if len(node_ids) == 1 else None)
+
+    def _on_summary(self, errors: int, warnings: int) -> None:
+        parts = [f"{errors} error{'s' * (errors != 1)}"] if errors else []
+        parts += [f"{warnings} warning{'s' * (warnings != 1)}"] if warnings else []
+        self.problems_label.setText(", ".join(parts) or "No problems")
+
+    def _on_plan_reset(self) -> None:
+        self.selection = []
+        self.views.inspector.show_node(None)
+        self.views.canvas.clear_statuses()
+        self.failure_button.show_failure("", "")
+
+    def _node_label(self, node_id: str) -> str:
+        node = self.document.plan.find(node_id)
+        return node.label if node is not None else node_id
+
+    def _node_path(self, node_id: str) -> str:
+        return self.document.plan.path_of(node_id)
+
+    # ------------------------------------------------------------------ cell
+
+    def switch_cell(self, name: str) -> None:
+        """Open another cell (not while a plan runs)."""
+        if name == self.session.name:
+            return
+        if self.controller.is_running:
+            self.cell_combo.setCurrentText(self.session.name)
+            self.show_message("Stop the run before switching the cell.")
+            return
+        self.show_message(f"Opening the {name} cell…")
+        self.session.open(name)
+
+    def _on_registry(self, registry: Any) -> None:
+        self.views.set_registry(registry)
+
+    def _on_cell_changed(self, name: str) -> None:
+        self.cell_combo.setCurrentText(name)
+        self.show_message(f"Cell in use: {name}")
+
+    # ------------------------------------------------------------------ files
+
+    def _display_name(self) -> str:
+        path = self.document.path
+        return path.name if path is not None else (self.document.plan.name or "Untitled plan")
+
+    def _update_title(self) -> None:
+        marker = "*" if self.document.dirty else ""
+        self.setWindowTitle(f"{self._display_name()}{marker} — {APP_TITLE}")
+
+    def maybe_save(self) -> bool:
+        """Ask about unsaved changes; False when the user cancelled (or saving failed)."""
+        if not self.document.dirty:
+            return True
+        answer = self.dialogs.ask_save_changes(self, self._display_name())
+        if answer == SAVE:
+            return self.save_plan()
+        return answer == DISCARD
+
+    def new_plan(self) -> None:
+        if self.maybe_save():
+            self.document.new()
+
+    def open_plan(self, path: str | Path | None = None) -> bool:
+        """Open a plan (asks for the file when ``path`` is None); False when not opened."""
+        if not self.maybe_save():
+            return False
+        if path is None:
+            path = self.dialogs.open_path(self, self.settings.last_dir())
+            if not path:
+                return False
+        try:
+            self.document.open(path)
+        except DocumentError as exc:
+            self.dialogs.error(self, "Cannot open the plan", str(exc))
+            return False
+        self.settings.add_recent(path)
+        self.show_message(f"Opened {path}")
+        return True
+
+    def save_plan(self) -> bool:
+        if self.document.path is None:
+            return self.save_plan_as()
+        return self._save_to(self.document.path)
+
+    def save_plan_as(self) -> bool:
+        folder = Path(self.settings.last_dir() or Path.home())
+        chosen = self.dialogs.save_path(self, str(folder / f"{self._display_name()}"))
+        if not chosen:
+            return False
+        path = Path(chosen)
+        if not path.name.endswith(".json"):
+            path = path.with_name(path.name + ".costar.json")
+        return self._save_to(path)
+
+    def _save_to(self, path: Path) -> bool:
+        try:
+            self.document.save(path)
+        except DocumentError as exc:
+            self.dialogs.error(self, "Cannot save the plan", str(exc))
+            return False
+        self.settings.add_recent(path)
+        self.show_message(f"Saved {path}")
+        return True
+
+    def offer_recoveries(self) -> bool:
+        """Offer the plans a crashed session left (newest first); True when one was restored.
+        Declined ones are deleted."""
+        restored = offer_recoveries(
+            self.document,
+            self.autosaver,
+            lambda text: self.dialogs.ask_restore(self, text),
+            lambda text: self.dialogs.error(self, "Cannot restore the plan", text),
+        )
+        if restored is not None:
+            self.show_message(f"Restored {restored.describe()}")
+        return restored is not None
+
+    def _about(self) -> None:
+        self.dialogs.about(
+            self,
+            f"<b>{APP_TITLE}</b><p>Teach a robot a task by composing a behavior tree "
+            "(after CoSTAR, Guerin et al., ICRA 2015).</p>",
+        )
+
+    # ------------------------------------------------------------------ window
+
+    def _restore_window(self) -> None:
+        geometry, state = self.settings.window_geometry(), self.settings.window_state()
+        if geometry is not None:
+            self.restoreGeometry(geometry)
+        else:
+            self.resize(1400, 900)
+        if state is not None:
+            self.restoreState(state)
+
+    def closeEvent(self, event: QCloseEvent) -> None:
+        if not self.maybe_save():
+            event.ignore()
+            return
+        self.controller.shutdown()
+        self.autosaver.stop()
+        self.settings.save_window(self.saveGeometry(), self.saveState())
+        event.accept()

@@ -1,0 +1,285 @@
+"""The inspector: the parameter area of the paper's Figure 5 (3) for the selected node.
+
+It shows the node's name (editable), what it is and its doc, then the settings of a logic
+node (engine.kinds.KIND_CONFIG) or one row per port of an operation (from its manifest).
+Every finished edit is exactly one document command; edits that change nothing push none.
+The panel follows the document: a change of the shown node refreshes the rows in place.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+from PySide6.QtCore import QStringListModel, Qt
+from PySide6.QtWidgets import (
+    QFormLayout,
+    QLabel,
+    QLineEdit,
+    QScrollArea,
+    QVBoxLayout,
+    QWidget,
+)
+
+from engine.kinds import KIND_CONFIG, KIND_DOC
+from engine.operations import Direction, OperationSource
+from engine.spec import Binding, NodeKind, NodeSpec
+from engine.validation import ERROR, Problem
+from instructor_app.document import DocumentError, PlanDocument
+from instructor_app.inspectors.base import EditorContext
+from instructor_app.inspectors.factory import type_names
+from instructor_app.inspectors.rows import ConfigRow, PortRow
+from instructor_app.inspectors.units import display_unit
+from instructor_app.node_factory import manifest_or_none, readable
+
+__all__ = ["InspectorPanel"]
+
+
+class InspectorPanel(QWidget):
+    """Edits the parameters of one node of a document.
+
+    Args:
+        document: the plan being edited.
+        registry: the cell's operations (manifests for the port rows).
+    """
+
+    def __init__(
+        self, document: PlanDocument, registry: OperationSource, parent: QWidget | None = None
+    ) -> None:
+        super().__init__(parent)
+        self.document = document
+        self._registry = registry
+        self._node_id: str | None = None
+        self._shown_op: str | None = None
+        self._object_names: list[str] = []
+        self._names = QStringListModel(self)
+        self._port_rows: dict[str, PortRow] = {}
+        self._config_rows: dict[str, ConfigRow] = {}
+        self._last_context = EditorContext()
+        self._problems: list[Problem] = []
+        self._field_labels: dict[str, QLabel] = {}
+        self._build()
+        document.node_changed.connect(self._node_changed)
+        document.node_removed.connect(self._node_removed)
+        document.plan_reset.connect(self._plan_reset)
+        document.plan_changed.connect(self._plan_changed)
+        self.show_node(None)
+
+    def _build(self) -> None:
+        self.name_field = QLineEdit()
+        self.name_field.setPlaceholderText("name")
+        self.name_field.editingFinished.connect(self._rename)
+        self.kind_label = QLabel()
+        self.doc_label = QLabel()
+        self.doc_label.setWordWrap(True)
+        self.doc_label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        self._form_holder = QWidget()
+        self.form = QFormLayout(self._form_holder)
+        scroll = QScrollArea()
+        scroll.setWidgetResizable(True)
+        scroll.setWidget(self._form_holder)
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(4, 4, 4, 4)
+        for widget in (self.name_field, self.kind_label, self.doc_label):
+            layout.addWidget(widget)
+        layout.addWidget(scroll, 1)
+
+    # ------------------------------------------------------------------ public
+
+    def show_node(self, node_id: str | None) -> None:
+        """Show a node's parameters (None: nothing selected)."""
+        node = self._find(node_id)
+        self._node_id = node.id if node is not None else None
+        self._rebuild(node)
+
+    def shown_node_id(self) -> str | None:
+        return self._node_id
+
+    def set_registry(self, registry: OperationSource) -> None:
+        """Use another cell's operations; the shown node is laid out again."""
+        self._registry = registry
+        self.show_node(self._node_id)
+
+    def set_object_names(self, names: Sequence[str]) -> None:
+        """Names the ObjectModel fields offer (e.g. ``ObjectLibrary().names()``)."""
+        self._object_names = list(names)
+        self._update_context()
+
+    def parameter_names(self) -> list[str]:
+        """Names the plan's outputs write and the plan declares, sorted (for completion)."""
+        names = {decl.name for decl in self.document.plan.parameters}
+        for _, node in self.document.plan.walk():
+            manifest = manifest_or_none(self._registry, node.op)
+            for port, binding in node.params.items():
+                spec = manifest.port(port) if manifest is not None else None
+                if binding.ref and spec is not None and spec.direction is Direction.OUT:
+                    names.add(binding.ref)
+        return sorted(names)
+
+    def completion_model(self) -> QStringListModel:
+        """The model behind the parameter-name completion of every name field."""
+        return self._names
+
+    def set_problems(self, problems: Sequence[Problem]) -> None:
+        """Mark the fields of the shown node that validation complains about
+        (connect ``ValidationPanel.problems_changed`` here)."""
+        self._problems = list(problems)
+        self._mark_problems()
+
+    def field_problem(self, name: str) -> str:
+        """The problem text shown next to a port or setting ("" when none)."""
+        label = self._field_labels.get(name)
+        return label.toolTip() if label is not None and label.property("problem") else ""
+
+    def port_row(self, port: str) -> PortRow:
+        return self._port_rows[port]
+
+    def config_row(self, key: str) -> ConfigRow:
+        return self._config_rows[key]
+
+    # ------------------------------------------------------------------ layout
+
+    def _find(self, node_id: str | None) -> NodeSpec | None:
+        if node_id is None:
+            return None
+        try:
+            return self.document.node(node_id)
+        except DocumentError:
+            return None
+
+    def _context(self) -> EditorContext:
+        objects = list(dict.fromkeys([*self._object_names, *self.document.plan.objects]))
+        return EditorContext(tuple(objects), tuple(self.document.plan.waypoints))
+
+    def _clear_form(self) -> None:
+        while self.form.rowCount():
+            self.form.removeRow(0)
+        self._port_rows.clear()
+        self._config_rows.clear()
+        self._field_labels.clear()
+
+    def _add_row(self, name: str, text: str, tip: str, row: QWidget) -> None:
+        label = QLabel(text)
+        label.setToolTip(tip)
+        label.setProperty("tip", tip)
+        row.setToolTip(tip)
+        self._field_labels[name] = label
+        self.form.addRow(label, row)
+
+    def _mark_problems(self) -> None:
+        found: dict[str, list[Problem]] = {}
+        for problem in self._problems:
+            if problem.node_id == self._node_id and problem.field:
+                found.setdefault(problem.field, []).append(problem)
+        for name, label in self._field_labels.items():
+            problems = found.get(name, [])
+            text = label.text().removeprefix("⚠ ")
+            label.setText(("⚠ " if problems else "") + text)
+            label.setProperty("problem", bool(problems))
+            colour = "#c0392b" if any(p.severity == ERROR for p in problems) else "#b8860b"
+            label.setStyleSheet(f"color: {colour}" if problems else "")
+            messages = "\n".join(p.message for p in problems)
+            label.setToolTip(messages or str(label.property("tip")))
+
+    def _rebuild(self, node: NodeSpec | None) -> None:
+        self._clear_form()
+        self._shown_op = node.op if node is not None else None
+        self.name_field.setEnabled(node is not None)
+        self.name_field.setText(node.name if node is not None else "")
+        if node is None:
+            self.kind_label.setText("Select a node to see its parameters.")
+            self.doc_label.setText("")
+            return
+        self._names.setStringList(self.parameter_names())
+        if node.kind is NodeKind.OPERATION:
+            self._layout_operation(node)
+        else:
+            self.kind_label.setText(f"<b>{readable(node.kind.value)}</b>")
+            self.doc_label.setText(KIND_DOC.get(node.kind, ""))
+            for field in KIND_CONFIG.get(node.kind, ()):
+                row = ConfigRow(field)
+                row.value_committed.connect(lambda v, key=field.name: self._set_config(key, v))
+                self._config_rows[field.name] = row
+                self._add_row(field.name, field.name, field.doc, row)
+        self._refresh(node)
+        self._mark_problems()
+
+    def _layout_operation(self, node: NodeSpec) -> None:
+        manifest = manifest_or_none(self._registry, node.op)
+        if manifest is None:
+            self.kind_label.setText(f"<b>{node.op or 'no operation'}</b>")
+            self.doc_label.setText(
+                "This cell has no such operation; its settings are kept as they are."
+            )
+            return
+        self.kind_label.setText(f"<b>{manifest.id}</b> ({manifest.kind.value})")
+        self.doc_label.setText(manifest.doc)
+        context = self._last_context = self._context()
+        for port in manifest.ports:
+            row = PortRow(port, self._names, context)
+            row.binding_committed.connect(lambda b, name=port.name: self._set_param(name, b))
+            self._port_rows[port.name] = row
+            unit = display_unit(port.unit).suffix if port.unit else ""
+            arrow = "→ " if port.direction is Direction.OUT else ""
+            text = f"{arrow}{port.name}" + (f" [{unit}]" if unit else "")
+            tip = f"{port.doc}\n{type_names(port.types)}" + (f", in {unit}" if unit else "")
+            self._add_row(port.name, text, tip, row)
+
+    def _refresh(self, node: NodeSpec) -> None:
+        """Show the node's current values in the existing rows."""
+        if self.name_field.text() != node.name and not self.name_field.hasFocus():
+            self.name_field.setText(node.name)
+        for port, row in self._port_rows.items():
+            row.load(node.params.get(port))
+        for key, config_row in self._config_rows.items():
+            config_row.load(node.config.get(key))
+
+    def _update_context(self) -> None:
+        context = self._context()
+        if context == self._last_context:
+            return
+        self._last_context = context
+        for row in self._port_rows.values():
+            row.set_context(context)
+
+    # ------------------------------------------------------------------ document -> view
+
+    def _node_changed(self, node_id: str) -> None:
+        if node_id != self._node_id:
+            return
+        node = self._find(node_id)
+        if node is None or node.op != self._shown_op:
+            self.show_node(node_id)
+        else:
+            self._refresh(node)
+
+    def _node_removed(self, _parent: str, _index: int, ids: list[str]) -> None:
+        if self._node_id in ids:
+            self.show_node(None)
+
+    def _plan_reset(self) -> None:
+        self.show_node(self._node_id)
+
+    def _plan_changed(self) -> None:
+        names = self.parameter_names()
+        if names != self._names.stringList():
+            self._names.setStringList(names)
+        self._update_context()
+
+    # ------------------------------------------------------------------ view -> document
+
+    def _rename(self) -> None:
+        if self._node_id is not None:
+            self.document.rename(self._node_id, self.name_field.text().strip())
+
+    def _set_param(self, port: str, binding: Binding | None) -> None:
+        node = self._find(self._node_id)
+        if node is None or node.params.get(port) == binding:
+            return
+        self.document.set_param(node.id, port, binding)
+
+    def _set_config(self, key: str, value: Any) -> None:
+        node = self._find(self._node_id)
+        if node is None or node.config.get(key) == value:
+            return
+        self.document.set_config(node.id, key, value)

@@ -1,0 +1,224 @@
+"""The palette: the paper's sidebar of logic nodes and capability operations (Figure 5, 2).
+
+Items come from :func:`instructor_app.node_factory.palette_items`, so a new capability shows
+up by itself. Typing in the search field filters as you type; Enter there inserts the first
+match ("search-to-insert"). Double-click or Enter on an item inserts it, dragging it onto
+the canvas drops it there. Operations the cell cannot run are greyed, with the reason as
+tooltip, and cannot be inserted or dragged.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterable
+
+from PySide6.QtCore import QMimeData, QSize, Qt, Signal
+from PySide6.QtGui import QColor, QIcon, QKeyEvent, QPainter, QPixmap
+from PySide6.QtWidgets import (
+    QLineEdit,
+    QTreeWidget,
+    QTreeWidgetItem,
+    QVBoxLayout,
+    QWidget,
+)
+
+from engine.operations import OperationKind, OperationSource
+from engine.spec import KIND_CATEGORY, Category, NodeKind
+from instructor_app.node_factory import PALETTE_MIME, PaletteItem, palette_items
+
+__all__ = ["PalettePanel", "item_colour"]
+
+_ITEM_ROLE = Qt.ItemDataRole.UserRole + 1
+
+_OP_COLOURS = {
+    OperationKind.ACTION: "#4a90d9",
+    OperationKind.QUERY: "#3fae6a",
+    OperationKind.CONDITION: "#e09a2b",
+}
+_CATEGORY_COLOURS = {
+    Category.COMPOSITE: "#8c8c8c",
+    Category.DECORATOR: "#9a7fc4",
+    Category.LEAF: "#b0b0b0",
+}
+
+
+def item_colour(item: PaletteItem) -> QColor:
+    """The colour that tells an item's kind: action, query, condition, or logic category."""
+    if item.op_kind is not None:
+        return QColor(_OP_COLOURS[item.op_kind])
+    return QColor(_CATEGORY_COLOURS[KIND_CATEGORY[item.kind]])
+
+
+def _icon(colour: QColor, round_shape: bool) -> QIcon:
+    pixmap = QPixmap(14, 14)
+    pixmap.fill(Qt.GlobalColor.transparent)
+    painter = QPainter(pixmap)
+    painter.setRenderHint(QPainter.RenderHint.Antialiasing)
+    painter.setBrush(colour)
+    painter.setPen(colour.darker(140))
+    if round_shape:
+        painter.drawEllipse(1, 1, 12, 12)
+    else:
+        painter.drawRoundedRect(1, 1, 12, 12, 3, 3)
+    painter.end()
+    return QIcon(pixmap)
+
+
+class _PaletteTree(QTreeWidget):
+    """The list itself: drags palette items, inserts on Enter."""
+
+    item_entered = Signal(object)
+
+    def mimeData(self, items: Iterable[QTreeWidgetItem]) -> QMimeData:
+        mime = QMimeData()
+        chosen = [i.data(0, _ITEM_ROLE) for i in items if i.data(0, _ITEM_ROLE) is not None]
+        if chosen:
+            mime.setData(PALETTE_MIME, json.dumps(chosen[0].payload).encode("utf-8"))
+            mime.setText(chosen[0].op or chosen[0].kind.value)
+        return mime
+
+    def mimeTypes(self) -> list[str]:
+        return [PALETTE_MIME]
+
+    def keyPressEvent(self, event: QKeyEvent) -> None:
+        if event.key() in (Qt.Key.Key_Return, Qt.Key.Key_Enter) and self.currentItem():
+            self.item_entered.emit(self.currentItem())
+            return
+        super().keyPressEvent(event)
+
+
+class PalettePanel(QWidget):
+    """The sidebar of insertable nodes.
+
+    Signals:
+        item_activated(PaletteItem): the user asked to insert this (available) item.
+    """
+
+    item_activated = Signal(object)
+
+    def __init__(
+        self, registry: OperationSource | None = None, parent: QWidget | None = None
+    ) -> None:
+        super().__init__(parent)
+        self.search_field = QLineEdit()
+        self.search_field.setPlaceholderText("Search nodes… (Enter inserts the first match)")
+        self.search_field.setClearButtonEnabled(True)
+        self.search_field.textChanged.connect(self._filter)
+        self.search_field.returnPressed.connect(self._insert_first_match)
+        self.tree = _PaletteTree()
+        self.tree.setHeaderHidden(True)
+        self.tree.setIconSize(QSize(14, 14))
+        self.tree.setDragEnabled(True)
+        self.tree.setDragDropMode(QTreeWidget.DragDropMode.DragOnly)
+        self.tree.itemDoubleClicked.connect(lambda item, _col: self._activate(item))
+        self.tree.item_entered.connect(self._activate)
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(2, 2, 2, 2)
+        layout.addWidget(self.search_field)
+        layout.addWidget(self.tree)
+        self._items: list[PaletteItem] = []
+        if registry is not None:
+            self.set_registry(registry)
+
+    # ------------------------------------------------------------------ public
+
+    def set_registry(self, registry: OperationSource) -> None:
+        """Rebuild the list from a (new) cell's registry, keeping the search text."""
+        self._items = palette_items(registry)
+        docs = {c.name: c.doc for c in getattr(registry, "capabilities", [])}
+        self.tree.clear()
+        groups: dict[str, QTreeWidgetItem] = {}
+        for item in self._items:
+            if item.group not in groups:
+                groups[item.group] = self._group_row(item, docs.get(item.group, ""))
+            groups[item.group].addChild(self._item_row(item))
+        self.tree.expandAll()
+        self._filter(self.search_field.text())
+
+    def items(self) -> list[PaletteItem]:
+        """Every item, shown or filtered out."""
+        return list(self._items)
+
+    def visible_items(self) -> list[PaletteItem]:
+        """The items the current search shows, in order."""
+        return [item for row, item in self._rows() if not row.isHidden()]
+
+    def groups(self) -> list[str]:
+        """Titles of the sections, in order."""
+        return [group.text(0) for group in self._group_rows()]
+
+    # ------------------------------------------------------------------ building
+
+    def _group_row(self, item: PaletteItem, doc: str) -> QTreeWidgetItem:
+        is_logic = item.kind is not NodeKind.OPERATION
+        title = item.group if is_logic else item.group.replace("_", " ").capitalize()
+        row = QTreeWidgetItem(self.tree, [title])
+        row.setFlags(Qt.ItemFlag.ItemIsEnabled)
+        font = row.font(0)
+        font.setBold(True)
+        row.setFont(0, font)
+        row.setToolTip(0, doc)
+        return row
+
+    def _item_row(self, item: PaletteItem) -> QTreeWidgetItem:
+        row = QTreeWidgetItem([item.label])
+        row.setData(0, _ITEM_ROLE, item)
+        row.setIcon(0, _icon(item_colour(item), item.kind is NodeKind.OPERATION))
+        kind = item.op_kind.value if item.op_kind is not None else "logic"
+        tip = f"{item.op or item.kind.value} ({kind})\n{item.doc}"
+        if item.available:
+            row.setFlags(
+                Qt.ItemFlag.ItemIsEnabled
+                | Qt.ItemFlag.ItemIsSelectable
+                | Qt.ItemFlag.ItemIsDragEnabled
+            )
+        else:
+            row.setFlags(Qt.ItemFlag.NoItemFlags)
+            tip = f"Not available: {item.reason}\n{tip}"
+        row.setToolTip(0, tip)
+        return row
+
+    def _group_rows(self) -> list[QTreeWidgetItem]:
+        count = self.tree.topLevelItemCount()
+        return [g for g in (self.tree.topLevelItem(i) for i in range(count)) if g is not None]
+
+    @staticmethod
+    def _children(group: QTreeWidgetItem) -> list[QTreeWidgetItem]:
+        count = group.childCount()
+        return [c for c in (group.child(i) for i in range(count)) if c is not None]
+
+    def _rows(self) -> list[tuple[QTreeWidgetItem, PaletteItem]]:
+        return [
+            (child, child.data(0, _ITEM_ROLE))
+            for group in self._group_rows()
+            for child in self._children(group)
+        ]
+
+    # ------------------------------------------------------------------ behaviour
+
+    def _filter(self, text: str) -> None:
+        for row, item in self._rows():
+            row.setHidden(not item.matches(text))
+        for group in self._group_rows():
+            shown = any(not child.isHidden() for child in self._children(group))
+            group.setHidden(not shown)
+            if text and shown:
+                group.setExpanded(True)
+        first = next(
+            (row for row, item in self._rows() if not row.isHidden() and item.available), None
+        )
+        if first is not None and text:
+            self.tree.setCurrentItem(first)
+
+    def _insert_first_match(self) -> None:
+        if not self.search_field.text().strip():
+            return
+        for item in self.visible_items():
+            if item.available:
+                self.item_activated.emit(item)
+                return
+
+    def _activate(self, row: object) -> None:
+        item = row.data(0, _ITEM_ROLE) if isinstance(row, QTreeWidgetItem) else None
+        if isinstance(item, PaletteItem) and item.available:
+            self.item_activated.emit(item)

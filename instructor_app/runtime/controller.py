@@ -1,0 +1,296 @@
+"""RunController: runs the document's plan on the session's cell and reports in Qt signals.
+
+The executor ticks on its own thread and delivers events on its dispatcher thread; those
+go into an :class:`~instructor_app.runtime.pump.EventPump` that a QTimer drains in the GUI
+thread about 30 times a second, so the canvas gets at most one status per node per frame.
+No method here waits for the engine: ``stop()`` asks the executor to stop and the run ends
+when its RunFinished event comes through the pump.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass
+
+from PySide6.QtCore import QObject, QTimer, Signal
+
+from engine.build import BuildError, build_tree
+from engine.events import RunFinished
+from engine.executor import Executor
+from engine.spec import PlanSpec
+from engine.status import Status
+from engine.validation import ERROR, Problem, has_errors, validate_plan
+from instructor_app.document.model import PlanDocument
+from instructor_app.runtime.pump import Batch, EventPump
+from instructor_app.runtime.session import CellSession
+
+__all__ = ["RunController", "RunOutcome", "IDLE", "RUNNING", "PAUSED", "FINISHED"]
+
+IDLE, RUNNING, PAUSED, FINISHED = "idle", "running", "paused", "finished"
+
+
+@dataclass(frozen=True)
+class RunOutcome:
+    """How a run ended.
+
+    Attributes:
+        event: the executor's RunFinished event (status, reason, ticks, message).
+        failed_node: the deepest node that was FAILURE at the end ("" if none).
+        failure_message: that node's message.
+        statuses: the last status seen of every node of the plan that ran.
+    """
+
+    event: RunFinished
+    failed_node: str
+    failure_message: str
+    statuses: dict[str, Status]
+
+    @property
+    def status(self) -> Status:
+        return self.event.status
+
+
+class RunController(QObject):
+    """Run, pause, step and stop the plan of ``document`` on the cell of ``session``.
+
+    Args:
+        document: the open plan (a snapshot of it is taken when a run starts).
+        session: the cell and its registry.
+        rate_hz: executor tick rate.
+        drain_hz: how often queued events reach the GUI.
+
+    Signals:
+        statuses_changed(dict): node id -> Status, only the nodes changed since last time.
+        blackboard_written(str, object): a blackboard key and its newest value.
+        log_message(str, str): text and level ("info", "warning", "error").
+        run_state_changed(str): "idle", "running", "paused" or "finished".
+        running_nodes_changed(list): ids of the nodes now RUNNING, in plan order.
+        run_finished(object): a :class:`RunOutcome`.
+        run_refused(list): the validation problems (or a build error) that kept it from starting.
+        failure_changed(str, str): the deepest failing node and its message ("" "": none).
+    """
+
+    # object, not dict: a dict signal goes through QVariantMap and turns Status into str.
+    statuses_changed = Signal(object)
+    blackboard_written = Signal(str, object)
+    log_message = Signal(str, str)
+    run_state_changed = Signal(str)
+    running_nodes_changed = Signal(list)
+    run_finished = Signal(object)
+    run_refused = Signal(list)
+    failure_changed = Signal(str, str)
+
+    def __init__(
+        self,
+        document: PlanDocument,
+        session: CellSession,
+        rate_hz: float = 20.0,
+        drain_hz: float = 30.0,
+        parent: QObject | None = None,
+    ) -> None:
+        super().__init__(parent)
+        self.document = document
+        self.session = session
+        self.rate_hz = rate_hz
+        self._pump = EventPump()
+        self._timer = QTimer(self)
+        self._timer.setInterval(max(1, round(1000 / drain_hz)))
+        self._timer.timeout.connect(self._drain)
+        self._executor: Executor | None = None
+        self._state = IDLE
+        self._plan: PlanSpec | None = None
+        self._order: dict[str, tuple[int, int]] = {}  # node id -> (depth, plan order)
+        self._statuses: dict[str, Status] = {}
+        self._messages: dict[str, str] = {}
+        self._running: list[str] = []
+        self._failure: tuple[str, str] = ("", "")
+
+    # ------------------------------------------------------------------ state
+
+    @property
+    def state(self) -> str:
+        return self._state
+
+    @property
+    def is_running(self) -> bool:
+        """True from start until the RunFinished event was handled (paused counts)."""
+        return self._state in (RUNNING, PAUSED)
+
+    @property
+    def statuses(self) -> dict[str, Status]:
+        """The last status seen of each node of the current (or last) run."""
+        return dict(self._statuses)
+
+    # ------------------------------------------------------------------ control
+
+    def run(self) -> bool:
+        """Start a run (resume when paused); False when the plan was refused or one runs."""
+        if self._state == PAUSED:
+            self.resume()
+            return True
+        if self._state == RUNNING:
+            return False
+        return self._start(paused=False)
+
+    def pause(self) -> None:
+        if self._executor is not None and self._state == RUNNING:
+            self._executor.pause()
+            self._set_state(PAUSED)
+
+    def resume(self) -> None:
+        if self._executor is not None and self._state == PAUSED:
+            self._executor.resume()
+            self._set_state(RUNNING)
+
+    def step(self) -> None:
+        """One tick: starts a paused run when idle, pauses a running one first."""
+        if not self.is_running:
+            if not self._start(paused=True):
+                return
+        elif self._state == RUNNING:
+            self.pause()
+        assert self._executor is not None
+        self._executor.step()
+
+    def stop(self) -> None:
+        """Halt what runs (an arm in motion stops); the run ends via run_finished."""
+        if self._executor is not None and self.is_running:
+            # timeout=0: never join the engine thread from the GUI thread.
+            self._executor.stop("stopped", timeout=0)
+
+    def shutdown(self, timeout: float = 2.0) -> None:
+        """Stop and wait (bounded) for the engine: for closing the application only."""
+        executor = self._executor
+        if executor is None:
+            return
+        executor.stop("stopped", timeout=timeout)
+        executor.wait(timeout)
+        self._drain()
+        self._timer.stop()
+
+    # ------------------------------------------------------------------ starting
+
+    def _start(self, paused: bool) -> bool:
+        plan = copy.deepcopy(self.document.plan)  # edits during the run do not reach it
+        registry = self.session.registry
+        problems = validate_plan(plan, registry)
+        if has_errors(problems):
+            self.run_refused.emit([p for p in problems if p.severity == ERROR])
+            return False
+        try:
+            tree = build_tree(plan, registry, clock=self.session.clock())
+        except BuildError as exc:
+            self.run_refused.emit([Problem(ERROR, None, exc.path, None, str(exc))])
+            return False
+        for problem in problems:
+            self.log_message.emit(str(problem), "warning")
+        self._reset_run(plan)
+        self._executor = Executor(tree, self.rate_hz, [self._pump.put], plan_name=plan.name)
+        self._executor.start(paused=paused)
+        self._timer.start()
+        self._set_state(PAUSED if paused else RUNNING)
+        self.log_message.emit(f"Run of {plan.name or 'the plan'} started", "info")
+        return True
+
+    def _reset_run(self, plan: PlanSpec) -> None:
+        self._plan = plan
+        self._order = _depth_order(plan)
+        self._pump.drain()  # leftovers of an earlier run must not colour this one
+        self._statuses, self._messages, self._running = {}, {}, []
+        self._set_failure("", "")
+
+    # ------------------------------------------------------------------ GUI thread
+
+    def _drain(self) -> None:
+        batch = self._pump.drain()
+        if batch.empty:
+            return
+        changed = {k: v for k, v in batch.statuses.items() if k in self._order}
+        self._statuses.update(changed)
+        self._messages.update({k: v for k, v in batch.messages.items() if k in self._order})
+        if changed:
+            self.statuses_changed.emit(changed)
+            self._update_running()
+        for key, value in batch.writes.items():
+            self.blackboard_written.emit(key, value)
+        self._emit_logs(batch)
+        if batch.failures:
+            self._update_failure()
+        if batch.finished is not None:
+            self._finish(batch.finished)
+
+    def _emit_logs(self, batch: Batch) -> None:
+        for node_id, message in batch.logs:
+            self.log_message.emit(f"{self._label(node_id)}: {message}", "info")
+        for node_id, message in batch.failures:
+            if node_id in self._order:
+                text = f"{self._label(node_id)} failed" + (f": {message}" if message else "")
+                self.log_message.emit(text, "error")
+
+    def _update_running(self) -> None:
+        running = sorted(
+            (k for k, v in self._statuses.items() if v is Status.RUNNING),
+            key=lambda k: self._order[k][1],
+        )
+        if running != self._running:
+            self._running = running
+            self.running_nodes_changed.emit(list(running))
+
+    def _deepest_failure(self) -> tuple[str, str]:
+        failed = [k for k, v in self._statuses.items() if v is Status.FAILURE]
+        if not failed:
+            return "", ""
+        node_id = max(failed, key=lambda k: self._order[k])
+        return node_id, self._messages.get(node_id, "")
+
+    def _update_failure(self) -> None:
+        node_id, message = self._deepest_failure()
+        if node_id:
+            self._set_failure(node_id, message)
+
+    def _set_failure(self, node_id: str, message: str) -> None:
+        if (node_id, message) != self._failure:
+            self._failure = (node_id, message)
+            self.failure_changed.emit(node_id, message)
+
+    def _finish(self, event: RunFinished) -> None:
+        self._timer.stop()
+        self._executor = None
+        failed, message = ("", "")
+        if event.status is Status.FAILURE:
+            failed, message = self._deepest_failure()
+        self._set_failure(failed, message or (event.message if failed else ""))
+        if self._running:
+            self._running = []
+            self.running_nodes_changed.emit([])
+        level = "info" if event.status is Status.SUCCESS else "warning"
+        self.log_message.emit(self._summary(event), level)
+        self._set_state(FINISHED)
+        self.run_finished.emit(RunOutcome(event, failed, message, dict(self._statuses)))
+
+    def _summary(self, event: RunFinished) -> str:
+        name = (self._plan.name if self._plan else "") or "the plan"
+        if event.reason != "finished":
+            return f"Run of {name} {event.reason} after {event.tick} ticks"
+        return f"Run of {name} ended: {event.status.value} after {event.tick} ticks"
+
+    def _label(self, node_id: str) -> str:
+        node = self._plan.find(node_id) if self._plan is not None else None
+        return node.label if node is not None else node_id
+
+    def _set_state(self, state: str) -> None:
+        if state != self._state:
+            self._state = state
+            self.run_state_changed.emit(state)
+
+
+def _depth_order(plan: PlanSpec) -> dict[str, tuple[int, int]]:
+    """node id -> (depth, position in tick order): the deepest, latest failure sorts last."""
+    order: dict[str, tuple[int, int]] = {}
+    stack = [(plan.tree, 0)] if plan.tree is not None else []
+    while stack:
+        node, depth = stack.pop()
+        assert node is not None
+        order[node.id] = (depth, len(order))
+        stack.extend((child, depth + 1) for child in reversed(node.children))
+    return order

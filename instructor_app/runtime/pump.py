@@ -1,0 +1,94 @@
+"""Executor events -> batches for the GUI thread.
+
+The executor delivers events on its dispatcher thread; :meth:`EventPump.put` is that thread's
+only entry point and just appends to a deque (atomic in CPython: no lock on the engine's
+path). The GUI thread calls :meth:`EventPump.drain` from a timer and gets one
+:class:`Batch`: the newest status per node, the newest blackboard value per key, every log
+line, and the RunFinished event if the run ended. No Qt here, so it is tested on its own.
+"""
+
+from __future__ import annotations
+
+import collections
+from dataclasses import dataclass, field
+from typing import Any
+
+from engine.events import (
+    BlackboardWritten,
+    Event,
+    LogMessage,
+    RunFinished,
+    RunStarted,
+    StatusChanged,
+)
+from engine.status import Status
+
+__all__ = ["Batch", "EventPump"]
+
+
+@dataclass
+class Batch:
+    """What happened since the last drain.
+
+    Attributes:
+        statuses: node id -> newest status (only nodes that changed).
+        messages: node id -> the message that came with its newest status.
+        failures: node ids that turned FAILURE, in the order they did (a node that failed
+            and was reset in the same batch is still here: its failure was real).
+        writes: blackboard key -> newest value, in order of first write.
+        logs: (node id, message) in order.
+        finished: the RunFinished event, if the run ended.
+        started: whether a RunStarted event arrived.
+    """
+
+    statuses: dict[str, Status] = field(default_factory=dict)
+    messages: dict[str, str] = field(default_factory=dict)
+    failures: list[tuple[str, str]] = field(default_factory=list)
+    writes: dict[str, Any] = field(default_factory=dict)
+    logs: list[tuple[str, str]] = field(default_factory=list)
+    finished: RunFinished | None = None
+    started: bool = False
+
+    @property
+    def empty(self) -> bool:
+        return not (self.statuses or self.writes or self.logs or self.finished or self.started)
+
+
+class EventPump:
+    """A thread-safe mailbox of engine events, drained in batches."""
+
+    def __init__(self) -> None:
+        self._queue: collections.deque[Event] = collections.deque()
+
+    def put(self, event: Event) -> None:
+        """Any thread (the executor's dispatcher): queue one event."""
+        self._queue.append(event)
+
+    def __len__(self) -> int:
+        return len(self._queue)
+
+    def drain(self) -> Batch:
+        """The GUI thread: take everything queued so far, coalesced."""
+        batch = Batch()
+        while True:
+            try:
+                event = self._queue.popleft()
+            except IndexError:
+                return batch
+            _merge(batch, event)
+
+
+def _merge(batch: Batch, event: Event) -> None:
+    if isinstance(event, StatusChanged):
+        batch.statuses[event.node_id] = event.new
+        batch.messages[event.node_id] = event.message
+        if event.new is Status.FAILURE:
+            batch.failures.append((event.node_id, event.message))
+    elif isinstance(event, BlackboardWritten):
+        batch.writes[event.key] = event.value
+    elif isinstance(event, LogMessage):
+        batch.logs.append((event.node_id, event.message))
+    elif isinstance(event, RunFinished):
+        batch.finished = event
+    elif isinstance(event, RunStarted):
+        batch.started = True

@@ -1,0 +1,123 @@
+"""The Instructor's user settings (QSettings): recent files, folders, window layout.
+
+Everything goes through :class:`AppSettings`, made with a QSettings the caller chooses, so
+that tests use a temporary file and never the user's settings.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+from PySide6.QtCore import QByteArray, QSettings
+from PySide6.QtGui import QAction
+from PySide6.QtWidgets import QMenu, QWidget
+
+__all__ = ["AppSettings", "RecentFilesMenu", "ORGANIZATION", "APPLICATION", "MAX_RECENT"]
+
+ORGANIZATION = "CoSTAR"
+APPLICATION = "Instructor"
+MAX_RECENT = 10
+
+_RECENT = "files/recent"
+_LAST_DIR = "files/last_dir"
+_GEOMETRY = "window/geometry"
+_STATE = "window/state"
+
+
+class AppSettings:
+    """Typed access to the application's QSettings.
+
+    Args:
+        settings: where to keep them (default: the user's CoSTAR/Instructor settings).
+    """
+
+    def __init__(self, settings: QSettings | None = None) -> None:
+        self.qsettings = settings if settings is not None else QSettings(ORGANIZATION, APPLICATION)
+
+    # ------------------------------------------------------------------ recent files
+
+    def recent_files(self) -> list[str]:
+        """Most recent first; at most MAX_RECENT."""
+        value = self.qsettings.value(_RECENT, [])
+        if isinstance(value, str):  # QSettings gives a lone string for a one-item list
+            value = [value]
+        return [str(v) for v in (value or []) if v][:MAX_RECENT]
+
+    def add_recent(self, path: str | Path) -> None:
+        text = str(Path(path).resolve())
+        files = [text] + [f for f in self.recent_files() if f != text]
+        self._set_recent(files[:MAX_RECENT])
+        self.set_last_dir(Path(text).parent)
+
+    def remove_recent(self, path: str | Path) -> None:
+        text = str(Path(path).resolve())
+        self._set_recent([f for f in self.recent_files() if f != text])
+
+    def clear_recent(self) -> None:
+        self._set_recent([])
+
+    def _set_recent(self, files: list[str]) -> None:
+        self.qsettings.setValue(_RECENT, files)
+        self.qsettings.sync()
+
+    # ------------------------------------------------------------------ folders and window
+
+    def last_dir(self) -> str:
+        return str(self.qsettings.value(_LAST_DIR, "") or "")
+
+    def set_last_dir(self, folder: str | Path) -> None:
+        self.qsettings.setValue(_LAST_DIR, str(folder))
+
+    def save_window(self, geometry: QByteArray, state: QByteArray) -> None:
+        self.qsettings.setValue(_GEOMETRY, geometry)
+        self.qsettings.setValue(_STATE, state)
+        self.qsettings.sync()
+
+    def window_geometry(self) -> QByteArray | None:
+        value = self.qsettings.value(_GEOMETRY)
+        return value if isinstance(value, QByteArray) else None
+
+    def window_state(self) -> QByteArray | None:
+        value = self.qsettings.value(_STATE)
+        return value if isinstance(value, QByteArray) else None
+
+
+class RecentFilesMenu(QMenu):
+    """File > Open Recent: rebuilt from the settings each time it is shown.
+
+    Args:
+        settings: where the list lives.
+        open_file: called with the path the user picked.
+    """
+
+    def __init__(
+        self,
+        settings: AppSettings,
+        open_file: Callable[[str], object],
+        parent: QWidget | None = None,
+    ) -> None:
+        super().__init__("Open &Recent", parent)
+        self._settings = settings
+        self._open_file = open_file
+        self.aboutToShow.connect(self.rebuild)
+        self.rebuild()
+
+    def rebuild(self) -> None:
+        self.clear()
+        files = self._settings.recent_files()
+        for number, path in enumerate(files, start=1):
+            action = QAction(f"&{number % 10} {Path(path).name}", self)
+            action.setToolTip(path)
+            action.setData(path)
+            action.triggered.connect(lambda _=False, p=path: self._open_file(p))
+            self.addAction(action)
+        if not files:
+            self.addAction("No recent files").setEnabled(False)
+            return
+        self.addSeparator()
+        self.addAction("Clear Menu", self._clear)
+
+    def _clear(self) -> None:
+        self._settings.clear_recent()
+        self.rebuild()

@@ -1,0 +1,29 @@
+"""Fixtures of the panel tests: a registry without a robot and a small plan document."""
+
+from __future__ import annotations
+
+import pytest
+
+from capabilities.base import CapabilityRegistry, NullCell
+from capabilities.debug import capability as debug_capability
+from capabilities.template import capability as template_capability
+from engine.spec import NodeKind, NodeSpec
+from instructor_app.document import PlanDocument
+
+
+@pytest.fixture
+def registry() -> CapabilityRegistry:
+    """debug (always available) and template (needs a lamp the null cell lacks)."""
+    return CapabilityRegistry([debug_capability(), template_capability()], cell=NullCell())
+
+
+@pytest.fixture
+def document(qapp: object) -> PlanDocument:
+    """A plan: Sequence[query -> OBJ_POSE, pretend_move, wait], with a clean undo stack."""
+    doc = PlanDocument()
+    root = doc.add_node(NodeSpec(NodeKind.SEQUENCE, "Main", id="root"))
+    doc.add_node(NodeSpec(NodeKind.OPERATION, "Find", id="query", op="debug.query"), root)
+    doc.add_node(NodeSpec(NodeKind.OPERATION, "Go", id="move", op="debug.pretend_move"), root)
+    doc.add_node(NodeSpec(NodeKind.WAIT, "Pause", id="wait", config={"seconds": 1.0}), root)
+    doc.undo_stack.clear()
+    return doc

@@ -1,0 +1,234 @@
+"""The inspector: one undo command per finished edit, undo restores the plan byte for byte."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import pytest
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import QComboBox
+from pytestqt.qtbot import QtBot
+
+from capabilities.base import CapabilityRegistry
+from engine.spec import Binding, NodeKind, NodeSpec, ParameterDecl
+from engine.types import ParamType, Pose, Waypoint
+from instructor_app.document import PlanDocument
+from instructor_app.inspectors.editors import NumberEditor
+from instructor_app.inspectors.rows import MODE_REFERENCE, MODE_UNSET, MODE_VALUE
+from instructor_app.panels.inspector import InspectorPanel
+
+
+@pytest.fixture
+def panel(
+    qtbot: QtBot, document: PlanDocument, registry: CapabilityRegistry
+) -> Iterator[InspectorPanel]:
+    widget = InspectorPanel(document, registry)
+    qtbot.addWidget(widget)
+    yield widget
+
+
+def _choose(combo: QComboBox, index: int) -> None:
+    """What a user's pick in a combo box does."""
+    combo.setCurrentIndex(index)
+    combo.activated.emit(index)
+
+
+def _undo_all_restores(document: PlanDocument, before: str) -> None:
+    while document.undo_stack.canUndo():
+        document.undo_stack.undo()
+    assert document.serialized() == before
+
+
+def test_nothing_shown_without_a_node(panel: InspectorPanel) -> None:
+    assert panel.shown_node_id() is None and not panel.name_field.isEnabled()
+    panel.show_node("no-such-node")
+    assert panel.shown_node_id() is None
+
+
+def test_rename_is_one_command(qtbot: QtBot, panel: InspectorPanel, document: PlanDocument) -> None:
+    before = document.serialized()
+    panel.show_node("move")
+    assert panel.name_field.text() == "Go"
+    panel.name_field.selectAll()
+    qtbot.keyClicks(panel.name_field, "Go to cup")
+    qtbot.keyClick(panel.name_field, Qt.Key.Key_Return)
+    panel.name_field.editingFinished.emit()  # the focus leaving afterwards
+    assert document.node("move").name == "Go to cup"
+    assert document.undo_stack.count() == 1
+    _undo_all_restores(document, before)
+    assert panel.name_field.text() == "Go"
+
+
+def test_typing_a_number_is_one_command(
+    qtbot: QtBot, panel: InspectorPanel, document: PlanDocument
+) -> None:
+    before = document.serialized()
+    panel.show_node("move")
+    row = panel.port_row("ticks")
+    assert row.mode == MODE_UNSET and "default: 3" in row.mode_combo.currentText()
+    _choose(row.mode_combo, MODE_VALUE)
+    assert document.node("move").params["ticks"] == Binding.fixed(3, ParamType.NUMBER)
+    assert document.undo_stack.count() == 1
+    assert isinstance(row.editor, NumberEditor)
+    spin = row.editor.spin
+    spin.lineEdit().selectAll()
+    qtbot.keyClicks(spin, "123")
+    assert document.undo_stack.count() == 1
+    qtbot.keyClick(spin, Qt.Key.Key_Return)
+    assert document.node("move").params["ticks"] == Binding.fixed(123.0, ParamType.NUMBER)
+    assert document.undo_stack.count() == 2
+    _undo_all_restores(document, before)
+    assert row.mode == MODE_UNSET
+
+
+def test_fixed_reference_switch(
+    panel: InspectorPanel, document: PlanDocument, qtbot: QtBot
+) -> None:
+    before = document.serialized()
+    panel.show_node("move")
+    row = panel.port_row("target")
+    assert [row.type_combo.itemText(i) for i in range(row.type_combo.count())] == [
+        "Pose",
+        "Waypoint",
+    ]
+    _choose(row.mode_combo, MODE_REFERENCE)
+    assert document.undo_stack.count() == 0  # no name yet: nothing to bind
+    qtbot.keyClicks(row.ref_field, "OBJ_POSE")
+    qtbot.keyClick(row.ref_field, Qt.Key.Key_Return)
+    assert document.node("move").params["target"] == Binding.reference("OBJ_POSE")
+    _choose(row.mode_combo, MODE_VALUE)
+    assert document.node("move").params["target"] == Binding.fixed(Pose(), ParamType.POSE)
+    _choose(row.mode_combo, MODE_REFERENCE)  # the name is remembered
+    assert document.node("move").params["target"] == Binding.reference("OBJ_POSE")
+    _choose(row.mode_combo, MODE_UNSET)
+    assert "target" not in document.node("move").params
+    assert document.undo_stack.count() == 4
+    _undo_all_restores(document, before)
+
+
+def test_type_switch_uses_the_plan_waypoints(panel: InspectorPanel, document: PlanDocument) -> None:
+    waypoint = Waypoint("above_cup", pose=Pose((0.4, 0.0, 0.3)))
+    document.set_plan_field("waypoints", [waypoint])
+    before = document.serialized()
+    count = document.undo_stack.count()
+    panel.show_node("move")
+    row = panel.port_row("target")
+    _choose(row.mode_combo, MODE_VALUE)
+    _choose(row.type_combo, 1)
+    assert document.node("move").params["target"] == Binding.fixed(waypoint, ParamType.WAYPOINT)
+    assert document.undo_stack.count() == count + 2
+    document.undo_stack.undo()
+    document.undo_stack.undo()
+    assert document.serialized() == before
+
+
+def test_output_name_and_completion(
+    qtbot: QtBot, panel: InspectorPanel, document: PlanDocument
+) -> None:
+    before = document.serialized()
+    document.set_plan_field("parameters", [ParameterDecl("SPEED", ParamType.NUMBER, 1.0)])
+    panel.show_node("query")
+    row = panel.port_row("result")
+    qtbot.keyClicks(row.ref_field, "CUP_POSE")
+    qtbot.keyClick(row.ref_field, Qt.Key.Key_Return)
+    assert document.node("query").params["result"] == Binding.reference("CUP_POSE")
+    assert document.undo_stack.count() == 2
+    assert panel.completion_model().stringList() == ["CUP_POSE", "SPEED"]
+    # The same model completes the input fields of another node.
+    panel.show_node("move")
+    completer = panel.port_row("target").ref_field.completer()
+    assert completer.model().stringList() == ["CUP_POSE", "SPEED"]
+    completer.setCompletionPrefix("cup")
+    assert completer.currentCompletion() == "CUP_POSE"
+    # Inputs that read a name do not add it: only writers do.
+    document.set_param("move", "target", Binding.reference("NOBODY_WRITES"))
+    assert "NOBODY_WRITES" not in panel.parameter_names()
+    # Clearing the output name unbinds it.
+    panel.show_node("query")
+    row = panel.port_row("result")
+    row.ref_field.clear()
+    row.ref_field.editingFinished.emit()
+    assert "result" not in document.node("query").params
+    _undo_all_restores(document, before)
+
+
+def test_logic_settings_are_one_command_each(panel: InspectorPanel, document: PlanDocument) -> None:
+    before = document.serialized()
+    panel.show_node("wait")
+    row = panel.config_row("seconds")
+    assert row.widget.value() == 1.0
+    row.widget.setValue(2.5)
+    assert document.node("wait").config == {"seconds": 2.5}
+    root = document.add_node(NodeSpec(NodeKind.PARALLEL, id="par"), "root")
+    panel.show_node(root)
+    policy = panel.config_row("success")
+    assert policy.widget.currentText() == "all"
+    policy.widget.setEditText("2")
+    policy.widget.lineEdit().editingFinished.emit()
+    policy.widget.setEditText("nonsense")
+    policy.widget.lineEdit().editingFinished.emit()
+    assert document.node("par").config == {"success": 2}
+    assert document.undo_stack.count() == 3
+    _undo_all_restores(document, before)
+
+
+def test_optional_count_off_removes_the_setting(
+    panel: InspectorPanel, document: PlanDocument
+) -> None:
+    document.add_node(NodeSpec(NodeKind.ENFORCE, id="enf", config={"count": 3}), "root")
+    panel.show_node("enf")
+    spin = panel.config_row("count").widget
+    assert spin.value() == 3
+    spin.setValue(0)
+    assert document.node("enf").config == {}
+    assert spin.specialValueText() == "off"
+
+
+def test_follows_document_changes(panel: InspectorPanel, document: PlanDocument) -> None:
+    panel.show_node("move")
+    row = panel.port_row("ticks")
+    document.set_param("move", "ticks", Binding.fixed(7.0, ParamType.NUMBER))
+    assert row.mode == MODE_VALUE and row.editor.value() == 7.0
+    assert panel.port_row("ticks") is row  # refreshed in place, not rebuilt
+    document.undo_stack.undo()
+    assert row.mode == MODE_UNSET
+    document.rename("move", "Elsewhere")
+    assert panel.name_field.text() == "Elsewhere"
+    document.remove_node("move")
+    assert panel.shown_node_id() is None
+    document.undo_stack.undo()
+    panel.show_node("move")
+    document.new()
+    assert panel.shown_node_id() is None
+
+
+def test_object_names_reach_the_editors(
+    panel: InspectorPanel, document: PlanDocument, registry: CapabilityRegistry
+) -> None:
+    panel.set_object_names(["cup", "plate_4_holes"])
+    panel.show_node("move")
+    row = panel.port_row("target")
+    assert row.editor is not None
+    assert panel._context().object_names == ("cup", "plate_4_holes")
+    # A node whose operation this cell lacks shows no rows and does not fail.
+    document.add_node(NodeSpec(NodeKind.OPERATION, id="ghost", op="welding.weld"), "root")
+    panel.show_node("ghost")
+    assert "no such operation" in panel.doc_label.text()
+
+
+def test_problems_are_marked_next_to_the_field(
+    qtbot: QtBot, panel: InspectorPanel, document: PlanDocument, registry: CapabilityRegistry
+) -> None:
+    from instructor_app.panels.validation import ValidationPanel
+
+    validation = ValidationPanel(document, registry)
+    qtbot.addWidget(validation)
+    validation.problems_changed.connect(panel.set_problems)
+    panel.show_node("move")
+    validation.revalidate()
+    assert "needs a value for 'target'" in panel.field_problem("target")
+    assert panel.field_problem("ticks") == ""
+    document.set_param("move", "target", Binding.fixed(Pose(), ParamType.POSE))
+    with qtbot.waitSignal(validation.problems_changed):
+        pass
+    assert panel.field_problem("target") == ""

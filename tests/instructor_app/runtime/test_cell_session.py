@@ -1,0 +1,67 @@
+"""CellSession: opens a cell, makes its registry, falls back to "none" when a cell fails."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from capabilities.cells import CellError, ManagedCell
+from instructor_app.runtime.session import CellSession
+
+
+class FakeCell(ManagedCell):
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self.closed = False
+
+    def close(self) -> None:
+        self.closed = True
+
+
+class Opener:
+    """Opens fake cells; "sim" fails when told to."""
+
+    def __init__(self, sim_fails: bool = False) -> None:
+        self.sim_fails = sim_fails
+        self.opened: list[tuple[str, dict[str, Any]]] = []
+
+    def __call__(self, name: str, **kwargs: Any) -> FakeCell:
+        self.opened.append((name, kwargs))
+        if name == "sim" and self.sim_fails:
+            raise CellError("the simulated cell did not start: no GPU today")
+        return FakeCell(name)
+
+
+def test_open_makes_a_registry_for_the_cell_and_tells_the_panels(qtbot: Any) -> None:
+    opener = Opener()
+    session = CellSession("sim", seed=3, speed=None, opener=opener)
+    with qtbot.waitSignals([session.cell_changed, session.registry_changed]):
+        assert session.open() is True
+    assert opener.opened == [("sim", {"seed": 3, "scene": None, "speed": None})]
+    assert session.registry.cell is session.cell and session.name == "sim"
+    assert "debug.succeed" in {m.id for m in session.registry.manifests()}
+    assert session.clock() is not None
+
+
+def test_switching_closes_the_old_cell(qtbot: Any) -> None:
+    session = CellSession("none", opener=Opener())
+    session.open()
+    old, old_registry = session.cell, session.registry
+    session.open("sim")
+    assert old.closed and session.cell.name == "sim" and session.registry is not old_registry
+    session.close()
+    assert session.cell is None and session.clock() is None
+
+
+def test_a_cell_that_fails_falls_back_to_none_and_says_why(qtbot: Any) -> None:
+    session = CellSession("sim", opener=Opener(sim_fails=True))
+    with qtbot.waitSignal(session.cell_failed) as failed:
+        assert session.open() is False
+    assert "no GPU today" in failed.args[0]
+    assert session.name == "none" and session.cell.name == "none"
+    motion = [m.id for m in session.registry.manifests() if m.id.startswith("motion.")]
+    assert motion and not session.registry.availability(motion[0]).available
+
+
+def test_the_real_none_cell_opens(none_session: CellSession) -> None:
+    assert none_session.name == "none"
+    assert none_session.registry.availability("debug.succeed").available
