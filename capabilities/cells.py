@@ -46,7 +46,11 @@ class ManagedCell:
 
 
 def open_cell(
-    name: str, seed: int = 0, start: bool = True, scene: str | None = None, speed: float | None = None
+    name: str,
+    seed: int = 0,
+    start: bool = True,
+    scene: str | None = None,
+    speed: float | None = None,
 ) -> Any:
     """The cell called ``name``, as a context manager.
 

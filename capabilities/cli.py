@@ -100,7 +100,11 @@ def _install_interrupt(executor: Executor) -> Callable[[], None]:
             executor.stop("stopped", timeout=0)
 
         signal.signal(signal.SIGINT, on_interrupt)
-        return lambda: signal.signal(signal.SIGINT, previous)
+
+        def restore() -> None:
+            signal.signal(signal.SIGINT, previous)
+
+        return restore
     return lambda: None
 
 
@@ -256,7 +260,9 @@ def _parser() -> argparse.ArgumentParser:
             help="the cell to run on (default: none, only cell-free capabilities)",
         )
         p.add_argument("--seed", type=int, default=0, help="scene seed of the simulated cell")
-        p.add_argument("--scene", help="scene of the simulated cell (name or path; default cup_to_bin)")
+        p.add_argument(
+            "--scene", help="scene of the simulated cell (name or path; default cup_to_bin)"
+        )
 
     validate = sub.add_parser("validate", help="check a plan; exit 0 valid, 2 invalid")
     validate.add_argument("plan")

@@ -304,5 +304,3 @@ class ObjectLibrary:
                 raise ObjectLibraryError(f"{file}: line {exc.lineno}: not JSON: {exc.msg}") from exc
             self._models[name] = parse_model(data, directory, file)
         return self._models[name]
-
-

@@ -14,6 +14,7 @@ __all__ = ["CameraDevice", "FrameLike", "MarkerLayout", "camera_interface"]
 
 class FrameLike(Protocol):
     rgb: np.ndarray
+    depth: np.ndarray | None
     K: np.ndarray
     T_world_camera: Pose
     stamp: float

@@ -108,7 +108,7 @@ class DetectMarkers:
             frame = camera.capture()
             sizes = env.layout["marker_sizes"]
             observations = detect_markers(frame.rgb, frame.K, sizes)
-            if getattr(frame, "depth", None) is not None:
+            if frame.depth is not None:
                 observations = [refine_with_depth(o, frame.depth, frame.K) for o in observations]
             seen = {
                 o.marker_id: (o, marker_pose_world(o, frame.T_world_camera)) for o in observations

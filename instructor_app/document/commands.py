@@ -56,7 +56,9 @@ class AddNodeCommand(_Command):
         self.layout = {k: v for k, v in (layout or {}).items() if k in ids}
 
     def redo(self) -> None:
-        self.document._apply_insert(copy.deepcopy(self.node), self.parent_id, self.index, self.layout)
+        self.document._apply_insert(
+            copy.deepcopy(self.node), self.parent_id, self.index, self.layout
+        )
 
     def undo(self) -> None:
         self.document._apply_detach(self.node.id)
@@ -102,7 +104,9 @@ class MoveNodeCommand(_Command):
 class SetParamCommand(_Command):
     """Bind an operation port to a fixed value or a reference, or unbind it (None)."""
 
-    def __init__(self, document: PlanDocument, node_id: str, port: str, binding: Binding | None) -> None:
+    def __init__(
+        self, document: PlanDocument, node_id: str, port: str, binding: Binding | None
+    ) -> None:
         node = document.node(node_id)
         super().__init__(document, f"Set {port} of {node.label}")
         self.node_id = node_id
@@ -153,7 +157,9 @@ class RenameCommand(_Command):
 class SetLayoutCommand(_Command):
     """Move nodes on the canvas or collapse/expand them (None: no stored layout)."""
 
-    def __init__(self, document: PlanDocument, layouts: dict[str, NodeLayout | None], text: str) -> None:
+    def __init__(
+        self, document: PlanDocument, layouts: dict[str, NodeLayout | None], text: str
+    ) -> None:
         super().__init__(document, text)
         self.new = {k: copy.copy(v) for k, v in layouts.items()}
         self.old = {k: copy.copy(document.plan.layout.get(k)) for k in layouts}

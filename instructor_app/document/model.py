@@ -58,14 +58,16 @@ class PlanDocument(QObject):
     plan_reset = Signal()
     node_inserted = Signal(str, int, str)
     node_removed = Signal(str, int, list)
-    node_moved = Signal(str, str, int, str, int)
+    node_moved: Signal = Signal(str, str, int, str, int)
     node_changed = Signal(str)
     layout_changed = Signal(list)
     plan_changed = Signal()
     path_changed = Signal(str)
     dirty_changed = Signal(bool)
 
-    def __init__(self, parent: QObject | None = None, aliases: dict[str, str] | None = None) -> None:
+    def __init__(
+        self, parent: QObject | None = None, aliases: dict[str, str] | None = None
+    ) -> None:
         super().__init__(parent)
         self.plan = PlanSpec(name="Untitled plan")
         self.path: Path | None = None

@@ -62,7 +62,9 @@ def test_cell_examples_are_reproduced_by_their_generator() -> None:
 
     from capabilities.waypoints import WaypointLibrary, waypoints_path_for
 
-    spec = importlib.util.spec_from_file_location("make_cell_examples", EXAMPLES / "make_cell_examples.py")
+    spec = importlib.util.spec_from_file_location(
+        "make_cell_examples", EXAMPLES / "make_cell_examples.py"
+    )
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
