@@ -115,7 +115,7 @@ def _screenshot(args: argparse.Namespace) -> int:
                 except DocumentError as exc:
                     print(f"error: {exc}", file=sys.stderr)
                     return EXIT_BAD_INPUT
-            window.resize(1400, 900)
+            window.resize(1920, 1080)
             window.show()
             code = _run_for_picture(window, args.timeout) if args.run else EXIT_OK
             _grab(window, Path(args.screenshot))
@@ -157,9 +157,26 @@ def _run_for_picture(window: MainWindow, timeout: float) -> int:
     return EXIT_OK if outcome[0].status is Status.SUCCESS else EXIT_RUN_FAILED
 
 
+def _node_to_show(window: MainWindow) -> str | None:
+    """The node the picture's inspector shows: the failing node, else the first motion."""
+    failed = window.controller.statuses
+    for node_id, status in failed.items():
+        if status is Status.FAILURE and not window.document.node(node_id).children:
+            return node_id
+    first_op = None
+    for _, node in window.document.plan.walk():
+        if node.op and node.op.startswith("motion.") and node.params:
+            return node.id
+        first_op = first_op or (node.id if node.op else None)
+    return first_op
+
+
 def _grab(window: MainWindow, path: Path) -> None:
     if window.views.validation.pending():  # the problems list shows the plan as it is
         window.views.validation.revalidate()
+    shown = _node_to_show(window)
+    if shown is not None:
+        window.select_node(shown)
     window.views.canvas.fit_all()
     QApplication.processEvents()
     path.parent.mkdir(parents=True, exist_ok=True)

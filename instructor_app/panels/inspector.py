@@ -74,7 +74,16 @@ class InspectorPanel(QWidget):
         self.doc_label.setWordWrap(True)
         self.doc_label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
         self._form_holder = QWidget()
-        self.form = QFormLayout(self._form_holder)
+        holder_layout = QVBoxLayout(self._form_holder)
+        holder_layout.setContentsMargins(0, 0, 0, 0)
+        form_widget = QWidget()
+        self.form = QFormLayout(form_widget)
+        # Labels above their fields when the dock is narrow, never cut off; rows keep their
+        # natural height and the space left stays below them.
+        self.form.setRowWrapPolicy(QFormLayout.RowWrapPolicy.WrapLongRows)
+        self.form.setFieldGrowthPolicy(QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
+        holder_layout.addWidget(form_widget)
+        holder_layout.addStretch(1)
         scroll = QScrollArea()
         scroll.setWidgetResizable(True)
         scroll.setWidget(self._form_holder)

@@ -189,6 +189,9 @@ class RunController(QObject):
         self._executor.start(paused=paused)
         self._timer.start()
         self._set_state(PAUSED if paused else RUNNING)
+        # Every node starts the run grey (IDLE), also those the run never reaches; sent after
+        # the state change, on which the views clear the last run's colours.
+        self.statuses_changed.emit(dict(self._statuses))
         self.log_message.emit(f"Run of {plan.name or 'the plan'} started", "info")
         return True
 
@@ -198,6 +201,7 @@ class RunController(QObject):
         self._pump.drain()  # leftovers of an earlier run must not colour this one
         self._statuses, self._messages, self._running = {}, {}, []
         self._set_failure("", "")
+        self._statuses.update({node_id: Status.IDLE for node_id in self._order})
 
     # ------------------------------------------------------------------ GUI thread
 

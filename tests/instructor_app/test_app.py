@@ -22,7 +22,7 @@ def test_screenshot_of_a_plan_writes_a_png(qapp: Any, tmp_path: Path, figure3_pa
     png = tmp_path / "shots" / "window.png"
     assert main([str(figure3_path), "--cell", "none", "--screenshot", str(png)]) == EXIT_OK
     image = picture(png)
-    assert (image.width(), image.height()) == (1400, 900)
+    assert (image.width(), image.height()) == (1920, 1080)
 
 
 def test_screenshot_after_a_run(qapp: Any, tmp_path: Path, figure3_path: Path, capsys: Any) -> None:
