@@ -8,7 +8,6 @@ save, recent, recovery), and the signal wiring, which lives in :meth:`_wire_view
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -17,17 +16,15 @@ from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
 from PySide6.QtWidgets import (
     QComboBox,
     QDockWidget,
-    QFileDialog,
     QLabel,
     QMainWindow,
-    QMessageBox,
     QWidget,
 )
 
-from engine.spec import NodeKind
+from instructor_app.dialogs import APP_TITLE, DISCARD, SAVE, Dialogs
 from instructor_app.document.autosave import DEFAULT_INTERVAL_MS, Autosaver, offer_recoveries
 from instructor_app.document.model import DocumentError, PlanDocument
-from instructor_app.node_factory import PaletteItem, make_node, manifest_or_none, readable
+from instructor_app.node_factory import make_node, manifest_or_none
 from instructor_app.runtime.controller import FINISHED, IDLE, RunController
 from instructor_app.runtime.run_view import (
     FailureButton,
@@ -37,116 +34,9 @@ from instructor_app.runtime.run_view import (
 )
 from instructor_app.runtime.session import CellSession
 from instructor_app.settings import AppSettings, RecentFilesMenu
+from instructor_app.views import Views, make_views
 
-__all__ = ["Dialogs", "MainWindow", "Views", "make_views", "APP_TITLE", "PLAN_FILTER"]
-
-APP_TITLE = "CoSTAR Instructor"
-PLAN_FILTER = "CoSTAR plans (*.costar.json);;JSON files (*.json);;All files (*)"
-SAVE, DISCARD, CANCEL = "save", "discard", "cancel"
-CANVAS_ACTIONS = (
-    "cut", "copy", "paste", "duplicate", "delete",
-    "move_left", "move_right", "toggle_collapse", "auto_layout",
-)  # fmt: skip
-
-
-@dataclass
-class Views:
-    """The canvas and panels the window shows; the one place that knows their APIs."""
-
-    canvas: Any
-    canvas_actions: dict[str, QAction]
-    palette: Any
-    inspector: Any
-    validation: Any
-    blackboard: Any
-    log: Any
-
-    def set_registry(self, registry: Any) -> None:
-        """Another cell: every view that shows operations rebuilds from its registry."""
-        for view in (self.palette, self.inspector, self.validation):
-            view.set_registry(registry)
-        self.canvas.set_operation_kinds({m.id: m.kind for m in registry.manifests()})
-        library = registry.cell.interfaces().get("objects")
-        self.inspector.set_object_names(library.names() if library is not None else [])
-
-
-def _item_for(kind: NodeKind, op: str | None) -> PaletteItem:
-    """The palette item of a canvas drop or "Add child" (the canvas passes kind and op)."""
-    label = readable(op or kind.value)
-    return PaletteItem(kind, op, label, "", "")
-
-
-def make_views(document: PlanDocument, session: CellSession, parent: QWidget) -> Views:
-    """Create the canvas and the panels for ``document`` on the session's cell."""
-    from instructor_app.canvas import CanvasView
-    from instructor_app.panels import (
-        BlackboardPanel,
-        InspectorPanel,
-        LogPanel,
-        PalettePanel,
-        ValidationPanel,
-    )
-
-    registry = session.registry
-    canvas = CanvasView(document, parent)
-    canvas.set_node_factory(
-        lambda kind, op: make_node(_item_for(kind, op), manifest_or_none(session.registry, op))
-    )
-    actions = {name: canvas.action(name) for name in CANVAS_ACTIONS}
-    views = Views(
-        canvas,
-        actions,
-        PalettePanel(registry, parent),
-        InspectorPanel(document, registry, parent),
-        ValidationPanel(document, registry, parent),
-        BlackboardPanel(parent),
-        LogPanel(parent=parent),
-    )
-    views.set_registry(registry)
-    return views
-
-
-class Dialogs:
-    """The window's questions and messages. Tests replace it, or patch :meth:`make_box`."""
-
-    def make_box(self, parent: QWidget) -> QMessageBox:
-        return QMessageBox(parent)
-
-    def ask_save_changes(self, parent: QWidget, name: str) -> str:
-        """ "save", "discard" or "cancel"."""
-        box = self.make_box(parent)
-        box.setIcon(QMessageBox.Icon.Warning)
-        box.setWindowTitle(APP_TITLE)
-        box.setText(f"Save the changes to {name}?")
-        box.setInformativeText("Your changes are lost if you don't save them.")
-        buttons = QMessageBox.StandardButton
-        box.setStandardButtons(buttons.Save | buttons.Discard | buttons.Cancel)
-        box.setDefaultButton(buttons.Save)
-        answer = box.exec()
-        return {buttons.Save: SAVE, buttons.Discard: DISCARD}.get(buttons(answer), CANCEL)
-
-    def ask_restore(self, parent: QWidget, description: str) -> bool:
-        buttons = QMessageBox.StandardButton
-        answer = QMessageBox.question(
-            parent,
-            APP_TITLE,
-            f"The Instructor did not close properly. Restore the unsaved plan?\n\n{description}",
-            buttons.Yes | buttons.No,
-            buttons.Yes,
-        )
-        return answer == buttons.Yes
-
-    def error(self, parent: QWidget, title: str, text: str) -> None:
-        QMessageBox.critical(parent, title, text)
-
-    def open_path(self, parent: QWidget, folder: str) -> str:
-        return QFileDialog.getOpenFileName(parent, "Open plan", folder, PLAN_FILTER)[0]
-
-    def save_path(self, parent: QWidget, suggested: str) -> str:
-        return QFileDialog.getSaveFileName(parent, "Save plan as", suggested, PLAN_FILTER)[0]
-
-    def about(self, parent: QWidget, text: str) -> None:
-        QMessageBox.about(parent, f"About {APP_TITLE}", text)
+__all__ = ["APP_TITLE", "DISCARD", "Dialogs", "MainWindow", "Views", "make_views"]
 
 
 class MainWindow(QMainWindow):

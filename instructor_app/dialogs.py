@@ -1,0 +1,54 @@
+"""The main window's questions and messages, replaceable in tests and headless runs."""
+
+from __future__ import annotations
+
+from PySide6.QtWidgets import QFileDialog, QMessageBox, QWidget
+
+__all__ = ["APP_TITLE", "CANCEL", "DISCARD", "PLAN_FILTER", "SAVE", "Dialogs"]
+
+APP_TITLE = "CoSTAR Instructor"
+PLAN_FILTER = "CoSTAR plans (*.costar.json);;JSON files (*.json);;All files (*)"
+SAVE, DISCARD, CANCEL = "save", "discard", "cancel"
+
+
+class Dialogs:
+    """The window's questions and messages. Tests replace it, or patch :meth:`make_box`."""
+
+    def make_box(self, parent: QWidget) -> QMessageBox:
+        return QMessageBox(parent)
+
+    def ask_save_changes(self, parent: QWidget, name: str) -> str:
+        """ "save", "discard" or "cancel"."""
+        box = self.make_box(parent)
+        box.setIcon(QMessageBox.Icon.Warning)
+        box.setWindowTitle(APP_TITLE)
+        box.setText(f"Save the changes to {name}?")
+        box.setInformativeText("Your changes are lost if you don't save them.")
+        buttons = QMessageBox.StandardButton
+        box.setStandardButtons(buttons.Save | buttons.Discard | buttons.Cancel)
+        box.setDefaultButton(buttons.Save)
+        answer = box.exec()
+        return {buttons.Save: SAVE, buttons.Discard: DISCARD}.get(buttons(answer), CANCEL)
+
+    def ask_restore(self, parent: QWidget, description: str) -> bool:
+        buttons = QMessageBox.StandardButton
+        answer = QMessageBox.question(
+            parent,
+            APP_TITLE,
+            f"The Instructor did not close properly. Restore the unsaved plan?\n\n{description}",
+            buttons.Yes | buttons.No,
+            buttons.Yes,
+        )
+        return answer == buttons.Yes
+
+    def error(self, parent: QWidget, title: str, text: str) -> None:
+        QMessageBox.critical(parent, title, text)
+
+    def open_path(self, parent: QWidget, folder: str) -> str:
+        return QFileDialog.getOpenFileName(parent, "Open plan", folder, PLAN_FILTER)[0]
+
+    def save_path(self, parent: QWidget, suggested: str) -> str:
+        return QFileDialog.getSaveFileName(parent, "Save plan as", suggested, PLAN_FILTER)[0]
+
+    def about(self, parent: QWidget, text: str) -> None:
+        QMessageBox.about(parent, f"About {APP_TITLE}", text)

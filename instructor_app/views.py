@@ -1,0 +1,78 @@
+"""The canvas and panels of the main window: the one place that knows their APIs."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from PySide6.QtGui import QAction
+from PySide6.QtWidgets import QWidget
+
+from engine.spec import NodeKind
+from instructor_app.document.model import PlanDocument
+from instructor_app.node_factory import PaletteItem, make_node, manifest_or_none, readable
+from instructor_app.runtime.session import CellSession
+
+__all__ = ["CANVAS_ACTIONS", "Views", "make_views"]
+
+CANVAS_ACTIONS = (
+    "cut", "copy", "paste", "duplicate", "delete",
+    "move_left", "move_right", "toggle_collapse", "auto_layout",
+)  # fmt: skip
+
+
+@dataclass
+class Views:
+    """The canvas and panels the window shows; the one place that knows their APIs."""
+
+    canvas: Any
+    canvas_actions: dict[str, QAction]
+    palette: Any
+    inspector: Any
+    validation: Any
+    blackboard: Any
+    log: Any
+
+    def set_registry(self, registry: Any) -> None:
+        """Another cell: every view that shows operations rebuilds from its registry."""
+        for view in (self.palette, self.inspector, self.validation):
+            view.set_registry(registry)
+        self.canvas.set_operation_kinds({m.id: m.kind for m in registry.manifests()})
+        library = registry.cell.interfaces().get("objects")
+        self.inspector.set_object_names(library.names() if library is not None else [])
+
+
+def _item_for(kind: NodeKind, op: str | None) -> PaletteItem:
+    """The palette item of a canvas drop or "Add child" (the canvas passes kind and op)."""
+    label = readable(op or kind.value)
+    return PaletteItem(kind, op, label, "", "")
+
+
+def make_views(document: PlanDocument, session: CellSession, parent: QWidget) -> Views:
+    """Create the canvas and the panels for ``document`` on the session's cell."""
+    from instructor_app.canvas import CanvasView
+    from instructor_app.panels import (
+        BlackboardPanel,
+        InspectorPanel,
+        LogPanel,
+        PalettePanel,
+        ValidationPanel,
+    )
+
+    registry = session.registry
+    canvas = CanvasView(document, parent)
+    canvas.set_node_factory(
+        lambda kind, op: make_node(_item_for(kind, op), manifest_or_none(session.registry, op))
+    )
+    actions = {name: canvas.action(name) for name in CANVAS_ACTIONS}
+    views = Views(
+        canvas,
+        actions,
+        PalettePanel(registry, parent),
+        InspectorPanel(document, registry, parent),
+        ValidationPanel(document, registry, parent),
+        BlackboardPanel(parent),
+        LogPanel(parent=parent),
+    )
+    views.set_registry(registry)
+    return views
