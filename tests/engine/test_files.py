@@ -12,7 +12,7 @@ from typing import Any
 import jsonschema
 import pytest
 
-from engine import files
+from engine import files, plan_writer
 from engine.files import (
     MAX_TREE_DEPTH,
     PlanFileError,
@@ -373,7 +373,7 @@ def test_failed_save_leaves_the_old_file(
     def broken(*args: Any) -> None:
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(files.os, failing, broken)
+    monkeypatch.setattr(plan_writer.os, failing, broken)
     with pytest.raises(
         PlanFileError,
         match=r"plan\.costar\.json: expected a place where the plan can be written, got No space",

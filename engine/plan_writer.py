@@ -1,0 +1,167 @@
+"""Writing plan files: deterministic JSON (save -> load -> save is byte-identical), atomically."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import uuid
+from pathlib import Path
+from typing import Any
+
+from engine.plan_format import (
+    FORMAT,
+    FORMAT_VERSION,
+    MAX_TREE_DEPTH,
+    PlanFileError,
+)
+from engine.spec import (
+    Binding,
+    NodeKind,
+    NodeSpec,
+    ParameterDecl,
+    PlanSpec,
+    RunPolicy,
+)
+from engine.types import ParamType, encode_value
+
+__all__ = ["dump_plan", "save_plan", "write_atomic"]
+
+# --------------------------------------------------------------------------- writing
+
+
+def _encode_typed(ptype: ParamType, value: Any) -> Any:
+    """A Number or Duration is read back as a float: write it as one, so the bytes stay put."""
+    is_int = isinstance(value, int) and not isinstance(value, bool)
+    if is_int and ParamType(ptype) in (ParamType.NUMBER, ParamType.DURATION):
+        return float(value)
+    return encode_value(value)
+
+
+def _encode_binding(binding: Binding) -> dict[str, Any]:
+    if binding.ref is not None:
+        return {"ref": binding.ref}
+    ptype = binding.type if binding.type is not None else ParamType.ANY
+    return {"type": ParamType(ptype).value, "value": _encode_typed(ptype, binding.value)}
+
+
+def _encode_node(node: NodeSpec, depth: int) -> dict[str, Any]:
+    if depth > MAX_TREE_DEPTH:
+        raise PlanFileError(
+            "<plan>", "$.tree", f"a tree at most {MAX_TREE_DEPTH} levels deep", "a deeper tree"
+        )
+    out: dict[str, Any] = {"id": node.id, "kind": NodeKind(node.kind).value}
+    if node.name:
+        out["name"] = node.name
+    if node.op is not None:
+        out["op"] = node.op
+    # A binding with neither value nor reference says nothing: leave it out.
+    params = {
+        p: b
+        for p, b in node.params.items()
+        if b.ref is not None or b.type is not None or b.value is not None
+    }
+    if params:
+        out["params"] = {port: _encode_binding(params[port]) for port in sorted(params)}
+    if node.config:
+        out["config"] = {key: encode_value(node.config[key]) for key in sorted(node.config)}
+    if node.children:
+        out["children"] = [_encode_node(child, depth + 1) for child in node.children]
+    return out
+
+
+def _encode_layout(plan: PlanSpec) -> dict[str, Any]:
+    """Tree order first, then entries of nodes not in the tree, by id: one canonical order."""
+    order = [node.id for _, node in plan.walk() if node.id in plan.layout]
+    order += sorted(set(plan.layout) - set(order))
+    return {
+        node_id: {
+            "x": float(plan.layout[node_id].x),
+            "y": float(plan.layout[node_id].y),
+            "collapsed": bool(plan.layout[node_id].collapsed),
+        }
+        for node_id in order
+    }
+
+
+def _encode_parameter(decl: ParameterDecl) -> dict[str, Any]:
+    out: dict[str, Any] = {"name": decl.name, "type": ParamType(decl.type).value}
+    if decl.value is not None:
+        out["value"] = _encode_typed(decl.type, decl.value)
+    if decl.doc:
+        out["doc"] = decl.doc
+    return out
+
+
+def dump_plan(plan: PlanSpec) -> str:
+    """The plan file text of a plan: deterministic, indent 2, trailing newline.
+
+    Raises:
+        PlanFileError: the plan holds a NaN or infinite number, or is deeper than
+            :data:`MAX_TREE_DEPTH`.
+    """
+    doc = {
+        "format": FORMAT,
+        "format_version": FORMAT_VERSION,
+        "id": plan.id,
+        "name": plan.name,
+        "description": plan.description,
+        "run_policy": RunPolicy(plan.run_policy).value,
+        "parameters": [_encode_parameter(decl) for decl in plan.parameters],
+        "tree": None if plan.tree is None else _encode_node(plan.tree, 1),
+        "waypoints": [encode_value(waypoint) for waypoint in plan.waypoints],
+        "objects": list(plan.objects),
+        "layout": {"nodes": _encode_layout(plan)},
+    }
+    try:
+        return json.dumps(doc, indent=2, ensure_ascii=False, allow_nan=False) + "\n"
+    except ValueError as exc:
+        raise PlanFileError(
+            "<plan>", "", "finite numbers (JSON has no NaN or Infinity)", str(exc)
+        ) from exc
+
+
+def save_plan(plan: PlanSpec, path: str | os.PathLike[str]) -> None:
+    """Write a plan file atomically: a temporary file in the same folder, fsync, rename.
+
+    A failure at any point leaves the previous file as it was.
+
+    Raises:
+        PlanFileError: the plan cannot be encoded or the file cannot be written.
+    """
+    write_atomic(Path(os.fspath(path)), dump_plan(plan).encode("utf-8"))
+
+
+def write_atomic(target: Path, data: bytes) -> None:
+    tmp = target.with_name(f".{target.name}.{uuid.uuid4().hex[:8]}.tmp")
+    done = False
+    try:
+        # os.open applies the umask to 0o666, as a plain open() of the target would.
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
+        with os.fdopen(fd, "wb") as handle:
+            handle.write(data)
+            handle.flush()
+            os.fsync(handle.fileno())
+        with contextlib.suppress(FileNotFoundError):
+            os.chmod(tmp, os.stat(target).st_mode & 0o7777)  # keep the old file's permissions
+        os.replace(tmp, target)
+        done = True
+    except OSError as exc:
+        raise PlanFileError(
+            str(target), "", "a place where the plan can be written", exc.strerror or str(exc)
+        ) from exc
+    finally:
+        if not done:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+    _sync_folder(target.parent)
+
+
+def _sync_folder(folder: Path) -> None:
+    """Make the rename itself durable where the system allows it (not on Windows)."""
+    with contextlib.suppress(OSError, AttributeError):
+        fd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
