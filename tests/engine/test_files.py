@@ -12,7 +12,7 @@ from typing import Any
 import jsonschema
 import pytest
 
-from engine import files, plan_writer
+from engine import plan_writer
 from engine.files import (
     MAX_TREE_DEPTH,
     PlanFileError,
