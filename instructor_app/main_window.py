@@ -90,6 +90,10 @@ class MainWindow(QMainWindow):
         area = Qt.DockWidgetArea
         self._dock("palette", "Palette", self.views.palette, area.LeftDockWidgetArea)
         self._dock("inspector", "Inspector", self.views.inspector, area.RightDockWidgetArea)
+        self._dock("plan", "Plan", self.views.plan_settings, area.RightDockWidgetArea)
+        self._dock("waypoints", "Waypoints", self.views.waypoints, area.RightDockWidgetArea)
+        self.splitDockWidget(self.docks["inspector"], self.docks["plan"], Qt.Orientation.Vertical)
+        self.tabifyDockWidget(self.docks["plan"], self.docks["waypoints"])
         bottom = [
             ("validation", "Problems", self.views.validation),
             ("log", "Log", self.views.log),
@@ -186,6 +190,7 @@ class MainWindow(QMainWindow):
         views, document = self.views, self.document
         views.canvas.selection_changed.connect(self._on_selection)
         views.canvas.message.connect(self.show_message)
+        views.waypoints.message.connect(self.show_message)
         views.palette.item_activated.connect(self.add_palette_item)
         views.validation.node_selected.connect(self.select_node)
         views.validation.summary_changed.connect(self._on_summary)

@@ -32,10 +32,12 @@ class Views:
     validation: Any
     blackboard: Any
     log: Any
+    plan_settings: Any
+    waypoints: Any
 
     def set_registry(self, registry: Any) -> None:
         """Another cell: every view that shows operations rebuilds from its registry."""
-        for view in (self.palette, self.inspector, self.validation):
+        for view in (self.palette, self.inspector, self.validation, self.waypoints):
             view.set_registry(registry)
         self.canvas.set_operation_kinds({m.id: m.kind for m in registry.manifests()})
         library = registry.cell.interfaces().get("objects")
@@ -56,7 +58,9 @@ def make_views(document: PlanDocument, session: CellSession, parent: QWidget) ->
         InspectorPanel,
         LogPanel,
         PalettePanel,
+        PlanSettingsPanel,
         ValidationPanel,
+        WaypointsPanel,
     )
 
     registry = session.registry
@@ -73,6 +77,8 @@ def make_views(document: PlanDocument, session: CellSession, parent: QWidget) ->
         ValidationPanel(document, registry, parent),
         BlackboardPanel(parent),
         LogPanel(parent=parent),
+        PlanSettingsPanel(document, parent),
+        WaypointsPanel(document, registry, parent),
     )
     views.set_registry(registry)
     return views

@@ -1,4 +1,5 @@
-"""Side panels of the Instructor: palette, inspector, validation, blackboard and log."""
+"""Side panels of the Instructor: palette, inspector, validation, blackboard, log, the plan's
+settings and its waypoints."""
 
 from __future__ import annotations
 
@@ -6,6 +7,16 @@ from instructor_app.panels.blackboard import BlackboardPanel
 from instructor_app.panels.inspector import InspectorPanel
 from instructor_app.panels.log import LogPanel
 from instructor_app.panels.palette import PalettePanel
+from instructor_app.panels.plan_settings import PlanSettingsPanel
 from instructor_app.panels.validation import ValidationPanel
+from instructor_app.panels.waypoints import WaypointsPanel
 
-__all__ = ["BlackboardPanel", "InspectorPanel", "LogPanel", "PalettePanel", "ValidationPanel"]
+__all__ = [
+    "BlackboardPanel",
+    "InspectorPanel",
+    "LogPanel",
+    "PalettePanel",
+    "PlanSettingsPanel",
+    "ValidationPanel",
+    "WaypointsPanel",
+]

@@ -1,7 +1,10 @@
-"""Drive the Instructor like a user: palette double-clicks, inspector fields, the run button.
+"""Drive the Instructor like a user: palette search and double-clicks, canvas clicks,
+inspector fields, the plan panels, the run button.
 
 For the window tests and the end-to-end test (build a plan from an empty document, save,
-reopen, run). Every helper goes through widgets and their signals, not private methods.
+reopen, run). Every helper goes through widgets: keys typed into fields, combo entries chosen
+with the keyboard, buttons clicked. Only editors without a typed path (pose, region, joints
+grids) get their value set and committed through the editor's own signal.
 """
 
 from __future__ import annotations
@@ -10,12 +13,23 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtCore import QSettings, Qt
-from PySide6.QtWidgets import QTreeWidgetItem, QWidget
+from PySide6.QtCore import QPointF, QSettings, Qt
+from PySide6.QtWidgets import QComboBox, QDockWidget, QToolBar, QTreeWidgetItem, QWidget
 
-from engine.types import ParamType
-from instructor_app.inspectors.rows import MODE_REFERENCE, MODE_VALUE, PortRow
+from engine.spec import RunPolicy
+from engine.types import ObjectModel, ParamType, Waypoint
+from instructor_app.inspectors.base import ParamEditor
+from instructor_app.inspectors.editors import (
+    ChoiceEditor,
+    NumberEditor,
+    ObjectModelEditor,
+    TextEditor,
+    WaypointEditor,
+)
+from instructor_app.inspectors.rows import MODE_REFERENCE, MODE_UNSET, MODE_VALUE, PortRow
 from instructor_app.main_window import DISCARD, Dialogs, MainWindow
+from instructor_app.panels.plan_settings import POLICY_TEXT, PlanSettingsPanel
+from instructor_app.panels.waypoints import WaypointsPanel
 from instructor_app.runtime.controller import RunOutcome
 from instructor_app.runtime.session import CellSession
 from instructor_app.settings import AppSettings
@@ -25,10 +39,21 @@ __all__ = [
     "make_window",
     "palette_row",
     "add_from_palette",
+    "search_insert",
+    "double_click_palette",
     "select",
+    "click_node",
+    "choose",
+    "choose_index",
     "rename",
     "bind_reference",
     "set_value",
+    "unset",
+    "plan_panels",
+    "set_run_policy",
+    "set_plan_name",
+    "import_waypoints",
+    "press_run",
     "run_to_end",
     "node_named",
 ]
@@ -116,9 +141,34 @@ def add_from_palette(qtbot: Any, window: MainWindow, key: str) -> str:
     tree = window.views.palette.tree
     tree.setCurrentItem(palette_row(window, key))
     qtbot.keyClick(tree, Qt.Key.Key_Return)
-    added = [i for i in _ids(window) if i not in before]
-    assert len(added) == 1, f"inserting {key!r} from the palette added {len(added)} nodes"
-    return added[0]
+    return _one_added(window, before, key)
+
+
+def search_insert(qtbot: Any, window: MainWindow, text: str, expect: str) -> str:
+    """Type ``text`` into the palette's search field and press Enter (search-to-insert);
+    checks that the node added is ``expect`` (an operation id or a kind) and returns its id."""
+    before = _ids(window)
+    field = window.views.palette.search_field
+    _replace_text(qtbot, field, text)
+    qtbot.keyClick(field, Qt.Key.Key_Return)
+    added = _one_added(window, before, text)
+    node = window.document.node(added)
+    assert expect in (node.op, node.kind.value), f"{text!r} inserted {node.op or node.kind}"
+    return added
+
+
+def double_click_palette(qtbot: Any, window: MainWindow, key: str) -> str:
+    """Clear the search, double-click the palette row of ``key``; the added node's id."""
+    before = _ids(window)
+    palette = window.views.palette
+    _replace_text(qtbot, palette.search_field, "")
+    row = palette_row(window, key)
+    palette.tree.scrollToItem(row)
+    centre = palette.tree.visualItemRect(row).center()
+    # A double click is press, release, then a second press that Qt reports as double.
+    qtbot.mouseClick(palette.tree.viewport(), Qt.MouseButton.LeftButton, pos=centre)
+    qtbot.mouseDClick(palette.tree.viewport(), Qt.MouseButton.LeftButton, pos=centre)
+    return _one_added(window, before, key)
 
 
 def select(window: MainWindow, node_id: str) -> None:
@@ -127,11 +177,30 @@ def select(window: MainWindow, node_id: str) -> None:
     assert window.views.inspector.shown_node_id() == node_id
 
 
+def click_node(qtbot: Any, window: MainWindow, node_id: str) -> None:
+    """Bring a node into view and click its body on the canvas; the inspector then shows it."""
+    canvas = window.views.canvas
+    canvas.center_on(node_id)
+    item = canvas.item(node_id)
+    viewer = canvas.viewer
+    rect = item.shape_rect()
+    # A spot of the body that nothing covers (ports sit on the edges, the title on top).
+    spots = [
+        QPointF(rect.left() + 16, rect.bottom() - 6),
+        QPointF(rect.right() - 16, rect.center().y()),
+    ]
+    points = [viewer.mapFromScene(item.mapToScene(spot)) for spot in spots]
+    pos = next((p for p in points if viewer.items(p)[:1] == [item]), None)
+    assert pos is not None, "no free spot of the node to click"
+    qtbot.mouseClick(viewer.viewport(), Qt.MouseButton.LeftButton, pos=pos)
+    assert canvas.selected_ids() == [node_id], f"the click selected {canvas.selected_ids()}"
+    assert window.views.inspector.shown_node_id() == node_id
+
+
 def rename(qtbot: Any, window: MainWindow, node_id: str, name: str) -> None:
     select(window, node_id)
     field = window.views.inspector.name_field
-    field.selectAll()
-    qtbot.keyClicks(field, name)
+    _replace_text(qtbot, field, name)
     qtbot.keyClick(field, Qt.Key.Key_Return)
 
 
@@ -140,39 +209,144 @@ def bind_reference(qtbot: Any, window: MainWindow, node_id: str, port: str, name
     select(window, node_id)
     row: PortRow = window.views.inspector.port_row(port)
     if row.mode_combo.count():
-        _choose_mode(row, MODE_REFERENCE)
-    row.ref_field.clear()
-    qtbot.keyClicks(row.ref_field, name)
+        choose_index(qtbot, row.mode_combo, MODE_REFERENCE)
+    _replace_text(qtbot, row.ref_field, name)
     qtbot.keyClick(row.ref_field, Qt.Key.Key_Return)
 
 
 def set_value(
-    window: MainWindow, node_id: str, port: str, value: Any, ptype: ParamType | None = None
+    qtbot: Any,
+    window: MainWindow,
+    node_id: str,
+    port: str,
+    value: Any,
+    ptype: ParamType | None = None,
 ) -> None:
-    """Give a port a fixed value through its editor (as if typed and committed)."""
+    """Give a port a fixed value: choose "value" (and the type), then enter the value in
+    its editor as a user would (type it, or pick it from the combo)."""
     select(window, node_id)
     row: PortRow = window.views.inspector.port_row(port)
+    choose_index(qtbot, row.mode_combo, MODE_VALUE)
     if ptype is not None and ptype is not row.value_type:
-        index = row.types.index(ptype)
-        row.type_combo.setCurrentIndex(index)
-        row.type_combo.activated.emit(index)
-    _choose_mode(row, MODE_VALUE)
-    row = window.views.inspector.port_row(port)
+        choose(qtbot, row.type_combo, ptype.value)
     assert row.editor is not None
-    row.editor.set_value(value)
-    row.editor.value_committed.emit(value)  # what the editor says when the user is done
+    _enter(qtbot, row.editor, value)
 
 
-def _choose_mode(row: PortRow, mode: int) -> None:
-    if row.mode != mode:
-        row.mode_combo.setCurrentIndex(mode)
-        row.mode_combo.activated.emit(mode)
+def unset(qtbot: Any, window: MainWindow, node_id: str, port: str) -> None:
+    """Choose "not set" / "default" for a port."""
+    select(window, node_id)
+    choose_index(qtbot, window.views.inspector.port_row(port).mode_combo, MODE_UNSET)
+
+
+def _enter(qtbot: Any, editor: ParamEditor, value: Any) -> None:
+    if isinstance(editor, WaypointEditor):
+        choose(qtbot, editor.combo, value.name if isinstance(value, Waypoint) else str(value))
+    elif isinstance(editor, ChoiceEditor):
+        choose(qtbot, editor.combo, str(value))
+    elif isinstance(editor, ObjectModelEditor):
+        line = editor.combo.lineEdit()
+        _replace_text(qtbot, line, value.name if isinstance(value, ObjectModel) else str(value))
+        qtbot.keyClick(line, Qt.Key.Key_Return)
+    elif isinstance(editor, TextEditor):
+        _replace_text(qtbot, editor.line, str(value))
+        qtbot.keyClick(editor.line, Qt.Key.Key_Return)
+    elif isinstance(editor, NumberEditor):
+        spin = editor.spin
+        shown = spin.unit.to_display(float(value))
+        spin.selectAll()
+        qtbot.keyClicks(spin, f"{shown:.{spin.decimals()}f}")
+        qtbot.keyClick(spin, Qt.Key.Key_Return)
+    else:  # pose, region, joints grids: no single field to type into
+        editor.set_value(value)
+        editor.value_committed.emit(value)
+    assert editor.value() == value, f"the editor shows {editor.value()!r}, not {value!r}"
+
+
+def choose(qtbot: Any, combo: QComboBox, text: str) -> None:
+    """Choose the entry whose text is ``text`` (or starts with ``text (``) from a combo."""
+    texts = [combo.itemText(i) for i in range(combo.count())]
+    index = next((i for i, t in enumerate(texts) if t == text or t.startswith(f"{text} (")), -1)
+    assert index >= 0, f"the combo offers {texts}, not {text!r}"
+    choose_index(qtbot, combo, index)
+
+
+def choose_index(qtbot: Any, combo: QComboBox, index: int) -> None:
+    """Open the combo's list, move to entry ``index`` with the arrow keys, press Enter."""
+    combo.showPopup()
+    view = combo.view()
+    qtbot.waitUntil(view.isVisible, timeout=2000)
+    current = view.currentIndex().row()
+    if current < 0:
+        qtbot.keyClick(view, Qt.Key.Key_Home)
+        current = view.currentIndex().row()
+    key = Qt.Key.Key_Down if index > current else Qt.Key.Key_Up
+    for _ in range(abs(index - current)):
+        qtbot.keyClick(view, key)
+    qtbot.keyClick(view, Qt.Key.Key_Return)
+    assert combo.currentIndex() == index, f"the combo shows entry {combo.currentIndex()}"
+
+
+# ---------------------------------------------------------------------- plan panels
+
+
+def plan_panels(window: MainWindow) -> tuple[PlanSettingsPanel, WaypointsPanel]:
+    """The window's plan settings and waypoints panels; docked here if the window has none
+    yet (as the window does it: registry changes reach the waypoints panel)."""
+    settings = window.findChild(PlanSettingsPanel)
+    if settings is None:
+        settings = PlanSettingsPanel(window.document, window)
+        _dock(window, "plan", "Plan", settings)
+    waypoints = window.findChild(WaypointsPanel)
+    if waypoints is None:
+        waypoints = WaypointsPanel(window.document, window.session.registry, window)
+        window.session.registry_changed.connect(waypoints.set_registry)
+        waypoints.message.connect(window.show_message)
+        _dock(window, "waypoints", "Waypoints", waypoints)
+    return settings, waypoints
+
+
+def _dock(window: MainWindow, name: str, title: str, widget: QWidget) -> None:
+    dock = QDockWidget(title, window)
+    dock.setObjectName(f"{name}_dock")
+    dock.setWidget(widget)
+    window.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, dock)
+    dock.show()
+
+
+def set_run_policy(qtbot: Any, window: MainWindow, policy: RunPolicy) -> None:
+    choose(qtbot, plan_panels(window)[0].policy_combo, POLICY_TEXT[policy])
+
+
+def set_plan_name(qtbot: Any, window: MainWindow, name: str) -> None:
+    field = plan_panels(window)[0].name_field
+    _replace_text(qtbot, field, name)
+    qtbot.keyClick(field, Qt.Key.Key_Return)
+
+
+def import_waypoints(qtbot: Any, window: MainWindow, path: Path) -> None:
+    """Press the waypoints panel's Import button and pick ``path`` in the file dialog."""
+    panel = plan_panels(window)[1]
+    panel.ask_path = lambda parent: str(path)
+    qtbot.mouseClick(panel.import_button, Qt.MouseButton.LeftButton)
+
+
+# ---------------------------------------------------------------------- runs
+
+
+def press_run(qtbot: Any, window: MainWindow) -> None:
+    """Click the Run button of the toolbar."""
+    toolbar = window.findChild(QToolBar, "run_toolbar")
+    assert toolbar is not None, "the window has no run toolbar"
+    button = toolbar.widgetForAction(window.run_actions.run)
+    assert button is not None and button.isEnabled(), "the Run button is not there or disabled"
+    qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
 
 
 def run_to_end(qtbot: Any, window: MainWindow, timeout_ms: int = 30_000) -> RunOutcome:
     """Press Run and wait for the run to finish; the outcome."""
     with qtbot.waitSignal(window.controller.run_finished, timeout=timeout_ms) as blocker:
-        window.run_actions.run.trigger()
+        press_run(qtbot, window)
     return blocker.args[0]
 
 
@@ -180,5 +354,21 @@ def node_named(window: MainWindow, name: str) -> str:
     return next(n.id for _, n in window.document.plan.walk() if n.name == name)
 
 
-def _ids(window: MainWindow) -> Iterable[str]:
+def _ids(window: MainWindow) -> list[str]:
     return [n.id for _, n in window.document.plan.walk()]
+
+
+def _one_added(window: MainWindow, before: Iterable[str], what: str) -> str:
+    old = set(before)
+    added = [i for i in _ids(window) if i not in old]
+    assert len(added) == 1, f"inserting {what!r} from the palette added {len(added)} nodes"
+    return added[0]
+
+
+def _replace_text(qtbot: Any, field: Any, text: str) -> None:
+    """Select all of a line edit and type over it (an empty ``text`` deletes it)."""
+    field.selectAll()
+    if text:
+        qtbot.keyClicks(field, text)
+    else:
+        qtbot.keyClick(field, Qt.Key.Key_Backspace)

@@ -1,0 +1,70 @@
+"""The plan's own settings: its name and its run policy (the paper's root "evaluated until it
+returns SUCCESS" is the policy "until success").
+
+Each finished edit is one document command (``set_plan_field``); the panel follows the
+document (undo, open, new) without echoing edits back.
+"""
+
+from __future__ import annotations
+
+from PySide6.QtWidgets import QComboBox, QFormLayout, QLineEdit, QWidget
+
+from engine.spec import RunPolicy
+from instructor_app.document import PlanDocument
+
+__all__ = ["PlanSettingsPanel", "POLICY_TEXT"]
+
+POLICY_TEXT: dict[RunPolicy, str] = {
+    RunPolicy.ONCE: "once",
+    RunPolicy.UNTIL_SUCCESS: "until success",
+    RunPolicy.FOREVER: "forever",
+}
+
+
+class PlanSettingsPanel(QWidget):
+    """Edits the plan's name and run policy.
+
+    Args:
+        document: the plan being edited.
+    """
+
+    def __init__(self, document: PlanDocument, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.document = document
+        self.name_field = QLineEdit()
+        self.name_field.setPlaceholderText("plan name")
+        self.name_field.editingFinished.connect(self._name_finished)
+        self.policy_combo = QComboBox()
+        for policy, text in POLICY_TEXT.items():
+            # The value, not the enum: Qt hands a str subclass back as a plain str.
+            self.policy_combo.addItem(text, policy.value)
+        self.policy_combo.setToolTip(
+            "once: run the tree once; until success: start again after a failure; "
+            "forever: start again after every run"
+        )
+        self.policy_combo.activated.connect(self._policy_chosen)
+        form = QFormLayout(self)
+        form.setContentsMargins(4, 4, 4, 4)
+        form.addRow("Name", self.name_field)
+        form.addRow("Run", self.policy_combo)
+        document.plan_changed.connect(self._refresh)
+        document.plan_reset.connect(self._refresh)
+        self._refresh()
+
+    def _name_finished(self) -> None:
+        name = self.name_field.text().strip()
+        if name and name != self.document.plan.name:
+            self.document.set_plan_field("name", name)
+
+    def _policy_chosen(self, index: int) -> None:
+        policy = RunPolicy(self.policy_combo.itemData(index))
+        if policy is not RunPolicy(self.document.plan.run_policy):
+            self.document.set_plan_field("run_policy", policy)
+
+    def _refresh(self) -> None:
+        plan = self.document.plan
+        if self.name_field.text() != plan.name and not self.name_field.hasFocus():
+            self.name_field.setText(plan.name)
+        index = self.policy_combo.findData(RunPolicy(plan.run_policy).value)
+        if index != self.policy_combo.currentIndex():
+            self.policy_combo.setCurrentIndex(index)
