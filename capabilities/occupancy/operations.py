@@ -1,0 +1,277 @@
+"""Operations of the occupancy capability: is a sphere of space occupied or empty?
+
+Design (conditions never block a tick): every camera has a feed holding its latest point
+cloud, renewed on the cell's worker pool whenever an operation finds it older than
+``refresh_period`` (0.1 s of cell time). A condition answers at once from the latest frame
+when that is not older than its ``max_age`` port (1 s); otherwise it returns a Job that
+finishes as soon as a new frame lands. In a reactive sequence rechecked every tick, a frame
+is therefore always being renewed and the condition answers in the same tick. The wait
+actions poll frames the same way until the region turns occupied (or empty) or the timeout
+of cell time passes. ``count_points`` always takes a fresh frame.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from capabilities.base import Capability, CapabilityEnv
+from capabilities.occupancy.feed import CameraFeed, Capture
+from capabilities.occupancy.state import CAMERAS, OccupancyState, StateBook
+from engine.operations import (
+    Direction,
+    Job,
+    OperationCall,
+    OperationFailed,
+    OperationKind,
+    OperationManifest,
+    PortSpec,
+    StartResult,
+)
+from engine.status import RUNNING, Status
+from engine.types import ParamType, Region
+
+__all__ = ["FeedJob", "build_capability"]
+
+CAP = "occupancy"
+
+Verdict = tuple[bool, str, dict[str, Any]] | None
+"""(succeeded, message, outputs), or None to keep waiting for the next frame."""
+
+
+class FeedJob(Job):
+    """Waits for a camera frame not older than ``newer_than`` and decides on it.
+
+    Args:
+        feed: the camera's feed.
+        clock: the cell's clock.
+        decide: a capture -> a verdict (None: wait for the next frame).
+        newer_than: frames stamped before this (cell time) are not looked at.
+        period: a frame older than this (s) is renewed while waiting.
+        deadline: cell time to give up at (None: wait for the first good frame only).
+        on_timeout: the failure message at the deadline, given the last verdict's message.
+    """
+
+    def __init__(
+        self,
+        feed: CameraFeed,
+        clock: Callable[[], float],
+        decide: Callable[[Capture], Verdict],
+        newer_than: float,
+        period: float,
+        deadline: float | None = None,
+        on_timeout: Callable[[str], str] = lambda last: f"timed out: {last}",
+    ) -> None:
+        super().__init__(on_cancel=self._unsubscribe)
+        self._feed, self._clock, self._decide = feed, clock, decide
+        self._newer_than, self._period, self._deadline = newer_than, period, deadline
+        self._on_timeout = on_timeout
+        self._seen: Capture | None = None
+        self._last = "no frame yet"
+        self._errors_at_start = feed.error_count()
+        feed.subscribe(self._frame_landed)
+
+    def _frame_landed(self) -> None:
+        wake = self._on_done
+        if wake is not None:
+            wake()
+
+    def _unsubscribe(self) -> None:
+        self._feed.unsubscribe(self._frame_landed)
+
+    def poll(self) -> Status:
+        if self._status is RUNNING:
+            self._step()
+        if self._status is not RUNNING:
+            self._unsubscribe()
+        return self._status
+
+    def _step(self) -> None:
+        capture = self._feed.latest()
+        if capture is not None and capture is not self._seen and capture.stamp >= self._newer_than:
+            self._seen = capture
+            verdict = self._decide(capture)
+            if verdict is not None:
+                ok, message, outputs = verdict
+                if ok:
+                    self.succeed(message, outputs)
+                else:
+                    self.fail(message)
+                return
+        if self._feed.error_count() > self._errors_at_start:
+            self.fail(f"{self._feed.name} camera: {self._feed.error()}")
+            return
+        now = self._clock()
+        # Never time out before one frame was judged: on a simulated cell running faster
+        # than real time, a short timeout can pass while the first frame renders.
+        if self._deadline is not None and now >= self._deadline and self._seen is not None:
+            self.fail(self._on_timeout(self._last))
+            return
+        if capture is None or now - capture.stamp >= self._period:
+            self._feed.refresh()
+
+    def note(self, message: str) -> None:
+        """Remember what the last frame said (for the timeout message)."""
+        self._last = message
+
+
+def _region_port() -> PortSpec:
+    return PortSpec("region", (ParamType.REGION,), doc="the sphere of space (world frame)")
+
+
+def _common_ports() -> tuple[PortSpec, ...]:
+    return (
+        _region_port(),
+        PortSpec("camera", (ParamType.TEXT,), default="shoulder", choices=CAMERAS,
+                 doc="which camera's depth image looks"),
+        PortSpec("min_points", (ParamType.NUMBER,), default=30.0,
+                 doc="this many points in the region make it occupied"),
+        PortSpec("mask_robot", (ParamType.BOOL,), default=True,
+                 doc="leave the robot's own arm and tool out"),
+    )  # fmt: skip
+
+
+class _Args:
+    """The common ports of a call, checked."""
+
+    def __init__(self, call: OperationCall) -> None:
+        region = call.args["region"]
+        if not isinstance(region, Region):
+            raise OperationFailed(f"region must be a Region, got {type(region).__name__}")
+        self.region = region
+        self.camera = str(call.args.get("camera", "shoulder"))
+        self.min_points = max(1, round(float(call.args.get("min_points", 30.0))))
+        self.mask_robot = bool(call.args.get("mask_robot", True))
+
+
+def _region_text(region: Region) -> str:
+    c = region.center
+    return (f"region ({c[0] * 1000:.0f}, {c[1] * 1000:.0f}, {c[2] * 1000:.0f}) mm "
+            f"r {region.radius * 1000:.0f} mm")  # fmt: skip
+
+
+class RegionCondition:
+    """``is_occupied`` (want True) or ``is_empty`` (want False)."""
+
+    def __init__(self, state: OccupancyState, want_occupied: bool) -> None:
+        self._state = state
+        self._want = want_occupied
+
+    def start(self, call: OperationCall) -> StartResult:
+        args = _Args(call)
+        max_age = float(call.args.get("max_age", 1.0))
+        state = self._state
+        feed = state.feed(args.camera)
+        want = self._want
+
+        def decide(capture: Capture) -> Verdict:
+            reading = state.read(capture, args.region, args.mask_robot)
+            occupied = reading.occupied(args.min_points)
+            word = "occupied" if occupied else "empty"
+            return occupied == want, f"{word}: {reading.describe(args.min_points)}", {}
+
+        return FeedJob(feed, state.clock, decide, state.clock() - max_age, state.refresh_period)
+
+
+class WaitForRegion:
+    """``wait_until_occupied`` / ``wait_until_empty``: poll frames until it turns so."""
+
+    def __init__(self, state: OccupancyState, want_occupied: bool) -> None:
+        self._state = state
+        self._want = want_occupied
+
+    def start(self, call: OperationCall) -> StartResult:
+        args = _Args(call)
+        timeout = float(call.args.get("timeout", 10.0))
+        period = max(0.0, float(call.args.get("period", 0.1)))
+        state = self._state
+        feed = state.feed(args.camera)
+        want, now = self._want, state.clock()
+        holder: list[FeedJob] = []
+
+        def decide(capture: Capture) -> Verdict:
+            reading = state.read(capture, args.region, args.mask_robot)
+            text = reading.describe(args.min_points)
+            if reading.occupied(args.min_points) == want:
+                return True, f"{'occupied' if want else 'empty'}: {text}", {}
+            holder[0].note(text)
+            return None
+
+        word = "occupied" if want else "empty"
+        job = FeedJob(
+            feed, state.clock, decide, now - period, period, now + timeout,
+            lambda last: f"timed out after {timeout:g} s: {_region_text(args.region)} "
+                         f"never {word}; last frame: {last}",
+        )  # fmt: skip
+        holder.append(job)
+        return job
+
+
+class CountPoints:
+    """``count_points``: a fresh frame's occupant points in the region."""
+
+    def __init__(self, state: OccupancyState) -> None:
+        self._state = state
+
+    def start(self, call: OperationCall) -> StartResult:
+        args = _Args(call)
+        state = self._state
+        feed = state.feed(args.camera)
+
+        def decide(capture: Capture) -> Verdict:
+            reading = state.read(capture, args.region, args.mask_robot)
+            return True, reading.describe(args.min_points), {"count": float(reading.points)}
+
+        # A frame taken after this call started: stamped at or after now.
+        return FeedJob(feed, state.clock, decide, state.clock(), 0.0)
+
+
+def build_capability() -> Capability:
+    cap = Capability(
+        CAP,
+        "Whether a sphere of space is occupied, from the depth cameras' point clouds.",
+        requires=("workers", "arm", "rgbd:shoulder"),
+    )
+    book = StateBook()
+
+    def op(op_id: str, kind: OperationKind, doc: str, *ports: PortSpec) -> OperationManifest:
+        return OperationManifest(f"{CAP}.{op_id}", kind, doc, CAP, ports)
+
+    def make(cls: type, *extra: Any) -> Callable[[CapabilityEnv], Any]:
+        return lambda env: cls(book.get(env), *extra)
+
+    max_age = PortSpec(
+        "max_age",
+        (ParamType.DURATION,),
+        default=1.0,
+        unit="s",
+        doc="answer from a frame up to this old; older: wait for a new one",
+    )
+    timeout = PortSpec(
+        "timeout",
+        (ParamType.DURATION,),
+        default=10.0,
+        unit="s",
+        doc="fail after this long (cell time)",
+    )
+    period = PortSpec("period", (ParamType.DURATION,), default=0.1, unit="s",
+                      doc="look again this often")  # fmt: skip
+    cap.add(op("is_occupied", OperationKind.CONDITION,
+               "True when something (not the table, not the robot) is in the region.",
+               *_common_ports(), max_age), make(RegionCondition, True))  # fmt: skip
+    cap.add(op("is_empty", OperationKind.CONDITION,
+               "True when nothing (but the table or the robot) is in the region.",
+               *_common_ports(), max_age), make(RegionCondition, False))  # fmt: skip
+    cap.add(op("wait_until_occupied", OperationKind.ACTION,
+               "Waits until something is in the region; fails after the timeout.",
+               *_common_ports(), timeout, period), make(WaitForRegion, True))  # fmt: skip
+    cap.add(op("wait_until_empty", OperationKind.ACTION,
+               "Waits until the region is clear; fails after the timeout.",
+               *_common_ports(), timeout, period), make(WaitForRegion, False))  # fmt: skip
+    cap.add(op("count_points", OperationKind.QUERY,
+               "How many points of a fresh frame are in the region (table and robot left out).",
+               *_common_ports(),
+               PortSpec("count", (ParamType.NUMBER,), Direction.OUT,
+                        doc="the occupant points counted")),
+            make(CountPoints))  # fmt: skip
+    return cap

@@ -1,0 +1,220 @@
+"""Operations of the predicates capability (the paper's Predicator), all conditions.
+
+Object poses are the world model's best detections (filled by the markers or perception
+capabilities); the tool is a box at the arm's TCP pose. Every predicate answers at once
+(no camera, no blocking) with a finished Job whose message says why it holds or not.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+from capabilities.base import Capability, CapabilityEnv
+from capabilities.predicates.collision import TOOL, PredicateError
+from capabilities.predicates.geometry import DIRECTIONS, box_center, offset_in_frame
+from capabilities.predicates.state import PredicatesState, StateBook
+from engine.operations import (
+    Job,
+    OperationCall,
+    OperationFailed,
+    OperationKind,
+    OperationManifest,
+    PortSpec,
+    StartResult,
+)
+from engine.types import ObjectModel, ParamType, Pose
+
+__all__ = ["build_capability"]
+
+CAP = "predicates"
+FRAMES = ("world", "robot", "object_b")
+
+
+def _verdict(holds: bool, message: str) -> Job:
+    """A finished job: SUCCESS (true) or FAILURE (false), with the reason."""
+    job = Job()
+    if holds:
+        job.succeed(message)
+    else:
+        job.fail(message)
+    return job
+
+
+def _name(model: Any) -> str:
+    return model.name if isinstance(model, ObjectModel) else str(model)
+
+
+def _guarded(fn: Callable[[OperationCall], Job]) -> Callable[[OperationCall], StartResult]:
+    def start(call: OperationCall) -> StartResult:
+        try:
+            return fn(call)
+        except PredicateError as exc:
+            raise OperationFailed(str(exc)) from exc
+
+    return start
+
+
+class Relation:
+    """``left_of``, ``right_of``, ``in_front_of``, ``behind``, ``up_from``, ``down_from``."""
+
+    def __init__(self, state: PredicatesState, relation: str) -> None:
+        self._state = state
+        self._relation = relation
+        self.start = _guarded(self._start)
+
+    def _start(self, call: OperationCall) -> Job:
+        state = self._state
+        state.sample()
+        a, b = state.best(call.args["object_a"]), state.best(call.args["object_b"])
+        frame_name = str(call.args.get("frame", "world"))
+        frame = self._frame(frame_name, b.pose)
+        margin = float(call.args.get("margin", 0.0))
+        offset = offset_in_frame(
+            box_center(a.pose, state.height(a.object_class)),
+            box_center(b.pose, state.height(b.object_class)),
+            frame,
+        )
+        axis, sign = DIRECTIONS[self._relation]
+        along = sign * float(offset[axis])
+        words = self._relation.replace("_", " ")
+        return _verdict(
+            along > margin,
+            f"{a.object_class} is {along * 1000:.0f} mm {words} {b.object_class} "
+            f"in the {frame_name.replace('_', ' ')} frame (needs more than {margin * 1000:.0f} mm)",
+        )
+
+    def _frame(self, name: str, pose_b: Pose) -> Pose:
+        if name == "world":
+            return Pose()
+        if name == "robot":
+            return self._state.robot_base()
+        if name == "object_b":
+            return pose_b
+        raise PredicateError(f"unknown frame {name!r}; frames: {', '.join(FRAMES)}")
+
+
+class Moving:
+    """``is_moving`` (want True) or ``is_stationary`` (want False) over a time window."""
+
+    def __init__(self, state: PredicatesState, want_moving: bool) -> None:
+        self._state = state
+        self._want = want_moving
+        self.start = _guarded(self._start)
+
+    def _start(self, call: OperationCall) -> Job:
+        state = self._state
+        state.sample()
+        name = _name(call.args["object"])
+        window = float(call.args.get("window", 0.5))
+        threshold = float(call.args.get("speed", 0.02))
+        motion = state.track(name).motion(call.clock() - window)
+        if motion.samples < 2 or motion.span < window / 4:
+            return _verdict(False, f"{name}: {motion.samples} detection(s) in the last "
+                                   f"{window:g} s, too few to tell")  # fmt: skip
+        moving = motion.speed > threshold
+        text = (f"{name} moves at {motion.speed * 1000:.0f} mm/s over {motion.samples} "
+                f"detections in {motion.span:.2f} s (threshold {threshold * 1000:.0f} mm/s)")  # fmt: skip
+        return _verdict(moving == self._want, text)
+
+
+class Contact:
+    """``touching`` / ``near_collision`` between two objects, or the tool and an object."""
+
+    def __init__(self, state: PredicatesState, port: str, tool: bool) -> None:
+        self._state = state
+        self._port = port  # "tolerance" (touching) or "distance" (near_collision)
+        self._tool = tool
+        self.start = _guarded(self._start)
+
+    def _start(self, call: OperationCall) -> Job:
+        state = self._state
+        state.sample()
+        limit = float(call.args.get(self._port, 0.0))
+        if self._tool:
+            b = state.best(call.args["object"])
+            first, second = (TOOL, state.tool_pose()), (b.object_class, b.pose)
+            label = f"the tool and {b.object_class}"
+        else:
+            a, b = state.best(call.args["object_a"]), state.best(call.args["object_b"])
+            if a is b:
+                raise PredicateError(f"object_a and object_b are both {a.object_class}")
+            first, second = (a.object_class, a.pose), (b.object_class, b.pose)
+            label = f"{a.object_class} and {b.object_class}"
+        gap = state.collision().distance(first, second)
+        gap_text = "over 1 m" if math.isinf(gap) else f"{gap * 1000:.1f} mm"
+        word = "touching" if self._port == "tolerance" else "near collision"
+        return _verdict(gap <= limit, f"{label}: {gap_text} apart "
+                                      f"({word} at {limit * 1000:.1f} mm or less)")  # fmt: skip
+
+
+def _object_port(name: str, doc: str) -> PortSpec:
+    return PortSpec(name, (ParamType.OBJECT,), doc=doc)
+
+
+def build_capability() -> Capability:
+    cap = Capability(
+        CAP,
+        "Predicates about objects: where they are relative to each other, motion, contact.",
+        requires=("world", "objects"),
+    )
+    book = StateBook()
+
+    def op(op_id: str, doc: str, *ports: PortSpec) -> OperationManifest:
+        return OperationManifest(f"{CAP}.{op_id}", OperationKind.CONDITION, doc, CAP, ports)
+
+    def make(cls: type, *extra: Any) -> Callable[[CapabilityEnv], Any]:
+        return lambda env: cls(book.get(env), *extra)
+
+    pair = (_object_port("object_a", "the object the predicate is about"),
+            _object_port("object_b", "the object it is compared with"))  # fmt: skip
+    frame = PortSpec(
+        "frame",
+        (ParamType.TEXT,),
+        default="world",
+        choices=FRAMES,
+        doc="directions along the world's, the robot base's or object_b's axes",
+    )
+    margin = PortSpec("margin", (ParamType.NUMBER,), default=0.01, unit="m",
+                      doc="by more than this (a tie under sensor noise is neither)")  # fmt: skip
+    for relation in DIRECTIONS:
+        words = relation.replace("_", " ")
+        cap.add(op(relation, f"True when object_a is {words} object_b (centres, along the "
+                             "frame's axes: front +x, left +y, up +z).",
+                   *pair, frame, margin), make(Relation, relation))  # fmt: skip
+    one = _object_port("object", "the object")
+    window = PortSpec(
+        "window",
+        (ParamType.DURATION,),
+        default=0.5,
+        unit="s",
+        doc="judge the detections of this last stretch of time",
+    )
+    speed = PortSpec("speed", (ParamType.NUMBER,), default=0.02, unit="m/s",
+                     doc="faster than this is moving")  # fmt: skip
+    cap.add(op("is_moving", "True when the object's detections moved faster than the speed.",
+               one, window, speed), make(Moving, True))  # fmt: skip
+    cap.add(op("is_stationary", "True when the object's detections stayed (slower than the "
+               "speed); false when too few were seen.", one, window, speed),
+            make(Moving, False))  # fmt: skip
+    tolerance = PortSpec(
+        "tolerance",
+        (ParamType.NUMBER,),
+        default=0.003,
+        unit="m",
+        doc="surfaces this close count as touching",
+    )
+    distance = PortSpec("distance", (ParamType.NUMBER,), default=0.03, unit="m",
+                        doc="surfaces this close are a near collision")  # fmt: skip
+    cap.add(op("touching", "True when the two objects' shapes touch or overlap.",
+               *pair, tolerance), make(Contact, "tolerance", False))  # fmt: skip
+    cap.add(op("near_collision", "True when the two objects' shapes are closer than the "
+               "distance (touching included).", *pair, distance),
+            make(Contact, "distance", False))  # fmt: skip
+    cap.add(op("tool_touching", "True when the tool touches or overlaps the object.",
+               one, tolerance), make(Contact, "tolerance", True))  # fmt: skip
+    cap.add(op("tool_near_collision", "True when the tool is closer to the object than the "
+               "distance (touching included).", one, distance),
+            make(Contact, "distance", True))  # fmt: skip
+    return cap
