@@ -1,0 +1,118 @@
+"""Point models of the object library: points sampled on each mesh, with normals, a
+nearest-neighbour index and FPFH features, built once per model and shared by threads."""
+
+from __future__ import annotations
+
+import threading
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import open3d as o3d
+
+from capabilities.object_library import ObjectLibrary, ObjectLibraryError, ObjectModelSpec
+from capabilities.perception.errors import PerceptionError
+
+__all__ = ["ModelCloud", "ModelSet"]
+
+_SPACING = 0.004  # m between sampled points
+_MIN_POINTS, _MAX_POINTS = 1500, 8000
+
+
+@dataclass
+class ModelCloud:
+    """One library model as points in its own frame (bottom centre, z up).
+
+    Attributes:
+        spec: the library entry.
+        points, normals: Nx3 samples of the mesh surface and their outward normals.
+        features: FPFH features of ``down`` (Open3D Feature), for global registration.
+        down: the samples thinned to the matching voxel (Open3D PointCloud).
+    """
+
+    spec: ObjectModelSpec
+    points: np.ndarray
+    normals: np.ndarray
+    down: Any
+    features: Any
+    _index: Any
+
+    @property
+    def name(self) -> str:
+        return self.spec.name
+
+    @property
+    def height(self) -> float:
+        return float(self.spec.dimensions[2])
+
+    @property
+    def holes(self) -> list[dict[str, Any]]:
+        """The plate holes of the model (``extra["holes"]``), empty for other models."""
+        holes = self.spec.extra.get("holes", [])
+        return holes if isinstance(holes, list) else []
+
+    def nearest(self, query: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(index, squared distance) of the nearest model point of each query point."""
+        idx, dist2 = self._index.knn_search(_tensor(query), 1)
+        return idx.numpy()[:, 0].astype(np.int64), dist2.numpy()[:, 0].astype(np.float64)
+
+
+def fpfh(cloud: Any, voxel: float) -> Any:
+    """FPFH features of a cloud that has normals (radius five voxels)."""
+    search = o3d.geometry.KDTreeSearchParamHybrid(radius=5 * voxel, max_nn=100)
+    return o3d.pipelines.registration.compute_fpfh_feature(cloud, search)  # type: ignore[call-arg]
+
+
+def _tensor(array: np.ndarray) -> Any:
+    """An Open3D tensor sharing a C-contiguous float64 copy of ``array``."""
+    return o3d.core.Tensor(np.ascontiguousarray(array, dtype=np.float64))  # type: ignore[call-overload]
+
+
+def _load(spec: ObjectModelSpec, voxel: float) -> ModelCloud:
+    mesh = o3d.io.read_triangle_mesh(str(spec.mesh_file))  # type: ignore[arg-type]
+    if len(mesh.triangles) == 0:
+        raise PerceptionError(f"{spec.mesh_file}: no triangles to sample")
+    mesh.compute_triangle_normals()
+    count = int(np.clip(mesh.get_surface_area() / _SPACING**2, _MIN_POINTS, _MAX_POINTS))
+    o3d.utility.random.seed(0)  # the same samples every time: recognition is reproducible
+    cloud = mesh.sample_points_uniformly(count, use_triangle_normal=True)
+    points = np.asarray(cloud.points).copy()
+    down = cloud.voxel_down_sample(voxel)
+    index = o3d.core.nns.NearestNeighborSearch(_tensor(points))
+    index.knn_index()
+    return ModelCloud(
+        spec, points, np.asarray(cloud.normals).copy(), down, fpfh(down, voxel), index
+    )
+
+
+class ModelSet:
+    """The point models of a library, loaded on first use; safe to share between threads.
+
+    Args:
+        library: the object library.
+        voxel: the grid (m) scene clusters are thinned to (features are made at that scale).
+    """
+
+    def __init__(self, library: ObjectLibrary, voxel: float) -> None:
+        self._library = library
+        self._voxel = voxel
+        self._models: dict[str, ModelCloud] = {}
+        self._lock = threading.Lock()
+
+    @property
+    def library(self) -> ObjectLibrary:
+        return self._library
+
+    def get(self, name: str) -> ModelCloud:
+        with self._lock:
+            if name not in self._models:
+                try:
+                    spec = self._library.get(name)
+                except ObjectLibraryError as exc:
+                    raise PerceptionError(str(exc)) from exc
+                self._models[name] = _load(spec, self._voxel)
+            return self._models[name]
+
+    def all(self) -> list[ModelCloud]:
+        """Every model of the library."""
+        return [self.get(name) for name in self._library.names()]

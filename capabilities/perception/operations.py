@@ -1,0 +1,238 @@
+"""Operations of the perception capability (paper IV-B's Perceptor).
+
+``detect_objects`` looks once through a camera and, on a worker thread, recognises the
+library's objects on the table (:class:`Recognizer`), gives them identities that persist
+between looks (:class:`SurfaceTracker`) and stores them in the cell's world model under the
+source ``perception:<camera>``. The conditions and queries read the world model and answer
+at once.
+
+The recogniser (its sampled models) and the trackers are shared by every operation of one
+capability instance and one cell: they are kept per object library and per world model.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import weakref
+from typing import Any
+
+from capabilities.base import Capability, CapabilityEnv
+from capabilities.perception.config import RecognitionConfig
+from capabilities.perception.errors import PerceptionError
+from capabilities.perception.recognizer import Recognizer
+from capabilities.perception.tracker import SurfaceTracker
+from capabilities.world_model import Detection, WorldModel
+from engine.operations import (
+    Direction,
+    Job,
+    OperationCall,
+    OperationFailed,
+    OperationKind,
+    OperationManifest,
+    PortSpec,
+    StartResult,
+)
+from engine.types import ObjectModel, ParamType, Pose
+
+__all__ = ["SOURCE_PREFIX", "build_capability"]
+
+CAP = "perception"
+CAMERAS = ("shoulder", "wrist")
+SOURCE_PREFIX = "perception:"
+
+
+class _Shared:
+    """What the operations of one capability instance share: recognisers by object library,
+    trackers by (world model, camera). Weak keys: a closed cell takes its state with it."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._recognizers: weakref.WeakKeyDictionary[Any, Recognizer] = weakref.WeakKeyDictionary()
+        self._trackers: weakref.WeakKeyDictionary[Any, dict[str, SurfaceTracker]] = (
+            weakref.WeakKeyDictionary()
+        )
+
+    def recognizer(self, library: Any, config: RecognitionConfig) -> Recognizer:
+        with self._lock:
+            found = self._recognizers.get(library)
+            if found is None or found.config != config:
+                found = self._recognizers[library] = Recognizer(library, config)
+            return found
+
+    def tracker(self, world: Any, camera: str, library: Any) -> SurfaceTracker:
+        with self._lock:
+            per_camera = self._trackers.setdefault(world, {})
+            if camera not in per_camera:
+                symmetries = {name: library.get(name).symmetry for name in library.names()}
+                per_camera[camera] = SurfaceTracker(symmetries=symmetries)
+            return per_camera[camera]
+
+
+class _Env:
+    """The interfaces every perception operation uses, taken from the cell once."""
+
+    def __init__(self, env: CapabilityEnv, shared: _Shared) -> None:
+        self.env = env
+        self.shared = shared
+        self.world: WorldModel = env.interface("world")
+        self.workers = env.interface("workers")
+        self.library = env.interface("objects")
+        try:
+            self.config = RecognitionConfig.from_settings(env.settings)
+        except PerceptionError as exc:
+            raise OperationFailed(str(exc)) from exc
+
+    def camera(self, name: str) -> Any:
+        if name not in CAMERAS:
+            raise OperationFailed(f"unknown camera {name!r}; cameras: {', '.join(CAMERAS)}")
+        interfaces = self.env.cell.interfaces()
+        if f"rgbd:{name}" not in interfaces:
+            raise OperationFailed(f"the {self.env.cell.name} cell has no {name} camera")
+        return interfaces[f"rgbd:{name}"]
+
+    def seen(self, model: Any) -> list[Detection]:
+        """Current perception detections of a class, best first."""
+        name = model.name if isinstance(model, ObjectModel) else str(model)
+        return [d for d in self.world.detections(name) if d.source.startswith(SOURCE_PREFIX)]
+
+
+class DetectObjects:
+    def __init__(self, env: _Env) -> None:
+        self._env = env
+
+    def start(self, call: OperationCall) -> StartResult:
+        env = self._env
+        camera = env.camera(str(call.args["camera"]))
+        recognizer = env.shared.recognizer(env.library, env.config)
+        tracker = env.shared.tracker(env.world, camera.name, env.library)
+        source = f"{SOURCE_PREFIX}{camera.name}"
+
+        def look() -> dict[str, Any]:
+            frame = camera.capture()
+            try:
+                found = recognizer.recognize(frame)
+            except PerceptionError as exc:
+                env.world.replace(source, [])
+                raise OperationFailed(f"{camera.name} camera: {exc}") from exc
+            tracked = tracker.update(found, frame.stamp)
+            detections = [
+                Detection(r.object_class, r.pose, r.confidence, frame.stamp, source, instance)
+                for instance, r in tracked
+            ]
+            env.world.replace(source, detections)
+            names = sorted(instance for instance, _ in tracked)
+            call.log(f"{camera.name} camera: {', '.join(names) or 'no objects'} "
+                     f"({1000 * recognizer.last_seconds:.0f} ms)")  # fmt: skip
+            return {"count": float(len(detections))}
+
+        job: Job = env.workers.submit(look, f"detect objects ({camera.name} camera)")
+        return job
+
+
+class ObjectFound:
+    def __init__(self, env: _Env) -> None:
+        self._env = env
+
+    def start(self, call: OperationCall) -> StartResult:
+        return bool(self._env.seen(call.args["object"]))
+
+
+class ObjectPose:
+    def __init__(self, env: _Env) -> None:
+        self._env = env
+
+    def start(self, call: OperationCall) -> StartResult:
+        seen = self._env.seen(call.args["object"])
+        if not seen:
+            raise OperationFailed(f"{_name(call.args['object'])} has not been seen")
+        call.write("pose", seen[0].pose)
+        return True
+
+
+class ObjectsOfClass:
+    def __init__(self, env: _Env) -> None:
+        self._env = env
+
+    def start(self, call: OperationCall) -> StartResult:
+        seen = self._env.seen(call.args["object"])
+        call.write("count", float(len(seen)))
+        call.write("poses", [d.pose for d in seen])
+        return True
+
+
+class PlateType:
+    def __init__(self, env: _Env) -> None:
+        self._env = env
+
+    def start(self, call: OperationCall) -> StartResult:
+        near: Pose = call.args["near"]
+        within = float(call.args["within"])
+        plates = [
+            d
+            for name in self._env.library.names()
+            if self._env.library.get(name).extra.get("holes")
+            for d in self._env.seen(name)
+        ]
+        ranked = sorted(plates, key=lambda d: math.dist(d.pose.position, near.position))
+        if not ranked or math.dist(ranked[0].pose.position, near.position) > within:
+            raise OperationFailed(f"no plate seen within {within:g} m of {near.position}")
+        call.write("model", ObjectModel(ranked[0].object_class))
+        call.write("pose", ranked[0].pose)
+        return True
+
+
+def _name(model: Any) -> str:
+    return model.name if isinstance(model, ObjectModel) else str(model)
+
+
+def _object_port() -> PortSpec:
+    return PortSpec("object", (ParamType.OBJECT,), doc="the object class (a model name)")
+
+
+def build_capability() -> Capability:
+    cap = Capability(
+        CAP,
+        "Recognises the library's objects on the table in RGB-D point clouds; plate types.",
+        requires=("world", "workers", "objects", "rgbd:shoulder"),
+    )
+    shared = _Shared()
+
+    def op(op_id: str, kind: OperationKind, doc: str, *ports: PortSpec) -> OperationManifest:
+        return OperationManifest(f"{CAP}.{op_id}", kind, doc, CAP, ports)
+
+    def maker(cls: type) -> Any:
+        return lambda env: cls(_Env(env, shared))
+
+    cap.add(op("detect_objects", OperationKind.ACTION,
+               "Looks through a camera and recognises the known objects on the table "
+               "(point cloud matched to the object models).",
+               PortSpec("camera", (ParamType.TEXT,), default="shoulder", doc="which camera looks",
+                        choices=CAMERAS),
+               PortSpec("count", (ParamType.NUMBER,), Direction.OUT,
+                        doc="how many objects were recognised")),
+            maker(DetectObjects))  # fmt: skip
+    cap.add(op("object_found", OperationKind.CONDITION,
+               "True when the last look recognised an object of this class.", _object_port()),
+            maker(ObjectFound))  # fmt: skip
+    cap.add(op("object_pose", OperationKind.QUERY,
+               "The pose of the most confidently recognised object of a class.", _object_port(),
+               PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the object is")),
+            maker(ObjectPose))  # fmt: skip
+    cap.add(op("objects_of_class", OperationKind.QUERY,
+               "How many objects of a class the last look recognised, and their poses.",
+               _object_port(),
+               PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="how many"),
+               PortSpec("poses", (ParamType.ANY,), Direction.OUT,
+                        doc="their poses, most confident first")),
+            maker(ObjectsOfClass))  # fmt: skip
+    cap.add(op("plate_type", OperationKind.QUERY,
+               "Which plate (by its holes) lies nearest to a pose.",
+               PortSpec("near", (ParamType.POSE,), default=Pose(),
+                        doc="the plate nearest this pose (default: nearest the robot base)"),
+               PortSpec("within", (ParamType.NUMBER,), default=2.0, unit="m",
+                        doc="fail when the nearest plate is farther than this"),
+               PortSpec("model", (ParamType.OBJECT,), Direction.OUT, doc="the plate's model"),
+               PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the plate is")),
+            maker(PlateType))  # fmt: skip
+    return cap
