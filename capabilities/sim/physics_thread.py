@@ -56,6 +56,7 @@ class PhysicsThread:
         self._time = 0.0
         self._queue: queue.SimpleQueue[tuple[Callable[[int], Any], Future[Any]] | None]
         self._queue = queue.SimpleQueue()
+        self._serving_s = 0.0  # wall seconds spent running posted calls (not simulated time)
         self._pre_hooks: list[StepHook] = []
         self._post_hooks: list[StepHook] = []
         self._timers: list[tuple[float, int, threading.Event]] = []
@@ -166,7 +167,11 @@ class PhysicsThread:
             self._drain()
             self._step_once()
             if self.speed is not None:
-                ahead = (self._time - sim_start) / self.speed - (time.perf_counter() - wall_start)
+                # Time spent serving calls (a camera frame takes 30-300 ms to render) does
+                # not pass in the simulated world, as a real camera renders while the world
+                # goes on; so the physics does not race to catch up after a render.
+                wall = time.perf_counter() - wall_start - self._serving_s
+                ahead = (self._time - sim_start) / self.speed - wall
                 if ahead > 0.002:
                     self._idle(ahead)
             elif self.steps % 64 == 0:
@@ -195,10 +200,13 @@ class PhysicsThread:
     def _execute(self, fn: Callable[[int], Any], future: Future[Any]) -> None:
         if not future.set_running_or_notify_cancel():
             return
+        started = time.perf_counter()
         try:
             future.set_result(fn(self.client))
         except BaseException as exc:
             future.set_exception(exc)
+        finally:
+            self._serving_s += time.perf_counter() - started
 
     def _step_once(self) -> None:
         self._run_hooks(self._pre_hooks)
