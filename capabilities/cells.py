@@ -7,6 +7,8 @@ from collections.abc import Mapping
 from types import TracebackType
 from typing import Any
 
+from capabilities.collaboration.console import OperatorConsole
+
 __all__ = ["CELL_NAMES", "CellError", "ManagedCell", "open_cell"]
 
 CELL_NAMES: tuple[str, ...] = ("none", "sim")
@@ -19,13 +21,24 @@ class CellError(Exception):
 class ManagedCell:
     """A cell with a lifetime: a context manager that closes it.
 
-    The ``none`` cell has no interfaces: only cell-free capabilities (``debug``) run.
+    The ``none`` cell has no robot: only cell-free capabilities (``debug``) and the
+    operator's console (``operator``: prompts and buttons) are there.
     """
 
     name = "none"
 
+    def __init__(self) -> None:
+        self._operator = OperatorConsole()
+
+    @property
+    def operator(self) -> OperatorConsole:
+        """The operator's console (made here if a subclass skipped ``__init__``)."""
+        if "_operator" not in self.__dict__:
+            self._operator = OperatorConsole()
+        return self._operator
+
     def interfaces(self) -> Mapping[str, Any]:
-        return {}
+        return {"operator": self.operator}
 
     def clock(self) -> float:
         return time.monotonic()

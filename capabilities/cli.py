@@ -17,6 +17,7 @@ from typing import Any, TextIO
 
 from capabilities.base import CapabilityError, CapabilityRegistry
 from capabilities.cells import CELL_NAMES, CellError, open_cell
+from capabilities.collaboration.answers import CONFIRM_MODES, PromptAnswerer
 from engine.build import BuildError, build_tree
 from engine.events import Event, LogMessage, RunFinished, StatusChanged
 from engine.executor import Executor
@@ -136,11 +137,15 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             listeners.append(TraceRecorder(args.trace, plan))
         executor = Executor(tree, args.rate, listeners, plan_name=plan.name)
         restore = _install_interrupt(executor)
+        console = cell.interfaces().get("operator")
+        answerer = PromptAnswerer(console, args.confirm, args.stdin, out) if console else None
         try:
             executor.start()
             result = _wait(executor, args.timeout)
         finally:
             restore()
+            if answerer is not None:
+                answerer.detach()
         return _report(result, plan, tree.blackboard.snapshot(), out, args.verbose)
 
 
@@ -275,6 +280,13 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--trace", help="write a trace (JSON lines) to this file")
     run.add_argument("--timeout", type=float, help="stop after this many seconds (exit 3)")
     run.add_argument("--verbose", "-v", action="store_true", help="print every status change")
+    run.add_argument(
+        "--confirm",
+        choices=CONFIRM_MODES,
+        default="ask",
+        help="answer operator prompts: yes, no, or ask (read y/n lines from stdin, a pipe "
+        "too; at the end of the input every prompt is answered no). Default: ask",
+    )
     add_cell(run)
     run.set_defaults(func=_cmd_run)
 
@@ -292,9 +304,12 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def main(
-    argv: Sequence[str] | None = None, out: TextIO | None = None, err: TextIO | None = None
+    argv: Sequence[str] | None = None,
+    out: TextIO | None = None,
+    err: TextIO | None = None,
+    inp: TextIO | None = None,
 ) -> int:
-    """Entry point of ``costar``; returns the exit code."""
+    """Entry point of ``costar``; returns the exit code (``inp``: answers to prompts)."""
     out = out or sys.stdout
     err = err or sys.stderr
     parser = _parser()
@@ -302,6 +317,7 @@ def main(
         args = parser.parse_args(argv)
     except SystemExit as exc:  # argparse exits 2 on bad arguments, 0 on --help
         return int(exc.code or 0)
+    args.stdin = inp or sys.stdin
     if args.command == "run" and args.rate <= 0:
         print("error: --rate must be above 0", file=err)
         return EXIT_INVALID

@@ -25,6 +25,7 @@ from instructor_app.dialogs import APP_TITLE, DISCARD, SAVE, Dialogs
 from instructor_app.document.autosave import DEFAULT_INTERVAL_MS, Autosaver, offer_recoveries
 from instructor_app.document.model import DocumentError, PlanDocument
 from instructor_app.node_factory import make_node, manifest_or_none
+from instructor_app.panels.operator import OperatorPanel
 from instructor_app.runtime.controller import FINISHED, IDLE, RunController
 from instructor_app.runtime.run_view import (
     FailureButton,
@@ -72,6 +73,7 @@ class MainWindow(QMainWindow):
         self.views: Views = make_views(self.document, session, self)
         self.run_actions = RunActions(self.controller, self)
         self.running_panel = RunningNodesPanel(self._node_path, self)
+        self.operator_panel = OperatorPanel(self)
         self.failure_button = FailureButton(self._node_label, self)
         self.selection: list[str] = []
         self._build_layout()
@@ -92,8 +94,10 @@ class MainWindow(QMainWindow):
         self._dock("inspector", "Inspector", self.views.inspector, area.RightDockWidgetArea)
         self._dock("plan", "Plan", self.views.plan_settings, area.RightDockWidgetArea)
         self._dock("waypoints", "Waypoints", self.views.waypoints, area.RightDockWidgetArea)
+        self._dock("operator", "Operator", self.operator_panel, area.RightDockWidgetArea)
         self.splitDockWidget(self.docks["inspector"], self.docks["plan"], Qt.Orientation.Vertical)
         self.tabifyDockWidget(self.docks["plan"], self.docks["waypoints"])
+        self.tabifyDockWidget(self.docks["waypoints"], self.docks["operator"])
         bottom = [
             ("validation", "Problems", self.views.validation),
             ("log", "Log", self.views.log),
@@ -191,6 +195,9 @@ class MainWindow(QMainWindow):
         views.canvas.selection_changed.connect(self._on_selection)
         views.canvas.message.connect(self.show_message)
         views.waypoints.message.connect(self.show_message)
+        self.session.cell_changed.connect(lambda _name: self._attach_operator())
+        self.operator_panel.prompt_shown.connect(lambda _text: self._raise_dock("operator"))
+        self._attach_operator()
         views.palette.item_activated.connect(self.add_palette_item)
         views.validation.node_selected.connect(self.select_node)
         views.validation.summary_changed.connect(self._on_summary)
@@ -226,6 +233,15 @@ class MainWindow(QMainWindow):
         self.run_presenter.problems_shown.connect(lambda: self.docks["validation"].raise_())
 
     # ------------------------------------------------------------------ editing
+
+    def _attach_operator(self) -> None:
+        """The operator panel answers the prompts of the cell in use (its "operator")."""
+        cell = self.session.cell
+        self.operator_panel.set_console(cell.interfaces().get("operator") if cell else None)
+
+    def _raise_dock(self, name: str) -> None:
+        self.docks[name].show()
+        self.docks[name].raise_()
 
     def show_message(self, text: str, timeout_ms: int = 8000) -> None:
         self.statusBar().showMessage(text, timeout_ms)

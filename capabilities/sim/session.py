@@ -2,9 +2,11 @@
 
 ``interfaces()`` maps interface names to backends: ``arm``, ``gripper``, ``suction``,
 ``freedrive`` (the devices of the SimCell), ``rgbd:shoulder`` and ``rgbd:wrist`` (cameras
-whose ``capture()`` renders on the physics thread), ``world`` (the cell's world model) and
-``workers`` (a thread pool for blocking work such as perception). The clock is simulated
-time. Ground truth stays on ``ground_truth`` and ``scene`` for tests and scores.
+whose ``capture()`` renders on the physics thread), ``world`` (the cell's world model),
+``workers`` (a thread pool for blocking work such as perception) and ``operator`` (the
+OperatorConsole: prompts and buttons). The clock is simulated time. A scene file with a
+``worker`` block gets a simulated person (``session.worker``, see ``sim/worker.py``).
+Ground truth stays on ``ground_truth`` and ``scene`` for tests and scores.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from capabilities.collaboration.console import OperatorConsole
 from capabilities.jobs import WorkerPool
 from capabilities.sim.cameras import (
     CameraConfig,
@@ -30,6 +33,7 @@ from capabilities.sim.cameras import (
 from capabilities.sim.cell import SimCell
 from capabilities.sim.config import CellConfig
 from capabilities.sim.scene import SceneState, default_scene_path, load_scene
+from capabilities.sim.worker import SimWorker, install_scene_worker
 from capabilities.world_model import WorldModel
 from engine.types import Pose
 
@@ -111,6 +115,8 @@ class SimCellSession:
         self.sim = SimCell(config, speed)
         self.world_model = WorldModel()
         self.workers = WorkerPool(2, "costar-sim-worker")
+        self.operator = OperatorConsole()
+        self.worker: SimWorker | None = None  # the simulated person, if the scene has one
         self.sim.start()
         try:
             path = (
@@ -136,6 +142,7 @@ class SimCellSession:
                 "shoulder": SimCameraDevice(self.sim, shoulder),
                 "wrist": SimCameraDevice(self.sim, wrist),
             }
+            self.worker = install_scene_worker(self.sim, self.scene, path, seed)
         except BaseException:
             self.close()
             raise
@@ -161,6 +168,7 @@ class SimCellSession:
             "workers": self.workers,
             "scene_layout": self.scene_layout(),
             "objects": self.scene.library,
+            "operator": self.operator,
         }
 
     def scene_layout(self) -> dict[str, Any]:

@@ -268,3 +268,25 @@ def test_a_crashed_session_is_offered_and_restored(
     assert second.windowTitle().startswith("figure3_debug.costar.json*")
     node_id = node_named(second, "edited before the crash")
     assert second.document.node(node_id).name == "edited before the crash"
+
+
+def test_an_operator_question_of_the_run_is_answered_in_the_window(
+    qtbot: Any, window: MainWindow, tmp_path: Path
+) -> None:
+    from PySide6.QtCore import Qt
+
+    from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
+    from engine.types import ParamType
+
+    ask = NodeSpec(NodeKind.OPERATION, "ask", op="collaboration.confirm",
+                   params={"prompt": Binding.fixed("Is the bin in place?", ParamType.TEXT)})  # fmt: skip
+    window.open_plan(write_plan(tmp_path / "ask.costar.json", PlanSpec(ask, "ask")))
+    panel = window.operator_panel
+    with qtbot.waitSignal(panel.prompt_shown, timeout=10_000):
+        window.run_actions.run.trigger()
+    assert window.docks["operator"].isVisible()
+    row = panel.rows()[0]
+    assert row.text_label.text() == "Is the bin in place?"
+    with qtbot.waitSignal(window.controller.run_finished, timeout=10_000) as finished:
+        qtbot.mouseClick(row.yes_button, Qt.MouseButton.LeftButton)
+    assert finished.args[0].status is Status.SUCCESS

@@ -123,15 +123,18 @@ def test_robot_in_a_sphere_counts_only_without_the_mask(
         masked += _occupied_after(registry, session, since, region)
         unmasked += _occupied_after(registry, session, since, region, mask_robot=False)
         frames += 1
-    # And while the arm sweeps through the sphere.
-    start = down_at(0.55, -0.25, 0.1)
-    run(session.sim.robot.move_pose_joint_space(start))
-    sweep = session.sim.robot.move_linear(down_at(0.55, 0.35, 0.1), speed=0.1)
+    # And while the arm sweeps through the sphere: in real time, so that frames are taken all
+    # along the sweep whatever the machine's load (as fast as possible, the sweep can be over
+    # between two frames).
     moving = 0
-    while not sweep.done():
-        masked += _occupied_after(registry, session, session.clock(), region)
-        moving += 1
-    run(sweep)
+    with SimCellSession("empty", seed=0, speed=1.0, shoulder_size=(320, 240)) as live:
+        live_registry = CapabilityRegistry(cell=live)
+        run(live.sim.robot.move_pose_joint_space(down_at(0.55, -0.1, 0.1)))
+        sweep = live.sim.robot.move_linear(down_at(0.55, 0.2, 0.1), speed=0.1)
+        while not sweep.done():
+            masked += _occupied_after(live_registry, live, live.clock(), region)
+            moving += 1
+        run(sweep)
     print(f"robot in the sphere: occupied with the mask in {masked}/{frames + moving} frames, "
           f"without it in {unmasked}/{frames} frames")  # fmt: skip
     assert moving >= 5

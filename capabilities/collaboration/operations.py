@@ -1,0 +1,286 @@
+"""Operations of the collaboration capability (the paper's Collaborator, section IV-B).
+
+The operator side (``confirm``, ``button_pressed``, ``wait_for_button``) needs only the
+cell's ``operator`` console, so it runs on every cell, the ``none`` cell included. The
+handoff side (``wait_for_handoff``, ``object_in_region``) also needs the world model, the
+object library and a camera; it looks them up when it starts and fails with the reason on
+a cell that lacks them (availability is per capability, and the capability is the pair).
+
+Times are on the cell's clock (``call.clock()``): simulated seconds on the simulated cell.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from capabilities.base import Capability, CapabilityEnv, CapabilityError
+from capabilities.collaboration.console import (
+    ConsoleEvent,
+    ConsoleEventKind,
+    OperatorConsole,
+    Prompt,
+    PromptState,
+)
+from capabilities.collaboration.handoff import (
+    HandoffJob,
+    HandoffSettings,
+    in_region,
+    object_markers,
+)
+from capabilities.markers.backend import camera_interface
+from capabilities.world_model import Detection, WorldModel
+from engine.operations import (
+    Direction,
+    Job,
+    OperationCall,
+    OperationFailed,
+    OperationKind,
+    OperationManifest,
+    PortSpec,
+    StartResult,
+)
+from engine.status import RUNNING, Status
+from engine.types import ObjectModel, ParamType, Region
+
+__all__ = ["CAP", "build_capability"]
+
+CAP = "collaboration"
+CAMERAS = ("shoulder", "wrist")
+
+
+def _seconds(call: OperationCall, port: str) -> float:
+    value = call.args.get(port, 0.0)
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value >= 0:
+        raise OperationFailed(f"{port} must be a number of seconds, 0 or more, not {value!r}")
+    return float(value)
+
+
+def _interface(env: CapabilityEnv, name: str, what: str) -> Any:
+    try:
+        return env.interface(name)
+    except CapabilityError as exc:
+        raise OperationFailed(f"{what} needs {name!r}: {exc}") from exc
+
+
+def _object_name(value: Any) -> str:
+    return value.name if isinstance(value, ObjectModel) else str(value)
+
+
+# ---------------------------------------------------------------------- operator
+
+
+class _PromptJob(Job):
+    """RUNNING while the prompt is open; a timeout (cell clock) or a halt withdraws it."""
+
+    def __init__(self, console: OperatorConsole, prompt: Prompt, call: OperationCall,
+                 deadline: float | None) -> None:  # fmt: skip
+        super().__init__(on_cancel=self._withdraw)
+        self._console, self._prompt, self._clock = console, prompt, call.clock
+        self._deadline = deadline
+        prompt.add_done_callback(self._closed)
+
+    def _withdraw(self) -> None:
+        self._console.cancel(self._prompt.id, "halted")
+
+    def _closed(self, prompt: Prompt) -> None:
+        if prompt.state is PromptState.YES:
+            self.succeed("yes")
+        elif prompt.state is PromptState.NO:
+            self.fail("declined")
+        else:
+            self.fail(prompt.reason or "withdrawn")
+
+    def poll(self) -> Status:
+        deadline = self._deadline
+        if self._status is RUNNING and deadline is not None and self._clock() >= deadline:
+            self._console.cancel(self._prompt.id, "timed out")
+        return self._status
+
+
+class Confirm:
+    """collaboration.confirm: asks the operator a yes/no question."""
+
+    def __init__(self, console: OperatorConsole) -> None:
+        self._console = console
+
+    def start(self, call: OperationCall) -> StartResult:
+        text = str(call.args.get("prompt", "")).strip()
+        if not text:
+            raise OperationFailed("confirm needs the text of the question")
+        timeout = _seconds(call, "timeout")
+        deadline = call.clock() + timeout if timeout > 0 else None  # counted from the asking
+        prompt = self._console.ask(text, call.node_name)
+        call.log(f"asked the operator: {text}")
+        return _PromptJob(self._console, prompt, call, deadline)
+
+
+class ButtonPressed:
+    """collaboration.button_pressed: true once per latched press."""
+
+    def __init__(self, console: OperatorConsole) -> None:
+        self._console = console
+
+    def start(self, call: OperationCall) -> StartResult:
+        return self._console.consume(str(call.args.get("button", "continue")))
+
+
+class _ButtonJob(Job):
+    """RUNNING until the button is pressed: a press finishes it at once from the thread that
+    pressed (no wait for the next tick); a timeout is checked on the cell's clock."""
+
+    def __init__(self, console: OperatorConsole, button: str, call: OperationCall,
+                 timeout: float) -> None:  # fmt: skip
+        super().__init__(on_cancel=lambda: console.remove_listener(self._heard))
+        self._console, self._button, self._clock = console, button, call.clock
+        self._deadline = call.clock() + timeout if timeout > 0 else None
+        console.add_listener(self._heard)
+        self._check()  # a press between clear() and add_listener() is not lost
+
+    def _heard(self, event: ConsoleEvent) -> None:
+        if event.kind is ConsoleEventKind.BUTTON_PRESSED and event.button == self._button:
+            self._check()
+
+    def _check(self) -> None:
+        if not self.finished and self._console.consume(self._button):
+            self._console.remove_listener(self._heard)
+            self.succeed(f"{self._button} pressed")
+
+    def poll(self) -> Status:
+        deadline = self._deadline
+        if self._status is RUNNING and deadline is not None and self._clock() >= deadline:
+            self._console.remove_listener(self._heard)
+            self.fail(f"timed out: {self._button!r} was not pressed")
+        return self._status
+
+
+class WaitForButton:
+    """collaboration.wait_for_button: RUNNING until the button is pressed."""
+
+    def __init__(self, console: OperatorConsole) -> None:
+        self._console = console
+
+    def start(self, call: OperationCall) -> StartResult:
+        button = str(call.args.get("button", "continue"))
+        if not call.args.get("earlier_press_counts", False):
+            self._console.clear(button)
+        return _ButtonJob(self._console, button, call, _seconds(call, "timeout"))
+
+
+# ---------------------------------------------------------------------- handoff
+
+
+class WaitForHandoff:
+    """collaboration.wait_for_handoff: watches a camera until the object is put in the region."""
+
+    def __init__(self, env: CapabilityEnv) -> None:
+        self._env = env
+
+    def start(self, call: OperationCall) -> StartResult:
+        what = "wait_for_handoff"
+        camera_name = str(call.args.get("camera", "shoulder"))
+        if camera_name not in CAMERAS:
+            raise OperationFailed(f"unknown camera {camera_name!r}; cameras: {', '.join(CAMERAS)}")
+        camera = _interface(self._env, camera_interface(camera_name), what)
+        world: WorldModel = _interface(self._env, "world", what)
+        library = _interface(self._env, "objects", what)
+        name = _object_name(call.args["object"])
+        if name not in library.names():
+            raise OperationFailed(f"the object library has no model {name!r}")
+        target = object_markers(library.get(name))
+        if not target.markers:
+            raise OperationFailed(f"{name} carries no marker: a handoff cannot be seen")
+        settings = HandoffSettings(
+            interval=max(_seconds(call, "interval"), 0.01), settle=_seconds(call, "settle"),
+            timeout=_seconds(call, "timeout"),
+        )  # fmt: skip
+        region: Region = call.args["region"]
+        return HandoffJob(camera, target, region, world, call.clock, settings, call.log)
+
+
+def latest(world: WorldModel, name: str) -> Detection | None:
+    """The newest detection of a class (by frame time), from any source."""
+    found = world.detections(name)
+    return max(found, key=lambda d: d.stamp) if found else None
+
+
+class ObjectInRegion:
+    """collaboration.object_in_region: the newest detection of the object is inside."""
+
+    def __init__(self, env: CapabilityEnv) -> None:
+        self._env = env
+
+    def start(self, call: OperationCall) -> StartResult:
+        world: WorldModel = _interface(self._env, "world", "object_in_region")
+        detection = latest(world, _object_name(call.args["object"]))
+        if detection is None:
+            return False
+        max_age = _seconds(call, "max_age")
+        if max_age > 0 and call.clock() - detection.stamp > max_age:
+            return False
+        return in_region(detection.pose, call.args["region"])
+
+
+# ---------------------------------------------------------------------- manifests
+
+
+def _port(name: str, types: tuple[ParamType, ...], doc: str, **kw: Any) -> PortSpec:
+    return PortSpec(name, types, doc=doc, **kw)
+
+
+TIME = (ParamType.DURATION, ParamType.NUMBER)
+
+
+def _manifests() -> list[tuple[OperationManifest, Any]]:
+    def op(op_id: str, kind: OperationKind, doc: str, *ports: PortSpec) -> OperationManifest:
+        return OperationManifest(f"{CAP}.{op_id}", kind, doc, CAP, ports)
+
+    button = _port("button", (ParamType.TEXT,), "the operator button", default="continue")
+    obj = _port("object", (ParamType.OBJECT,), "the object (by its model name)")
+    region = _port("region", (ParamType.REGION,), "where it must be (a sphere)")
+    console = lambda env: env.interface("operator")  # noqa: E731
+    return [
+        (op("confirm", OperationKind.ACTION,
+            "Asks the operator a yes/no question; succeeds on yes, fails on no.",
+            _port("prompt", (ParamType.TEXT,), "the question shown to the operator"),
+            _port("timeout", TIME, "give up after this long (0: wait for ever)", default=0.0,
+                  unit="s")),
+         lambda env: Confirm(console(env))),
+        (op("button_pressed", OperationKind.CONDITION,
+            "True when the operator pressed the button since it was last checked.", button),
+         lambda env: ButtonPressed(console(env))),
+        (op("wait_for_button", OperationKind.ACTION,
+            "Waits until the operator presses the button (or the foot pedal).", button,
+            _port("timeout", TIME, "give up after this long (0: wait for ever)", default=0.0,
+                  unit="s"),
+            _port("earlier_press_counts", (ParamType.BOOL,),
+                  "a press made before this node started counts", default=False)),
+         lambda env: WaitForButton(console(env))),
+        (op("wait_for_handoff", OperationKind.ACTION,
+            "Waits until a person puts the object down in the region (seen by its markers).",
+            obj, region,
+            _port("camera", (ParamType.TEXT,), "which camera watches", default="shoulder",
+                  choices=CAMERAS),
+            _port("timeout", TIME, "give up after this long (0: wait for ever)", default=0.0,
+                  unit="s"),
+            _port("settle", TIME, "how long it must lie still first", default=0.0, unit="s"),
+            _port("interval", TIME, "time between camera frames", default=0.1, unit="s"),
+            PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where it was put")),
+         WaitForHandoff),
+        (op("object_in_region", OperationKind.CONDITION,
+            "True when the object was last seen inside the region.", obj, region,
+            _port("max_age", TIME, "ignore sightings older than this (0: any age)",
+                  default=0.0, unit="s")),
+         ObjectInRegion),
+    ]  # fmt: skip
+
+
+def build_capability() -> Capability:
+    """The collaboration capability (requires the cell's ``operator`` console)."""
+    cap = Capability(
+        CAP,
+        "People and the robot: operator prompts and buttons, objects handed over.",
+        requires=("operator",),
+    )
+    for manifest, factory in _manifests():
+        cap.add(manifest, factory)
+    return cap
