@@ -13,10 +13,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from capabilities.sim.cameras import SHOULDER_EYE, SHOULDER_TARGET, WRIST_MOUNT, look_at
 from capabilities.sim.errors import SimError
 from engine.types import ParamType, Pose, ValueError_, decode_value
 
-__all__ = ["CellConfig", "TableConfig", "DEFAULT_CONFIG_PATH", "FORMAT_VERSION"]
+__all__ = ["CameraSettings", "CellConfig", "TableConfig", "DEFAULT_CONFIG_PATH", "FORMAT_VERSION"]
 
 FORMAT_VERSION = 1
 DEFAULT_CONFIG_PATH = (
@@ -38,6 +39,36 @@ class TableConfig:
 
 
 @dataclass(frozen=True)
+class CameraSettings:
+    """One RGB-D camera of the cell.
+
+    Attributes:
+        pose: the camera's OpenCV frame (x right, y down, z forward): in the world for a fixed
+            camera, in the flange (tool0) frame for a wrist camera.
+        on_wrist: mounted on the flange, moving with the arm.
+        size: (width, height) of the images in pixels.
+        fov_y_deg: vertical field of view in degrees.
+        near, far: depth range (m); beyond it depth reads NaN.
+    """
+
+    pose: Pose
+    on_wrist: bool = False
+    size: tuple[int, int] = (640, 480)
+    fov_y_deg: float = 45.0
+    near: float = 0.1
+    far: float = 3.0
+
+
+def _default_cameras() -> dict[str, CameraSettings]:
+    return {
+        # On a stand behind the robot base, off to its left, aimed at the middle of the table;
+        # 640x480 because a 4 cm marker at 1.5 m is too small to read at 320x240.
+        "shoulder": CameraSettings(look_at(SHOULDER_EYE, SHOULDER_TARGET)),
+        "wrist": CameraSettings(WRIST_MOUNT, True, (320, 240), near=0.05, far=2.0),
+    }
+
+
+@dataclass(frozen=True)
 class CellConfig:
     """Everything the simulated cell needs to build its world.
 
@@ -54,6 +85,7 @@ class CellConfig:
         table: the table box.
         stand_size: width and depth (m) of the robot's stand, which reaches from the floor up
             to the robot base.
+        cameras: the RGB-D cameras by name ("shoulder", "wrist").
     """
 
     robot_base: Pose = _BASE
@@ -68,6 +100,7 @@ class CellConfig:
     handle_grasp: Pose = _HANDLE_GRASP
     table: TableConfig = TableConfig()
     stand_size: tuple[float, float] = (0.2, 0.2)
+    cameras: dict[str, CameraSettings] = field(default_factory=_default_cameras)
 
     @classmethod
     def load(cls, path: str | Path = DEFAULT_CONFIG_PATH) -> CellConfig:
@@ -117,6 +150,7 @@ class CellConfig:
                 top_z=_numbers(table, "top_z", (default.table.top_z,), 1, "$.table")[0],
             ),
             stand_size=_numbers(data, "stand_size", default.stand_size, 2),  # type: ignore[arg-type]
+            cameras=_cameras(data.get("cameras"), default.cameras),
         )
 
     def to_json(self) -> dict[str, Any]:
@@ -138,6 +172,17 @@ class CellConfig:
                 "top_z": self.table.top_z,
             },
             "stand_size": list(self.stand_size),
+            "cameras": {
+                name: {
+                    "pose": pose(c.pose),
+                    "on_wrist": c.on_wrist,
+                    "size": list(c.size),
+                    "fov_y_deg": c.fov_y_deg,
+                    "near": c.near,
+                    "far": c.far,
+                }
+                for name, c in self.cameras.items()
+            },
         }
 
 
@@ -165,3 +210,34 @@ def _numbers(
     ):
         raise ValueError_(f"{prefix}.{key}", f"{n} finite number(s)", data[key])
     return tuple(float(v) for v in value)
+
+
+def _cameras(data: Any, default: dict[str, CameraSettings]) -> dict[str, CameraSettings]:
+    """The ``cameras`` block: missing cameras and fields keep their defaults."""
+    if data is None:
+        return dict(default)
+    if not isinstance(data, dict):
+        raise ValueError_("$.cameras", "an object of cameras by name", data)
+    cameras = dict(default)
+    for name, entry in data.items():
+        path = f"$.cameras.{name}"
+        if not isinstance(entry, dict):
+            raise ValueError_(path, "an object with pose, on_wrist, size, fov_y_deg", entry)
+        base = cameras.get(name, CameraSettings(Pose()))
+        on_wrist = entry.get("on_wrist", base.on_wrist)
+        if not isinstance(on_wrist, bool):
+            raise ValueError_(f"{path}.on_wrist", "true or false", on_wrist)
+        size = _numbers(entry, "size", base.size, 2, path)
+        if not all(v >= 16 and v == int(v) for v in size):
+            raise ValueError_(f"{path}.size", "two whole numbers of pixels, at least 16", size)
+        fov, near, far = (
+            _numbers(entry, key, (getattr(base, key),), 1, path)[0]
+            for key in ("fov_y_deg", "near", "far")
+        )
+        if not (1.0 <= fov <= 170.0 and 0.0 < near < far):
+            raise ValueError_(path, "a field of view of 1-170 deg and 0 < near < far", entry)
+        cameras[name] = CameraSettings(
+            decode_value(ParamType.POSE, entry["pose"], f"{path}.pose") if "pose" in entry else base.pose,
+            on_wrist, (int(size[0]), int(size[1])), fov, near, far,
+        )  # fmt: skip
+    return cameras

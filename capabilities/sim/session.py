@@ -12,6 +12,7 @@ Ground truth stays on ``ground_truth`` and ``scene`` for tests and scores.
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Mapping
 from pathlib import Path
 from types import TracebackType
@@ -27,11 +28,9 @@ from capabilities.sim.cameras import (
     LinkMount,
     RGBDFrame,
     SimCamera,
-    shoulder_camera,
-    wrist_camera,
 )
 from capabilities.sim.cell import SimCell
-from capabilities.sim.config import CellConfig
+from capabilities.sim.config import CameraSettings, CellConfig
 from capabilities.sim.scene import SceneState, default_scene_path, load_scene
 from capabilities.sim.worker import SimWorker, install_scene_worker
 from capabilities.world_model import WorldModel
@@ -96,9 +95,8 @@ class SimCellSession:
         seed: randomisation seed of the scene.
         speed: 1.0 real time (GUI); None as fast as possible (CLI, tests).
         config: the cell configuration (default ``resources/cells/sim_default.json``).
-        shoulder_size: (width, height) of the shoulder camera (it looks from 1.5 m: a 4 cm
-            marker needs 640x480 to be read).
-        wrist_size: (width, height) of the wrist camera.
+        shoulder_size: (width, height) of the shoulder camera instead of the configured one.
+        wrist_size: (width, height) of the wrist camera instead of the configured one.
     """
 
     name = "sim"
@@ -109,8 +107,8 @@ class SimCellSession:
         seed: int = 0,
         speed: float | None = None,
         config: CellConfig | None = None,
-        shoulder_size: tuple[int, int] = (640, 480),
-        wrist_size: tuple[int, int] = (320, 240),
+        shoulder_size: tuple[int, int] | None = None,
+        wrist_size: tuple[int, int] | None = None,
     ) -> None:
         self.sim = SimCell(config, speed)
         self.world_model = WorldModel()
@@ -131,21 +129,29 @@ class SimCellSession:
                     keep_out=((holster[0], holster[1], 0.12),),
                 )
             )  # fmt: skip
-            shoulder = shoulder_camera(
-                CameraConfig(width=shoulder_size[0], height=shoulder_size[1])
-            )
-            wrist = wrist_camera(
-                self.sim.robot_body_id, self.sim.robot.flange_link(),
-                CameraConfig(width=wrist_size[0], height=wrist_size[1], near=0.05, far=2.0),
-            )  # fmt: skip
+            sizes = {"shoulder": shoulder_size, "wrist": wrist_size}
             self.cameras = {
-                "shoulder": SimCameraDevice(self.sim, shoulder),
-                "wrist": SimCameraDevice(self.sim, wrist),
+                name: SimCameraDevice(self.sim, self._camera(name, settings, sizes.get(name)))
+                for name, settings in self.sim.config.cameras.items()
             }
             self.worker = install_scene_worker(self.sim, self.scene, path, seed)
         except BaseException:
             self.close()
             raise
+
+    def _camera(
+        self, name: str, settings: CameraSettings, size: tuple[int, int] | None
+    ) -> SimCamera:
+        """A simulated camera as the cell configuration describes it."""
+        width, height = size or settings.size
+        optics = CameraConfig(
+            width=width, height=height, fov_y=math.radians(settings.fov_y_deg),
+            near=settings.near, far=settings.far,
+        )  # fmt: skip
+        if settings.on_wrist:
+            mount = LinkMount(self.sim.robot_body_id, self.sim.robot.flange_link(), settings.pose)
+            return SimCamera(name, optics, mount)
+        return SimCamera(name, optics, FixedMount(settings.pose))
 
     @property
     def ground_truth(self) -> Any:
@@ -162,8 +168,7 @@ class SimCellSession:
             "gripper": self.sim.gripper,
             "suction": self.sim.suction,
             "freedrive": self.sim.robot,
-            "rgbd:shoulder": self.cameras["shoulder"],
-            "rgbd:wrist": self.cameras["wrist"],
+            **{f"rgbd:{name}": camera for name, camera in self.cameras.items()},
             "world": self.world_model,
             "workers": self.workers,
             "scene_layout": self.scene_layout(),

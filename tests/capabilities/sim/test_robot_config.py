@@ -23,3 +23,40 @@ def test_a_bad_field_names_the_file_and_json_path(tmp_path: Path) -> None:
     path.write_text(json.dumps(data))
     with pytest.raises(SimError, match=r"cell\.json.*\$\.holster_pose\.position"):
         CellConfig.load(path)
+
+
+def test_the_cell_file_describes_the_cameras() -> None:
+    from capabilities.sim.config import DEFAULT_CONFIG_PATH, CellConfig
+
+    config = CellConfig.load(DEFAULT_CONFIG_PATH)
+    assert set(config.cameras) == {"shoulder", "wrist"}
+    assert config.cameras["shoulder"].size == (640, 480) and not config.cameras["shoulder"].on_wrist
+    assert config.cameras["wrist"].on_wrist
+    assert CellConfig.from_json(config.to_json()) == config
+
+
+def test_a_bad_camera_entry_names_its_json_path() -> None:
+    import pytest
+
+    from capabilities.sim.config import CellConfig
+    from engine.types import ValueError_
+
+    data = CellConfig().to_json()
+    data["cameras"]["shoulder"]["size"] = [640, "tall"]
+    with pytest.raises(ValueError_, match=r"\$\.cameras\.shoulder\.size"):
+        CellConfig.from_json(data)
+
+
+def test_a_session_builds_the_configured_cameras() -> None:
+    import dataclasses
+
+    from capabilities.sim.config import CellConfig
+    from capabilities.sim.session import SimCellSession
+
+    config = CellConfig()
+    small = dataclasses.replace(config.cameras["shoulder"], size=(160, 120))
+    config = dataclasses.replace(config, cameras={**config.cameras, "shoulder": small})
+    with SimCellSession("empty", config=config) as session:
+        frame = session.interfaces()["rgbd:shoulder"].capture()
+        assert frame.rgb.shape == (120, 160, 3)
+        assert frame.T_world_camera == small.pose
