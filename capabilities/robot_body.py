@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from capabilities.geometry import matrix_to_pose, pose_to_matrix
 from engine.types import Pose
 
 __all__ = [
@@ -72,6 +73,14 @@ _LINK_CAPSULES: tuple[tuple[int, tuple[float, ...], tuple[float, ...], float], .
 )
 
 
+pose_matrix = pose_to_matrix  # 4x4 matrix of a pose
+
+
+def matrix_pose(m: np.ndarray) -> Pose:
+    """The pose of a 4x4 homogeneous matrix (rotation part orthonormal)."""
+    return matrix_to_pose(m, project=False)
+
+
 class RobotBodyError(Exception):
     """The robot's body cannot be placed (unknown base pose, bad joints)."""
 
@@ -96,36 +105,6 @@ class Capsule:
         )
         closest = self.a + t[:, None] * ab
         return np.linalg.norm(points - closest, axis=1) - self.radius
-
-
-def pose_matrix(pose: Pose) -> np.ndarray:
-    """The 4x4 homogeneous matrix of a pose."""
-    x, y, z, w = pose.orientation
-    m = np.eye(4)
-    m[:3, :3] = [
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ]
-    m[:3, 3] = pose.position
-    return m
-
-
-def matrix_pose(m: np.ndarray) -> Pose:
-    """The pose of a 4x4 homogeneous matrix (rotation part orthonormal)."""
-    r = m[:3, :3]
-    trace = float(np.trace(r))
-    if trace > 0:
-        s = math.sqrt(trace + 1.0) * 2
-        q = ((r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s, s / 4)
-    else:
-        i = int(np.argmax(np.diag(r)))
-        j, k = (i + 1) % 3, (i + 2) % 3
-        s = math.sqrt(1.0 + r[i, i] - r[j, j] - r[k, k]) * 2
-        v = [0.0, 0.0, 0.0]
-        v[i], v[j], v[k] = s / 4, (r[j, i] + r[i, j]) / s, (r[k, i] + r[i, k]) / s
-        q = (v[0], v[1], v[2], (r[k, j] - r[j, k]) / s)
-    return Pose(tuple(float(c) for c in m[:3, 3]), q)  # type: ignore[arg-type]
 
 
 def _rpy(xyz: Sequence[float], rpy: Sequence[float]) -> np.ndarray:

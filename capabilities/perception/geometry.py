@@ -11,6 +11,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from capabilities.geometry import matrix_to_pose as _matrix_to_pose
+from capabilities.geometry import pose_to_matrix
 from engine.types import Pose
 
 __all__ = [
@@ -23,41 +25,9 @@ __all__ = [
 ]
 
 
-def pose_to_matrix(pose: Pose) -> np.ndarray:
-    """The 4x4 homogeneous matrix of a pose."""
-    x, y, z, w = pose.orientation
-    m = np.eye(4)
-    m[:3, :3] = [
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ]
-    m[:3, 3] = pose.position
-    return m
-
-
 def matrix_to_pose(m: np.ndarray) -> Pose:
     """The pose of a 4x4 matrix whose rotation part is orthonormal."""
-    r = m[:3, :3]
-    # Shepperd's method: take the largest of w, x, y, z first for numerical stability.
-    t = np.trace(r)
-    cases = [t, r[0, 0], r[1, 1], r[2, 2]]
-    k = int(np.argmax(cases))
-    if k == 0:
-        s = 2.0 * math.sqrt(1.0 + t)
-        q = ((r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s, s / 4)
-    elif k == 1:
-        s = 2.0 * math.sqrt(1.0 + r[0, 0] - r[1, 1] - r[2, 2])
-        q = (s / 4, (r[0, 1] + r[1, 0]) / s, (r[0, 2] + r[2, 0]) / s, (r[2, 1] - r[1, 2]) / s)
-    elif k == 2:
-        s = 2.0 * math.sqrt(1.0 + r[1, 1] - r[0, 0] - r[2, 2])
-        q = ((r[0, 1] + r[1, 0]) / s, s / 4, (r[1, 2] + r[2, 1]) / s, (r[0, 2] - r[2, 0]) / s)
-    else:
-        s = 2.0 * math.sqrt(1.0 + r[2, 2] - r[0, 0] - r[1, 1])
-        q = ((r[0, 2] + r[2, 0]) / s, (r[1, 2] + r[2, 1]) / s, s / 4, (r[1, 0] - r[0, 1]) / s)
-    if q[3] < 0:
-        q = (-q[0], -q[1], -q[2], -q[3])
-    return Pose(tuple(float(v) for v in m[:3, 3]), q)  # type: ignore[arg-type]
+    return _matrix_to_pose(m, project=False)
 
 
 def wrap_angle(angle: float) -> float:
