@@ -79,13 +79,14 @@ class _Maker:
         return Binding.fixed(ObjectModel(name), ParamType.OBJECT)
 
 
-def cup_to_bin() -> PlanSpec:
-    m = _Maker("cup_to_bin")
+def _figure3_tree(m: _Maker, finder: str, detect: str, title: str) -> NodeSpec:
+    """The Figure 3 tree; ``finder`` is the capability that finds objects (markers or
+    perception) and ``detect`` its operation that looks."""
     transfer = m.node(
         NodeKind.SEQUENCE, "transfer",
-        m.op("markers.object_found", "CUP found", object=m.obj("cup")),
-        m.op("markers.object_pose", "pose of CUP", object=m.obj("cup"), pose=Binding.reference("CUP_POSE")),
-        m.op("markers.object_pose", "pose of BIN", object=m.obj("waste_bin"),
+        m.op(f"{finder}.object_found", "CUP found", object=m.obj("cup")),
+        m.op(f"{finder}.object_pose", "pose of CUP", object=m.obj("cup"), pose=Binding.reference("CUP_POSE")),
+        m.op(f"{finder}.object_pose", "pose of BIN", object=m.obj("waste_bin"),
              pose=Binding.reference("BIN_POSE")),
         m.op("gripper.open", "open gripper"),
         m.move("move above CUP_POSE", "above cup", "CUP_POSE"),
@@ -100,13 +101,17 @@ def cup_to_bin() -> PlanSpec:
         NodeKind.FORCE_FAILURE, "then look again",
         m.op("timing.wait", "WAIT", seconds=Binding.fixed(1.0, ParamType.DURATION)),
     )  # fmt: skip
-    tree = m.node(
-        NodeKind.SEQUENCE, "cup to bin",
+    return m.node(
+        NodeKind.SEQUENCE, title,
         m.move("step out of view", "observe"),
-        m.op("markers.detect_markers", "detect CUP and BIN", camera=Binding.fixed("shoulder", ParamType.TEXT)),
+        m.op(f"{finder}.{detect}", "detect CUP and BIN", camera=Binding.fixed("shoulder", ParamType.TEXT)),
         m.node(NodeKind.SELECTOR, "transfer or wait", transfer, wait),
         m.move("back to observe", "observe"),
     )  # fmt: skip
+
+
+def cup_to_bin() -> PlanSpec:
+    tree = _figure3_tree(_Maker("cup_to_bin"), "markers", "detect_markers", "cup to bin")
     return PlanSpec(
         tree, "Cup to bin (Figure 3, simulated cell)",
         "The paper's Figure 3 on the simulated cell: find the cup and the waste bin through their "
@@ -122,34 +127,7 @@ def cup_to_bin() -> PlanSpec:
 def cup_to_bin_vision() -> PlanSpec:
     """Figure 3 with model-based recognition (perception) in place of the ArUco markers."""
     m = _Maker("cup_to_bin_vision")
-    transfer = m.node(
-        NodeKind.SEQUENCE, "transfer",
-        m.op("perception.object_found", "CUP found", object=m.obj("cup")),
-        m.op("perception.object_pose", "pose of CUP", object=m.obj("cup"),
-             pose=Binding.reference("CUP_POSE")),
-        m.op("perception.object_pose", "pose of BIN", object=m.obj("waste_bin"),
-             pose=Binding.reference("BIN_POSE")),
-        m.op("gripper.open", "open gripper"),
-        m.move("move above CUP_POSE", "above cup", "CUP_POSE"),
-        m.move("move to CUP_POSE", "grasp cup", "CUP_POSE", linear=True),
-        m.op("gripper.close", "grasp"),
-        m.op("gripper.is_holding", "holding the cup"),
-        m.move("lift", "above cup", "CUP_POSE", linear=True),
-        m.move("move to BIN_POSE", "over bin", "BIN_POSE"),
-        m.op("gripper.open", "release"),
-    )  # fmt: skip
-    wait = m.node(
-        NodeKind.FORCE_FAILURE, "then look again",
-        m.op("timing.wait", "WAIT", seconds=Binding.fixed(1.0, ParamType.DURATION)),
-    )  # fmt: skip
-    tree = m.node(
-        NodeKind.SEQUENCE, "cup to bin (vision)",
-        m.move("step out of view", "observe"),
-        m.op("perception.detect_objects", "detect CUP and BIN",
-             camera=Binding.fixed("shoulder", ParamType.TEXT)),
-        m.node(NodeKind.SELECTOR, "transfer or wait", transfer, wait),
-        m.move("back to observe", "observe"),
-    )  # fmt: skip
+    tree = _figure3_tree(m, "perception", "detect_objects", "cup to bin (vision)")
     return PlanSpec(
         tree, "Cup to bin, by vision (Figure 3, simulated cell)",
         "The paper's Figure 3 with model-based recognition instead of markers: the shoulder "
