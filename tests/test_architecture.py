@@ -48,3 +48,32 @@ def test_the_check_sees_a_forbidden_import(tmp_path: Path) -> None:
     sample = tmp_path / "sample.py"
     sample.write_text("def f():\n    from PySide6 import QtCore\n", encoding="utf-8")
     assert "PySide6" in _imports(sample)
+
+
+def _modules_imported(path: Path) -> set[str]:
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    names: set[str] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            names.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            names.add(node.module)
+    return names
+
+
+def test_operations_do_not_reach_into_the_simulator() -> None:
+    """Only the simulated cell itself (and the cell chooser) may import capabilities.sim: an
+    operation that did could read the simulator's ground truth."""
+    allowed = {ROOT / "capabilities" / "cells.py"}
+    offenders = []
+    for path in sorted((ROOT / "capabilities").rglob("*.py")):
+        if (ROOT / "capabilities" / "sim") in path.parents or path in allowed:
+            continue
+        bad = {
+            m
+            for m in _modules_imported(path)
+            if m == "capabilities.sim" or m.startswith("capabilities.sim.")
+        }
+        if bad:
+            offenders.append(f"{path.relative_to(ROOT)} imports {', '.join(sorted(bad))}")
+    assert not offenders, "\n".join(offenders)
