@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import signal
 import sys
 import threading
@@ -66,6 +67,8 @@ def _cmd_validate(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             f"{args.plan}: invalid ({sum(p.severity == 'error' for p in problems)} errors)",
             file=out,
         )
+        if args.cell == "none" and any("cannot run on this cell" in p.message for p in problems):
+            print("hint: some operations need a robot cell; try --cell sim", file=out)
         return EXIT_INVALID
     print(f"{args.plan}: valid", file=out)
     return EXIT_SUCCESS
@@ -329,6 +332,11 @@ def main(
     except CapabilityError as exc:
         print(f"error: {exc}", file=err)
         return EXIT_INVALID
+    except BrokenPipeError:
+        # The reader went away (costar ops | head): say nothing more, as Unix tools do.
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return EXIT_FAILURE
 
 
 if __name__ == "__main__":

@@ -195,3 +195,19 @@ def test_ops_lists_every_robot_operation_with_reasons_when_no_cell() -> None:
     assert not move["available"] and "arm" in move["reason"]
     assert {p["name"] for p in move["params"]} >= {"target", "mode", "speed"}
     assert ops["timing.wait"]["available"]
+
+
+def test_validate_on_no_cell_hints_at_the_simulated_cell() -> None:
+    code, out, _ = run_cli("validate", str(EXAMPLES / "cup_to_bin.costar.json"))
+    assert code == 2
+    assert "the none cell has no arm" in out
+    assert "try --cell sim" in out
+
+
+def test_ops_into_a_closed_pipe_ends_quietly() -> None:
+    proc = subprocess.run(
+        f"{sys.executable} -m capabilities.cli ops | head -n 1",
+        shell=True, capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert proc.stdout.count("\n") == 1
+    assert "Traceback" not in proc.stderr
