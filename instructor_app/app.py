@@ -20,6 +20,10 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+# NodeGraphQt loads Qt.py, which loads every Qt module, QtMultimedia too; with no audio server
+# its backend lookup logs noise on every start. The Instructor plays no sound.
+os.environ.setdefault("QT_LOGGING_RULES", "qt.multimedia*=false")
+
 from PySide6.QtCore import QEventLoop, QSettings, QTimer
 from PySide6.QtWidgets import QApplication, QWidget
 

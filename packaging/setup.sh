@@ -12,6 +12,8 @@ apt_packages=(
   libfontconfig1 libdbus-1-3 xvfb xauth libxcb-cursor0 libxcb-icccm4 libxcb-keysyms1
   libxcb-shape0 libxcb-xinerama0 libxcb-randr0 libxcb-render-util0 libxcb-image0
   libxcb-xfixes0 libxcb-xkb1
+  # NodeGraphQt imports Qt.py, which loads QtMultimedia (it needs PulseAudio's client library).
+  libpulse0
 )
 missing=()
 for pkg in "${apt_packages[@]}"; do
