@@ -182,6 +182,11 @@ def _grab(window: MainWindow, path: Path) -> None:
     if shown is not None:
         window.select_node(shown)
     window.views.canvas.fit_all()
+    # Dock layouts settle over a few event-loop turns (tabified docks re-parent their tab
+    # bars); let them, so that the picture shows the window as a person would see it.
+    settle = QEventLoop()
+    QTimer.singleShot(200, settle.quit)
+    settle.exec()
     QApplication.processEvents()
     path.parent.mkdir(parents=True, exist_ok=True)
     if not window.grab().save(str(path), "PNG"):

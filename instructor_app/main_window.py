@@ -98,6 +98,7 @@ class MainWindow(QMainWindow):
         self.splitDockWidget(self.docks["inspector"], self.docks["plan"], Qt.Orientation.Vertical)
         self.tabifyDockWidget(self.docks["plan"], self.docks["waypoints"])
         self.tabifyDockWidget(self.docks["waypoints"], self.docks["operator"])
+        self.docks["plan"].raise_()  # the operator tab comes forward when the robot asks
         bottom = [
             ("validation", "Problems", self.views.validation),
             ("log", "Log", self.views.log),
