@@ -49,11 +49,18 @@ def _load(path: str, registry: CapabilityRegistry, err: TextIO) -> PlanSpec | No
         return None
 
 
-def _cmd_validate(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+def _open(args: argparse.Namespace, err: TextIO, start: bool) -> Any:
+    """The cell the command asked for, or None after saying why it could not be opened."""
     try:
-        cell = open_cell(args.cell, seed=args.seed, start=False, scene=args.scene)
+        return open_cell(args.cell, seed=args.seed, start=start, scene=args.scene)
     except CellError as exc:
         print(f"error: {exc}", file=err)
+        return None
+
+
+def _cmd_validate(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    cell = _open(args, err, start=False)
+    if cell is None:
         return EXIT_INVALID
     with cell:
         registry = CapabilityRegistry(cell=cell)
@@ -113,10 +120,8 @@ def _install_interrupt(executor: Executor) -> Callable[[], None]:
 
 
 def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
-    try:
-        cell = open_cell(args.cell, seed=args.seed, start=True, scene=args.scene)
-    except CellError as exc:
-        print(f"error: {exc}", file=err)
+    cell = _open(args, err, start=True)
+    if cell is None:
         return EXIT_INVALID
     with cell:
         registry = CapabilityRegistry(cell=cell)
