@@ -15,6 +15,7 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
+from capabilities.errors import CapabilityError
 from engine.operations import (
     Availability,
     Operation,
@@ -36,10 +37,6 @@ __all__ = [
 ]
 
 ENTRY_POINT_GROUP = "costar.capabilities"
-
-
-class CapabilityError(Exception):
-    """A capability could not be loaded or registered."""
 
 
 class Cell(Protocol):

@@ -36,7 +36,7 @@ KIND_ALIASES: Mapping[str, str] = types.MappingProxyType(
 )
 
 TOP_FIELDS: tuple[str, ...] = ("format", "format_version", "id", "name", "description")
-TOP_FIELDS += ("run_policy", "parameters", "tree", "waypoints", "objects", "layout")
+TOP_FIELDS += ("run_policy", "reset_cell", "parameters", "tree", "waypoints", "objects", "layout")
 NODE_FIELDS = ("id", "kind", "name", "op", "params", "config", "children")
 IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 

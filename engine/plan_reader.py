@@ -121,6 +121,11 @@ class _Reader:
             self.fail(path, "a non-empty text" if nonempty else "a text", describe(value))
         return value
 
+    def flag(self, value: Any, path: str) -> bool:
+        if not isinstance(value, bool):
+            self.fail(path, "true or false", describe(value))
+        return value
+
     def items(self, value: Any, path: str, what: str) -> list[Any]:
         if not isinstance(value, list):
             self.fail(path, f"a list of {what}", describe(value))
@@ -158,6 +163,7 @@ class _Reader:
                     doc.get("run_policy", "once"), "$.run_policy", [p.value for p in RunPolicy]
                 )
             ),
+            reset_cell=self.flag(doc.get("reset_cell", False), "$.reset_cell"),
         )
         if doc.get("tree") is not None:
             plan.tree = self.node(doc["tree"], "$.tree", 1)

@@ -184,6 +184,8 @@ class PlanSpec:
     name: str = ""
     description: str = ""
     run_policy: RunPolicy = RunPolicy.ONCE
+    # Put the cell back to its scene's seed (robot home, objects in place) before each run.
+    reset_cell: bool = False
     parameters: list[ParameterDecl] = field(default_factory=list)
     waypoints: list[Waypoint] = field(default_factory=list)
     objects: list[str] = field(default_factory=list)
