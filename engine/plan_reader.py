@@ -2,16 +2,16 @@
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Mapping
-from pathlib import Path
 from typing import Any, NoReturn
 
+from engine.json_reader import JsonReader, parse_json, read_json_file
 from engine.plan_format import (
     FORMAT,
     FORMAT_VERSION,
     KIND_ALIASES,
+    MAX_NESTING,
     MAX_TREE_DEPTH,
     NODE_FIELDS,
     READABLE_VERSIONS,
@@ -32,59 +32,9 @@ from engine.spec import (
     RunPolicy,
     new_id,
 )
-from engine.types import ParamType, ValueError_, Waypoint, decode_value
+from engine.types import ParamType, Waypoint
 
 __all__ = ["load_plan", "loads_plan"]
-
-# --------------------------------------------------------------------------- reading
-
-
-class _JsonObject(dict[str, Any]):
-    """A parsed JSON object that remembers keys it had more than once (JSON keeps the last)."""
-
-    duplicates: tuple[str, ...] = ()
-
-
-class _ObjectHook:
-    """Builds parsed JSON objects; marks (rare) objects that had a key twice."""
-
-    def __init__(self) -> None:
-        self.found_duplicates = False
-
-    def __call__(self, pairs: list[tuple[str, Any]]) -> dict[str, Any]:
-        obj = dict(pairs)
-        if len(obj) == len(pairs):
-            return obj
-        self.found_duplicates = True
-        seen: set[str] = set()
-        marked = _JsonObject(obj)
-        for key, _ in pairs:
-            if key in seen and key not in marked.duplicates:
-                marked.duplicates += (key,)
-            seen.add(key)
-        return marked
-
-
-class _NotFinite(ValueError):
-    """NaN, Infinity or -Infinity in the text: Python reads them, JSON does not have them."""
-
-
-def _no_constant(name: str) -> NoReturn:
-    raise _NotFinite(name)
-
-
-def _first_duplicate(doc: Any) -> tuple[str, str] | None:
-    """(path, key) of the first key given twice in one object, in document order."""
-    stack: list[tuple[str, Any]] = [("$", doc)]
-    while stack:
-        path, value = stack.pop()
-        if isinstance(value, dict):
-            if getattr(value, "duplicates", ()):
-                return path, value.duplicates[0]  # type: ignore[attr-defined]
-            stack.extend((at(path, k), v) for k, v in reversed(value.items()))
-        elif isinstance(value, list):
-            stack.extend((at(path, i), v) for i, v in reversed(list(enumerate(value))))
-    return None
 
 
 class _Reader:
@@ -98,18 +48,14 @@ class _Reader:
     def fail(self, path: str, expected: str, got: str) -> NoReturn:
         raise PlanFileError(self.file, path, expected, got)
 
+    def at(self, value: Any, path: str) -> JsonReader:
+        """The one JSON reader, at ``value`` (found at ``path``) of this file."""
+        return JsonReader(value, self.file, path, PlanFileError)
+
     def fields(
         self, value: Any, path: str, fields: tuple[str, ...], required: tuple[str, ...] = ()
     ) -> dict[str, Any]:
-        if not isinstance(value, dict):
-            self.fail(path, f"an object with {', '.join(required or fields)}", describe(value))
-        for key in value:
-            if key not in fields:
-                self.fail(at(path, key), f"one of the fields {', '.join(fields)}", f"{key!r}")
-        for key in required:
-            if key not in value:
-                self.fail(at(path, key), "a value here (it is required)", "nothing")
-        return value
+        return self.at(value, path).as_object(fields, required)
 
     def mapping(self, value: Any, path: str, what: str) -> dict[str, Any]:
         if not isinstance(value, dict):
@@ -117,19 +63,13 @@ class _Reader:
         return value
 
     def text(self, value: Any, path: str, nonempty: bool = False) -> str:
-        if not isinstance(value, str) or (nonempty and not value.strip()):
-            self.fail(path, "a non-empty text" if nonempty else "a text", describe(value))
-        return value
+        return self.at(value, path).as_text(nonempty)
 
     def flag(self, value: Any, path: str) -> bool:
-        if not isinstance(value, bool):
-            self.fail(path, "true or false", describe(value))
-        return value
+        return self.at(value, path).as_bool()
 
     def items(self, value: Any, path: str, what: str) -> list[Any]:
-        if not isinstance(value, list):
-            self.fail(path, f"a list of {what}", describe(value))
-        return value
+        return self.at(value, path).as_list(what)
 
     def unique(self, name: str, before: list[str], path: str) -> None:
         if name in before:
@@ -141,11 +81,7 @@ class _Reader:
         return str(value)
 
     def value(self, ptype: ParamType, value: Any, path: str) -> Any:
-        try:
-            return decode_value(ptype, value, path)
-        except ValueError_ as exc:
-            got = str(exc).partition(f"{exc.path}: expected {exc.expected}, got ")[2]
-            raise PlanFileError(self.file, exc.path, exc.expected, got or "something else") from exc
+        return self.at(value, path).as_typed(ptype)
 
     def ptype(self, value: Any, path: str) -> ParamType:
         return ParamType(self.choice(value, path, [t.value for t in ParamType]))
@@ -330,7 +266,7 @@ def loads_plan(
 
     Args:
         text: the JSON text.
-        source_name: the file name used in error messages.
+        source_name: the file as the user named it, for error messages.
         aliases: former operation ids -> current ids; the loaded spec holds current ids.
 
     Returns:
@@ -339,28 +275,9 @@ def loads_plan(
     Raises:
         PlanFileError: the text is not a plan this program reads.
     """
-    try:
-        hook = _ObjectHook()
-        doc = json.loads(text, object_pairs_hook=hook, parse_constant=_no_constant)
-    except json.JSONDecodeError as exc:
-        cut = exc.pos >= len(text.rstrip())
-        got = "the end of the file: it is cut off" if cut else f"a syntax error ({exc.msg})"
-        raise PlanFileError(source_name, "", "valid JSON", got, exc.lineno, exc.colno) from exc
-    except _NotFinite as exc:
-        raise PlanFileError(
-            source_name, "", "finite numbers (JSON has no NaN or Infinity)", str(exc)
-        ) from exc
-    except ValueError as exc:  # a number too long to convert, for one
-        raise PlanFileError(source_name, "", "valid JSON", str(exc)) from exc
-    except RecursionError as exc:
-        raise PlanFileError(
-            source_name, "", f"a tree at most {MAX_TREE_DEPTH} levels deep", "deeper nesting"
-        ) from exc
+    doc = parse_json(text, source_name, "plan", max_depth=MAX_NESTING, error=PlanFileError)
     reader = _Reader(source_name, aliases or {})
     reader.check_format(doc)
-    duplicate = _first_duplicate(doc) if hook.found_duplicates else None
-    if duplicate is not None:
-        reader.fail(duplicate[0], "each field at most once in an object", f"{duplicate[1]!r} twice")
     return reader.plan(doc)
 
 
@@ -378,16 +295,7 @@ def load_plan(path: str | os.PathLike[str], aliases: Mapping[str, str] | None = 
         PlanFileError: the file is missing, unreadable, or not a plan this program reads.
     """
     file = os.fspath(path)
-    try:
-        data = Path(file).read_bytes()
-    except FileNotFoundError as exc:
-        raise PlanFileError(file, "", "a plan file", f"no file at {file}") from exc
-    except OSError as exc:
-        raise PlanFileError(file, "", "a readable plan file", exc.strerror or str(exc)) from exc
-    try:
-        text = data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise PlanFileError(
-            file, "", "UTF-8 text", f"a byte that is not UTF-8 at offset {exc.start}"
-        ) from exc
-    return loads_plan(text, file, aliases)
+    doc = read_json_file(file, "plan", max_depth=MAX_NESTING, error=PlanFileError)
+    reader = _Reader(file, aliases or {})
+    reader.check_format(doc)
+    return reader.plan(doc)

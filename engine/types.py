@@ -13,6 +13,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from engine.errors import EngineError
+
 __all__ = [
     "ParamType",
     "Pose",
@@ -21,7 +23,8 @@ __all__ = [
     "Region",
     "Waypoint",
     "WaypointFrame",
-    "ValueError_",
+    "MAX_VALUE_DEPTH",
+    "ValueShapeError",
     "encode_value",
     "decode_value",
     "check_value",
@@ -29,14 +32,27 @@ __all__ = [
 ]
 
 
-class ValueError_(ValueError):
-    """A value does not have the shape its type needs. ``path`` is a JSON path."""
+MAX_VALUE_DEPTH = 64
+"""Deepest nesting of lists and objects in an ``Any`` value (deeper is refused on reading and
+cut short on writing, so no value can exhaust the interpreter's recursion limit)."""
 
-    def __init__(self, path: str, expected: str, got: Any) -> None:
+
+class ValueShapeError(EngineError):
+    """A value does not have the shape its type needs.
+
+    Attributes:
+        path: the JSON path of the value.
+        expected: what its type needs.
+        got: the value.
+        got_text: a short description of the value for messages.
+    """
+
+    def __init__(self, path: str, expected: str, got: Any, got_text: str | None = None) -> None:
         self.path = path
         self.expected = expected
         self.got = got
-        super().__init__(f"{path}: expected {expected}, got {_describe(got)}")
+        self.got_text = _describe(got) if got_text is None else got_text
+        super().__init__(f"{path}: expected {expected}, got {self.got_text}")
 
 
 def _describe(value: Any) -> str:
@@ -192,32 +208,42 @@ def _floats(value: Any, n: int, path: str) -> tuple[float, ...]:
         or len(value) != n
         or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
     ):
-        raise ValueError_(path, f"a list of {n} numbers", value)
+        raise ValueShapeError(path, f"a list of {n} numbers", value)
     return tuple(float(v) for v in value)
+
+
+def _floats3(value: Any, path: str) -> tuple[float, float, float]:
+    x, y, z = _floats(value, 3, path)
+    return (x, y, z)
+
+
+def _floats4(value: Any, path: str) -> tuple[float, float, float, float]:
+    x, y, z, w = _floats(value, 4, path)
+    return (x, y, z, w)
 
 
 def _obj(
     value: Any, path: str, keys: Sequence[str], optional: Sequence[str] = ()
 ) -> dict[str, Any]:
     if not isinstance(value, dict):
-        raise ValueError_(path, f"an object with {', '.join(keys)}", value)
+        raise ValueShapeError(path, f"an object with {', '.join(keys)}", value)
     for key in keys:
         if key not in value:
-            raise ValueError_(f"{path}.{key}", "a value (missing)", None)
+            raise ValueShapeError(f"{path}.{key}", "a value (missing)", None)
     for key in value:
         if key not in keys and key not in optional:
-            raise ValueError_(f"{path}.{key}", "no such field", value[key])
+            raise ValueShapeError(f"{path}.{key}", "no such field", value[key])
     return value
 
 
 def _decode_pose(value: Any, path: str) -> Pose:
     obj = _obj(value, path, ("position", "orientation"))
-    position = _floats(obj["position"], 3, f"{path}.position")
-    orientation = _floats(obj["orientation"], 4, f"{path}.orientation")
+    position = _floats3(obj["position"], f"{path}.position")
+    orientation = _floats4(obj["orientation"], f"{path}.orientation")
     try:
-        return Pose(position, orientation)  # type: ignore[arg-type]
+        return Pose(position, orientation)
     except ValueError as exc:
-        raise ValueError_(f"{path}.orientation", "a non-zero quaternion", orientation) from exc
+        raise ValueShapeError(f"{path}.orientation", "a non-zero quaternion", orientation) from exc
 
 
 def _encode_pose(pose: Pose) -> dict[str, Any]:
@@ -226,32 +252,32 @@ def _encode_pose(pose: Pose) -> dict[str, Any]:
 
 def _decode_joints(value: Any, path: str) -> JointConfig:
     if not isinstance(value, list) or not value:
-        raise ValueError_(path, "a list of joint angles in radians", value)
+        raise ValueShapeError(path, "a list of joint angles in radians", value)
     return JointConfig(_floats(value, len(value), path))
 
 
 def _decode_number(value: Any, path: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ValueError_(path, "a finite number", value)
+        raise ValueShapeError(path, "a finite number", value)
     return float(value)
 
 
 def _decode_text(value: Any, path: str) -> str:
     if not isinstance(value, str):
-        raise ValueError_(path, "a text string", value)
+        raise ValueShapeError(path, "a text string", value)
     return value
 
 
 def _decode_bool(value: Any, path: str) -> bool:
     if not isinstance(value, bool):
-        raise ValueError_(path, "true or false", value)
+        raise ValueShapeError(path, "true or false", value)
     return value
 
 
 def _decode_duration(value: Any, path: str) -> float:
     seconds = _decode_number(value, path)
     if seconds < 0:
-        raise ValueError_(path, "a duration in seconds, not negative", value)
+        raise ValueShapeError(path, "a duration in seconds, not negative", value)
     return seconds
 
 
@@ -263,8 +289,8 @@ def _decode_region(value: Any, path: str) -> Region:
     obj = _obj(value, path, ("center", "radius"))
     radius = _decode_number(obj["radius"], f"{path}.radius")
     if radius <= 0:
-        raise ValueError_(f"{path}.radius", "a radius above 0 m", radius)
-    return Region(_floats(obj["center"], 3, f"{path}.center"), radius)  # type: ignore[arg-type]
+        raise ValueShapeError(f"{path}.radius", "a radius above 0 m", radius)
+    return Region(_floats3(obj["center"], f"{path}.center"), radius)
 
 
 def _decode_waypoint(value: Any, path: str) -> Waypoint:
@@ -272,14 +298,14 @@ def _decode_waypoint(value: Any, path: str) -> Waypoint:
     name = _decode_text(obj["name"], f"{path}.name")
     frames = [f.value for f in WaypointFrame]
     if obj["frame"] not in frames:
-        raise ValueError_(f"{path}.frame", f"one of {frames}", obj["frame"])
+        raise ValueShapeError(f"{path}.frame", f"one of {frames}", obj["frame"])
     pose = _decode_pose(obj["pose"], f"{path}.pose") if "pose" in obj else None
     joints = _decode_joints(obj["joints"], f"{path}.joints") if "joints" in obj else None
     reference = _decode_text(obj.get("reference", ""), f"{path}.reference")
     try:
         return Waypoint(name, WaypointFrame(obj["frame"]), pose, joints, reference)
     except ValueError as exc:
-        raise ValueError_(path, str(exc), value) from exc
+        raise ValueShapeError(path, str(exc), value) from exc
 
 
 def _encode_waypoint(wp: Waypoint) -> dict[str, Any]:
@@ -294,7 +320,24 @@ def _encode_waypoint(wp: Waypoint) -> dict[str, Any]:
 
 
 def _decode_any(value: Any, path: str) -> Any:
+    stack: list[tuple[str, Any, int]] = [(path, value, 1)]
+    while stack:
+        here, item, depth = stack.pop()
+        if isinstance(item, (list, dict)):
+            if depth > MAX_VALUE_DEPTH:
+                raise ValueShapeError(
+                    here,
+                    f"a value nested at most {MAX_VALUE_DEPTH} levels deep",
+                    item,
+                    "deeper nesting",
+                )
+            pairs = item.items() if isinstance(item, dict) else enumerate(item)
+            stack.extend((_at(here, k), v, depth + 1) for k, v in pairs)
     return value
+
+
+def _at(path: str, key: Any) -> str:
+    return f"{path}[{key}]" if isinstance(key, int) else f"{path}.{key}"
 
 
 _DECODERS: dict[ParamType, Callable[[Any, str], Any]] = {
@@ -325,12 +368,17 @@ _PY_TYPES: dict[ParamType, type | tuple[type, ...]] = {
 
 
 def decode_value(ptype: ParamType, value: Any, path: str = "$") -> Any:
-    """Turn the JSON form of a value into its Python value, or raise ValueError_."""
+    """Turn the JSON form of a value into its Python value, or raise ValueShapeError."""
     return _DECODERS[ptype](value, path)
 
 
-def encode_value(value: Any) -> Any:
-    """The JSON form of a value of any parameter type."""
+def encode_value(value: Any, depth: int = 1) -> Any:
+    """The JSON form of a value of any parameter type.
+
+    Lists and objects nested deeper than :data:`MAX_VALUE_DEPTH` are cut short: the part
+    below that depth becomes the text ``"<nested deeper than N levels>"``, so a display or a
+    trace of any value never exhausts the recursion limit.
+    """
     if isinstance(value, Pose):
         return _encode_pose(value)
     if isinstance(value, JointConfig):
@@ -343,10 +391,12 @@ def encode_value(value: Any) -> Any:
         return _encode_waypoint(value)
     if isinstance(value, (bool, int, float, str)) or value is None:
         return value
+    if isinstance(value, (list, tuple, dict)) and depth > MAX_VALUE_DEPTH:
+        return f"<nested deeper than {MAX_VALUE_DEPTH} levels>"
     if isinstance(value, (list, tuple)):
-        return [encode_value(v) for v in value]
+        return [encode_value(v, depth + 1) for v in value]
     if isinstance(value, dict):
-        return {str(k): encode_value(v) for k, v in value.items()}
+        return {str(k): encode_value(v, depth + 1) for k, v in value.items()}
     return repr(value)
 
 

@@ -325,7 +325,8 @@ def test_invalid_json_gives_line_and_column(name: str, line: int, column: int, g
         load_plan(DATA / name)
     assert info.value.got == got
     assert (info.value.line, info.value.column) == (line, column)
-    assert str(info.value).startswith(f"{name}: line {line} column {column}: expected valid JSON")
+    given = DATA / name  # the error names the file as given, not only its base name
+    assert str(info.value).startswith(f"{given}: line {line} column {column}: expected valid JSON")
 
 
 def test_data_files_of_newer_version_and_duplicate_keys() -> None:
