@@ -18,13 +18,14 @@ A model is a folder ``<library>/<name>/`` with ``model.json`` (format_version 1)
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from engine.types import ParamType, Pose, ValueError_, decode_value
+from capabilities.errors import CapabilityError
+from engine.json_reader import JsonFileError, JsonReader, read_json_file
+from engine.types import Pose
 
 __all__ = [
     "BoxPart",
@@ -45,8 +46,12 @@ _KNOWN_FIELDS = {
 }  # fmt: skip
 
 
-class ObjectLibraryError(Exception):
-    """A model folder or its model.json is missing or malformed; the message names the field."""
+class ObjectLibraryError(CapabilityError):
+    """A model folder or its model.json is missing or malformed; the message names the field.
+
+    A malformed file wraps the reader's :class:`engine.json_reader.JsonFileError` (its
+    ``__cause__``).
+    """
 
 
 def default_library_path() -> Path:
@@ -123,150 +128,85 @@ class ObjectModelSpec:
         return math.hypot(self.dimensions[0], self.dimensions[1]) / 2
 
 
-class _Fields:
-    """Typed access to a JSON object that names the file and JSON path in every error."""
-
-    def __init__(self, data: Any, file: Path, path: str) -> None:
-        self.file, self.path = file, path
-        if not isinstance(data, dict):
-            self.fail(path, "an object", data)
-        self.data: dict[str, Any] = data
-
-    def fail(self, path: str, expected: str, got: Any) -> None:
-        err = ValueError_(path, expected, got)
-        raise ObjectLibraryError(f"{self.file}: {err}")
-
-    def get(self, key: str, default: Any = ...) -> Any:
-        if key not in self.data:
-            if default is ...:
-                self.fail(f"{self.path}.{key}", "a value (missing)", None)
-            return default
-        return self.data[key]
-
-    def number(self, key: str, default: Any = ..., minimum: float = 0.0) -> float:
-        value = self.get(key, default)
-        ok = isinstance(value, (int, float)) and not isinstance(value, bool)
-        if not ok or not math.isfinite(value) or value <= minimum:
-            self.fail(f"{self.path}.{key}", f"a number above {minimum}", value)
-        return float(value)
-
-    def vector(self, key: str, n: int, default: Any = ...) -> tuple[float, ...]:
-        value = self.get(key, default)
-        try:
-            return _floats(value, n)
-        except (TypeError, ValueError):
-            self.fail(f"{self.path}.{key}", f"a list of {n} numbers", value)
-        raise AssertionError  # unreachable: fail() raises
-
-    def text(self, key: str, default: Any = ...) -> str:
-        value = self.get(key, default)
-        if not isinstance(value, str):
-            self.fail(f"{self.path}.{key}", "a text string", value)
-        return str(value)
-
-    def pose(self, key: str) -> Pose:
-        try:
-            return decode_value(ParamType.POSE, self.get(key), f"{self.path}.{key}")  # type: ignore[no-any-return]
-        except ValueError_ as exc:
-            raise ObjectLibraryError(f"{self.file}: {exc}") from exc
-
-    def child(self, key: str) -> _Fields:
-        return _Fields(self.get(key), self.file, f"{self.path}.{key}")
-
-
-def _floats(value: Any, n: int) -> tuple[float, ...]:
-    if not isinstance(value, list) or len(value) != n:
-        raise ValueError("length")
-    if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
-        raise TypeError("not numbers")
-    if not all(math.isfinite(v) for v in value):
-        raise ValueError("not finite")
-    return tuple(float(v) for v in value)
-
-
-def _parse_collision(f: _Fields) -> CollisionSpec:
-    kind = f.text("type")
+def _parse_collision(f: JsonReader) -> CollisionSpec:
+    kind = f.choice("type", ("cylinder", "box", "compound", "convex_hull"))
     if kind == "cylinder":
-        return CollisionSpec(kind, radius=f.number("radius"), height=f.number("height"))
+        radius, height = (
+            f.number("radius", lo=0.0, above=True),
+            f.number("height", lo=0.0, above=True),
+        )
+        return CollisionSpec(kind, radius=radius, height=height)
     if kind == "box":
-        size = f.vector("size", 3)
-        pos = f.vector("position", 3, [0.0, 0.0, size[2] / 2])
-        return CollisionSpec(kind, boxes=(BoxPart(size, pos),))  # type: ignore[arg-type]
+        size = f.vector3("size")
+        pos = f.vector3("position", (0.0, 0.0, size[2] / 2))
+        return CollisionSpec(kind, boxes=(BoxPart(size, pos),))
     if kind == "compound":
-        boxes = f.get("boxes")
-        if not isinstance(boxes, list) or not boxes:
-            f.fail(f"{f.path}.boxes", "a non-empty list of boxes", boxes)
-        parts = []
-        for i, item in enumerate(boxes):
-            b = _Fields(item, f.file, f"{f.path}.boxes[{i}]")
-            parts.append(BoxPart(b.vector("size", 3), b.vector("position", 3)))  # type: ignore[arg-type]
-        return CollisionSpec(kind, boxes=tuple(parts))
-    if kind == "convex_hull":
-        return CollisionSpec(kind)
-    f.fail(f"{f.path}.type", "one of cylinder, box, compound, convex_hull", kind)
-    raise AssertionError
+        boxes = f.items("boxes", "boxes", optional=False)
+        if not boxes:
+            f.fail("a non-empty list of boxes", key="boxes")
+        parts = tuple(BoxPart(b.vector3("size"), b.vector3("position")) for b in boxes)
+        return CollisionSpec(kind, boxes=parts)
+    return CollisionSpec(kind)
 
 
-def _parse_symmetry(f: _Fields) -> Symmetry:
-    kind = f.text("kind")
+def _parse_symmetry(f: JsonReader) -> Symmetry:
+    kind = f.choice("kind", ("none", "continuous", "discrete"))
     if kind == "none":
         return Symmetry()
-    axis = f.vector("axis", 3)
+    axis = f.vector3("axis")
     if kind == "continuous":
-        return Symmetry(kind, axis)  # type: ignore[arg-type]
-    if kind == "discrete":
-        order = f.get("order")
-        if not isinstance(order, int) or isinstance(order, bool) or order < 1:
-            f.fail(f"{f.path}.order", "a whole number of 1 or more", order)
-        return Symmetry(kind, axis, order)  # type: ignore[arg-type]
-    f.fail(f"{f.path}.kind", "one of none, continuous, discrete", kind)
-    raise AssertionError
+        return Symmetry(kind, axis)
+    return Symmetry(kind, axis, f.integer("order", lo=1))
 
 
-def _parse_markers(f: _Fields) -> tuple[MarkerSpec, ...]:
-    items = f.get("markers", [])
-    if not isinstance(items, list):
-        f.fail(f"{f.path}.markers", "a list of markers", items)
-    out = []
-    for i, item in enumerate(items):
-        m = _Fields(item, f.file, f"{f.path}.markers[{i}]")
-        marker_id = m.get("id")
-        if not isinstance(marker_id, int) or isinstance(marker_id, bool) or not 0 <= marker_id < 50:
-            m.fail(f"{m.path}.id", "a DICT_4X4_50 marker id (0..49)", marker_id)
-        out.append(MarkerSpec(marker_id, m.number("size"), m.pose("pose")))
-    return tuple(out)
+def _parse_markers(f: JsonReader) -> tuple[MarkerSpec, ...]:
+    return tuple(
+        MarkerSpec(
+            m.integer("id", lo=0, hi=49), m.number("size", lo=0.0, above=True), m.pose("pose")
+        )
+        for m in f.items("markers", "markers")
+    )
 
 
-def parse_model(data: Any, directory: Path, file: Path) -> ObjectModelSpec:
-    """Check and convert the content of a ``model.json``; raise ObjectLibraryError."""
-    f = _Fields(data, file, "$")
-    version = f.get("format_version")
-    if version != FORMAT_VERSION:
-        f.fail("$.format_version", f"{FORMAT_VERSION}", version)
+def _parse_model(f: JsonReader, directory: Path) -> ObjectModelSpec:
+    f.as_object()
+    f.check_version((FORMAT_VERSION,))
     name = f.text("name")
     if name != directory.name:
-        f.fail("$.name", f"the folder's name {directory.name!r}", name)
+        f.fail(f"the folder's name {directory.name!r}", key="name")
     mesh_file = directory / f.text("mesh")
     if not mesh_file.is_file():
-        f.fail("$.mesh", f"a file in {directory}", str(mesh_file.name))
-    dimensions = f.vector("dimensions", 3)
+        f.fail(f"a file in {directory}", key="mesh")
+    dimensions = f.vector3("dimensions")
     if min(dimensions) <= 0:
-        f.fail("$.dimensions", "three sizes above 0 m", list(dimensions))
+        f.fail("three sizes above 0 m", key="dimensions")
     return ObjectModelSpec(
         name=name,
         directory=directory,
         mesh_file=mesh_file,
-        collision=_parse_collision(f.child("collision")),
-        mass=f.number("mass"),
-        center_of_mass=f.vector("center_of_mass", 3, [0.0, 0.0, dimensions[2] / 2]),  # type: ignore[arg-type]
-        dimensions=dimensions,  # type: ignore[arg-type]
-        symmetry=_parse_symmetry(f.child("symmetry")) if "symmetry" in f.data else Symmetry(),
+        collision=_parse_collision(f.child("collision", optional=False)),
+        mass=f.number("mass", lo=0.0, above=True),
+        center_of_mass=f.vector3("center_of_mass", (0.0, 0.0, dimensions[2] / 2)),
+        dimensions=dimensions,
+        symmetry=_parse_symmetry(f.child("symmetry")) if f.has("symmetry") else Symmetry(),
         markers=_parse_markers(f),
-        color=f.vector("color", 4, [0.7, 0.7, 0.7, 1.0]),  # type: ignore[arg-type]
-        friction=f.number("friction", 0.6),
+        color=f.vector4("color", (0.7, 0.7, 0.7, 1.0)),
+        friction=f.number("friction", 0.6, lo=0.0, above=True),
         description=f.text("description", ""),
-        extra={k: v for k, v in f.data.items() if k not in _KNOWN_FIELDS},
+        extra={k: v for k, v in f.as_object().items() if k not in _KNOWN_FIELDS},
     )
+
+
+def parse_model(data: Any, directory: Path, file: Path | str) -> ObjectModelSpec:
+    """Check and convert the content of a ``model.json``.
+
+    Raises:
+        ObjectLibraryError: a field is off; the message names ``file`` and the JSON path.
+    """
+    try:
+        return _parse_model(JsonReader(data, file), directory)
+    except JsonFileError as exc:
+        raise ObjectLibraryError(str(exc)) from exc
 
 
 class ObjectLibrary:
@@ -299,8 +239,8 @@ class ObjectLibrary:
                     f"{file}: no such model {name!r} (library {self._path} has {self.names()})"
                 )
             try:
-                data = json.loads(file.read_text(encoding="utf-8"))
-            except json.JSONDecodeError as exc:
-                raise ObjectLibraryError(f"{file}: line {exc.lineno}: not JSON: {exc.msg}") from exc
+                data = read_json_file(file, "object model")
+            except JsonFileError as exc:
+                raise ObjectLibraryError(str(exc)) from exc
             self._models[name] = parse_model(data, directory, file)
         return self._models[name]

@@ -21,7 +21,9 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
-from engine.types import ParamType, ValueError_, Waypoint, decode_value, encode_value
+from capabilities.errors import CapabilityError
+from engine.json_reader import JsonFileError, JsonReader, read_json_file
+from engine.types import ParamType, Waypoint, encode_value
 
 __all__ = [
     "FORMAT",
@@ -36,7 +38,7 @@ FORMAT_VERSION = 1
 _PLAN_SUFFIXES = (".costar.json", ".json")
 
 
-class WaypointFileError(Exception):
+class WaypointFileError(CapabilityError):
     """A waypoint file cannot be read or written, or an edit is not possible.
 
     Attributes:
@@ -49,6 +51,13 @@ class WaypointFileError(Exception):
         self.path = path
         where = f"{file}: {path}: " if file is not None else ""
         super().__init__(f"{where}{message}")
+
+    @classmethod
+    def wrapping(cls, error: JsonFileError, file: Path | None) -> WaypointFileError:
+        """The error for what the JSON reader refused (it becomes the ``__cause__``)."""
+        line = f"line {error.line} column {error.column}: " if error.line is not None else ""
+        message = f"{line}expected {error.expected}, got {error.got}"
+        return cls(message, file, error.json_path or "$")
 
 
 def waypoints_path_for(plan_path: Path | str) -> Path:
@@ -138,50 +147,34 @@ class WaypointLibrary:
     @classmethod
     def from_json(cls, data: Any, file: Path | None = None) -> WaypointLibrary:
         """Read the mapping of a file; raises WaypointFileError with the JSON path."""
-        if not isinstance(data, dict):
-            raise WaypointFileError("expected a JSON object", file)
-        if data.get("format") != FORMAT:
-            raise WaypointFileError(
-                f"expected {FORMAT!r}, got {data.get('format')!r}", file, "$.format"
-            )
-        version = data.get("format_version")
-        if version != FORMAT_VERSION:
-            raise WaypointFileError(
-                f"format_version {version!r} is not supported (this version reads {FORMAT_VERSION})",
-                file,
-                "$.format_version",
-            )
-        items = data.get("waypoints")
-        if not isinstance(items, list):
-            raise WaypointFileError("expected a list of waypoints", file, "$.waypoints")
+        try:
+            return cls._read(JsonReader(data, "<waypoints>" if file is None else file))
+        except JsonFileError as exc:
+            raise WaypointFileError.wrapping(exc, file) from exc
+
+    @classmethod
+    def _read(cls, r: JsonReader) -> WaypointLibrary:
+        r.as_object(("format", "format_version", "waypoints"), ("format",))
+        r.choice("format", (FORMAT,))
+        r.check_version((FORMAT_VERSION,))
         library = cls()
-        for index, item in enumerate(items):
-            path = f"$.waypoints[{index}]"
-            try:
-                waypoint = decode_value(ParamType.WAYPOINT, item, path)
-            except ValueError_ as exc:
-                raise WaypointFileError(f"expected {exc.expected}", file, exc.path) from exc
+        for item in r.items("waypoints", "waypoints", optional=False):
+            waypoint = item.as_typed(ParamType.WAYPOINT)
             if waypoint.name in library:
-                raise WaypointFileError(
-                    f"a second waypoint {waypoint.name!r}", file, f"{path}.name"
+                item.fail(
+                    "a name no other waypoint has", f"a second waypoint {waypoint.name!r}", "name"
                 )
             library.add(waypoint)
         return library
 
     @classmethod
     def load(cls, file: Path | str) -> WaypointLibrary:
-        """Read a waypoint file."""
+        """Read a waypoint file; raises WaypointFileError naming the file and JSON path."""
         file = Path(file)
         try:
-            text = file.read_text(encoding="utf-8")
-        except OSError as exc:
-            raise WaypointFileError(f"cannot read: {exc.strerror or exc}", file) from exc
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise WaypointFileError(
-                f"not JSON (line {exc.lineno}, column {exc.colno}: {exc.msg})", file
-            ) from exc
+            data = read_json_file(file, "waypoint")
+        except JsonFileError as exc:
+            raise WaypointFileError.wrapping(exc, file) from exc
         return cls.from_json(data, file)
 
     def save(self, file: Path | str) -> None:

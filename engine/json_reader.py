@@ -441,7 +441,9 @@ class JsonReader:
         optional: bool = True,
     ) -> JsonReader:
         """A reader of the object in field ``key`` (an empty object when absent and ``optional``)."""
-        if optional and not self.has(key):
+        if not self.has(key):
+            if not optional:
+                self.fail("an object here (it is required)", "nothing", key)
             self.as_object()
             return JsonReader({}, self.file, at(self.path, key), self.error)
         reader = self.at(key)
@@ -450,7 +452,9 @@ class JsonReader:
 
     def items(self, key: str, what: str = "values", optional: bool = True) -> list[JsonReader]:
         """Readers of the items of the list in field ``key`` (none when absent and ``optional``)."""
-        if optional and not self.has(key):
+        if not self.has(key):
+            if not optional:
+                self.fail(f"a list of {what} here (it is required)", "nothing", key)
             self.as_object()
             return []
         reader = self.at(key)

@@ -7,22 +7,37 @@ the table top is at ``table_top_z``.
 
 from __future__ import annotations
 
-import json
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from capabilities.sim.cameras import SHOULDER_EYE, SHOULDER_TARGET, WRIST_MOUNT, look_at
 from capabilities.sim.errors import SimError
-from engine.types import ParamType, Pose, ValueError_, decode_value
+from engine.json_reader import JsonFileError, JsonReader, read_json_file
+from engine.types import ParamType, Pose
 
-__all__ = ["CameraSettings", "CellConfig", "TableConfig", "DEFAULT_CONFIG_PATH", "FORMAT_VERSION"]
+__all__ = [
+    "CameraSettings",
+    "CellConfig",
+    "CellConfigError",
+    "TableConfig",
+    "DEFAULT_CONFIG_PATH",
+    "FORMAT_VERSION",
+]
 
 FORMAT_VERSION = 1
 DEFAULT_CONFIG_PATH = (
     Path(__file__).resolve().parents[2] / "resources" / "cells" / "sim_default.json"
 )
+
+
+class CellConfigError(SimError):
+    """A cell configuration file is missing or off; the message names the file and JSON path.
+
+    It wraps the reader's :class:`engine.json_reader.JsonFileError` (its ``__cause__``).
+    """
+
+
 _DOWN = (1.0, 0.0, 0.0, 0.0)  # tool z axis pointing down: 180 degrees about world x
 _BASE = Pose((0.0, 0.0, 0.0), (0.0, 0.0, 1.0, 0.0))
 _HOLSTER = Pose((0.35, -0.45, 0.0))
@@ -107,51 +122,25 @@ class CellConfig:
         """Read a cell configuration file.
 
         Raises:
-            SimError: the file is missing, not JSON, or a field is off (names the JSON path).
+            CellConfigError: the file is missing, not JSON, or a field is off; the message
+                names the file as given and the JSON path.
         """
-        path = Path(path)
         try:
-            data = json.loads(path.read_text(encoding="utf-8"))
-            return cls.from_json(data)
-        except OSError as exc:
-            raise SimError(f"{path}: cannot read cell config: {exc}") from exc
-        except json.JSONDecodeError as exc:
-            raise SimError(f"{path}: not valid JSON: {exc}") from exc
-        except (ValueError_, ValueError, TypeError) as exc:
-            raise SimError(f"{path}: {exc}") from exc
+            return _config(JsonReader(read_json_file(path, "cell configuration"), path))
+        except JsonFileError as exc:
+            raise CellConfigError(str(exc)) from exc
 
     @classmethod
-    def from_json(cls, data: Any) -> CellConfig:
-        """Build from the JSON form; raises ValueError_ naming the path of a bad field."""
-        if not isinstance(data, dict):
-            raise ValueError_("$", "an object", data)
-        if data.get("format_version") != FORMAT_VERSION:
-            raise ValueError_("$.format_version", str(FORMAT_VERSION), data.get("format_version"))
-        default = cls()
-        offsets = data.get("tcp_offsets", {})
-        if not isinstance(offsets, dict):
-            raise ValueError_("$.tcp_offsets", "an object of poses", offsets)
-        table = data.get("table", {})
-        return cls(
-            robot_base=_pose(data, "robot_base", default.robot_base),
-            home_joints=_numbers(data, "home_joints", default.home_joints, 6),
-            tcp_offsets={
-                **default.tcp_offsets,
-                **{
-                    k: decode_value(ParamType.POSE, v, f"$.tcp_offsets.{k}")
-                    for k, v in offsets.items()
-                },
-            },
-            holster_pose=_pose(data, "holster_pose", default.holster_pose),
-            handle_grasp=_pose(data, "handle_grasp", default.handle_grasp),
-            table=TableConfig(
-                size=_numbers(table, "size", default.table.size, 3, "$.table"),  # type: ignore[arg-type]
-                center=_numbers(table, "center", default.table.center, 2, "$.table"),  # type: ignore[arg-type]
-                top_z=_numbers(table, "top_z", (default.table.top_z,), 1, "$.table")[0],
-            ),
-            stand_size=_numbers(data, "stand_size", default.stand_size, 2),  # type: ignore[arg-type]
-            cameras=_cameras(data.get("cameras"), default.cameras),
-        )
+    def from_json(cls, data: Any, source: str = "<cell config>") -> CellConfig:
+        """Build from the JSON form.
+
+        Raises:
+            CellConfigError: a field is off; the message names ``source`` and the JSON path.
+        """
+        try:
+            return _config(JsonReader(data, source))
+        except JsonFileError as exc:
+            raise CellConfigError(str(exc)) from exc
 
     def to_json(self) -> dict[str, Any]:
         """The JSON form (what ``from_json`` reads)."""
@@ -186,58 +175,56 @@ class CellConfig:
         }
 
 
-def _pose(data: dict[str, Any], key: str, default: Pose) -> Pose:
-    if key not in data:
-        return default
-    return decode_value(ParamType.POSE, data[key], f"$.{key}")  # type: ignore[no-any-return]
+FIELDS = ("format_version", "_comment", "robot_base", "home_joints", "tcp_offsets")
+FIELDS += ("holster_pose", "handle_grasp", "table", "stand_size", "cameras", "capabilities")
+CAMERA_FIELDS = ("pose", "on_wrist", "size", "fov_y_deg", "near", "far")
 
 
-def _numbers(
-    data: Any, key: str, default: tuple[float, ...], n: int, prefix: str = "$"
-) -> tuple[float, ...]:
-    if not isinstance(data, dict):
-        raise ValueError_(prefix, "an object", data)
-    if key not in data:
-        return tuple(default)
-    value = data[key]
-    if n == 1:
-        value = [value]
-    if (
-        not isinstance(value, list)
-        or len(value) != n
-        or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
-        or not all(math.isfinite(v) for v in value)
-    ):
-        raise ValueError_(f"{prefix}.{key}", f"{n} finite number(s)", data[key])
-    return tuple(float(v) for v in value)
+def _config(r: JsonReader) -> CellConfig:
+    r.as_object(FIELDS)
+    r.check_version((FORMAT_VERSION,))
+    default = CellConfig()
+    table = r.child("table", ("size", "center", "top_z"))
+    home = r.vector("home_joints", 6, default.home_joints)
+    offsets = {k: v.as_typed(ParamType.POSE) for k, v in r.entries("tcp_offsets", "poses")}
+    return CellConfig(
+        robot_base=r.pose("robot_base", default.robot_base),
+        home_joints=home,
+        tcp_offsets={**default.tcp_offsets, **offsets},
+        holster_pose=r.pose("holster_pose", default.holster_pose),
+        handle_grasp=r.pose("handle_grasp", default.handle_grasp),
+        table=TableConfig(
+            size=table.vector3("size", default.table.size),
+            center=table.vector2("center", default.table.center),
+            top_z=table.number("top_z", default.table.top_z),
+        ),
+        stand_size=r.vector2("stand_size", default.stand_size),
+        cameras=_cameras(r, default.cameras),
+    )
 
 
-def _cameras(data: Any, default: dict[str, CameraSettings]) -> dict[str, CameraSettings]:
+def _cameras(r: JsonReader, default: dict[str, CameraSettings]) -> dict[str, CameraSettings]:
     """The ``cameras`` block: missing cameras and fields keep their defaults."""
-    if data is None:
-        return dict(default)
-    if not isinstance(data, dict):
-        raise ValueError_("$.cameras", "an object of cameras by name", data)
     cameras = dict(default)
-    for name, entry in data.items():
-        path = f"$.cameras.{name}"
-        if not isinstance(entry, dict):
-            raise ValueError_(path, "an object with pose, on_wrist, size, fov_y_deg", entry)
+    for name, entry in r.entries("cameras", "cameras"):
+        entry.as_object(CAMERA_FIELDS)
         base = cameras.get(name, CameraSettings(Pose()))
-        on_wrist = entry.get("on_wrist", base.on_wrist)
-        if not isinstance(on_wrist, bool):
-            raise ValueError_(f"{path}.on_wrist", "true or false", on_wrist)
-        size = _numbers(entry, "size", base.size, 2, path)
-        if not all(v >= 16 and v == int(v) for v in size):
-            raise ValueError_(f"{path}.size", "two whole numbers of pixels, at least 16", size)
-        fov, near, far = (
-            _numbers(entry, key, (getattr(base, key),), 1, path)[0]
-            for key in ("fov_y_deg", "near", "far")
-        )
-        if not (1.0 <= fov <= 170.0 and 0.0 < near < far):
-            raise ValueError_(path, "a field of view of 1-170 deg and 0 < near < far", entry)
+        width, height = _pixels(entry.at("size")) if entry.has("size") else base.size
+        fov = entry.number("fov_y_deg", base.fov_y_deg, lo=1.0, hi=170.0)
+        near = entry.number("near", base.near, lo=0.0, above=True)
+        far = entry.number("far", base.far, lo=near, above=True)
         cameras[name] = CameraSettings(
-            decode_value(ParamType.POSE, entry["pose"], f"{path}.pose") if "pose" in entry else base.pose,
-            on_wrist, (int(size[0]), int(size[1])), fov, near, far,
-        )  # fmt: skip
+            entry.pose("pose", base.pose),
+            entry.flag("on_wrist", base.on_wrist),
+            (width, height),
+            fov,
+            near,
+            far,
+        )
     return cameras
+
+
+def _pixels(r: JsonReader) -> tuple[int, int]:
+    if len(r.as_list("two whole numbers of pixels")) != 2:
+        r.fail("two whole numbers of pixels")
+    return r.at(0).as_integer(16), r.at(1).as_integer(16)

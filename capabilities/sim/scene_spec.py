@@ -22,13 +22,13 @@ randomisation; ``capabilities.sim.scene.load_scene`` builds it in pybullet. Fiel
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from capabilities.sim.objects import SceneError
+from engine.json_reader import JsonFileError, JsonReader, read_json_file
 
 __all__ = [
     "FORMAT_VERSION",
@@ -47,7 +47,10 @@ FORMAT_VERSION = 1
 
 
 class SceneFileError(SceneError):
-    """A scene file is missing or malformed; the message names the file and JSON path."""
+    """A scene file is missing or malformed; the message names the file and JSON path.
+
+    It wraps the reader's :class:`engine.json_reader.JsonFileError` (its ``__cause__``).
+    """
 
 
 @dataclass(frozen=True)
@@ -128,104 +131,43 @@ class SceneSpec:
     max_tries: int = 200
 
 
-class _Reader:
-    """Typed access to one JSON object; errors name the source and JSON path."""
-
-    def __init__(self, data: Any, source: str, path: str) -> None:
-        self.source, self.path = source, path
-        if not isinstance(data, dict):
-            self.fail("", "an object", data)
-        self.data: dict[str, Any] = data
-
-    def fail(self, key: str, expected: str, got: Any) -> None:
-        where = f"{self.path}.{key}" if key else self.path
-        got_text = repr(got) if len(repr(got)) < 60 else repr(got)[:57] + "..."
-        raise SceneFileError(f"{self.source}: {where}: expected {expected}, got {got_text}")
-
-    def get(self, key: str, default: Any = ...) -> Any:
-        if key not in self.data:
-            if default is ...:
-                self.fail(key, "a value (missing)", None)
-            return default
-        return self.data[key]
-
-    def number(
-        self, key: str, default: Any = ..., lo: float = -math.inf, hi: float = math.inf
-    ) -> float:
-        value = self.get(key, default)
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not lo <= value <= hi:
-            self.fail(key, f"a number in [{lo}, {hi}]", value)
-        return float(value)
-
-    def numbers(self, key: str, n: int, default: Any = ...) -> tuple[float, ...]:
-        value = self.get(key, default)
-        ok = isinstance(value, (list, tuple)) and len(value) == n
-        if not ok or not all(
-            isinstance(v, (int, float)) and not isinstance(v, bool) for v in value
-        ):
-            self.fail(key, f"a list of {n} numbers", value)
-        return tuple(float(v) for v in value)
-
-    def text(self, key: str, default: Any = ...) -> str:
-        value = self.get(key, default)
-        if not isinstance(value, str):
-            self.fail(key, "a text string", value)
-        return str(value)
-
-    def items(self, key: str) -> list[_Reader]:
-        value = self.get(key, [])
-        if not isinstance(value, list):
-            self.fail(key, "a list", value)
-        return [_Reader(v, self.source, f"{self.path}.{key}[{i}]") for i, v in enumerate(value)]
-
-    def child(self, key: str) -> _Reader:
-        return _Reader(self.get(key, {}), self.source, f"{self.path}.{key}")
-
-
-def _table(r: _Reader) -> TableSpec:
+def _table(r: JsonReader) -> TableSpec:
     d = TableSpec()
-    floor = r.get("floor", d.floor)
-    if not isinstance(floor, bool):
-        r.fail("floor", "true or false", floor)
-    size = r.numbers("size", 3, d.size)
+    size = r.vector3("size", d.size)
     if min(size) <= 0:
-        r.fail("size", "three sizes above 0 m", list(size))
+        r.fail("three sizes above 0 m", key="size")
     return TableSpec(
-        center=r.numbers("center", 2, d.center),  # type: ignore[arg-type]
-        size=size,  # type: ignore[arg-type]
+        center=r.vector2("center", d.center),
+        size=size,
         top_z=r.number("top_z", d.top_z),
-        color=r.numbers("color", 4, d.color),  # type: ignore[arg-type]
-        floor=floor,
+        color=r.vector4("color", d.color),
+        floor=r.flag("floor", d.floor),
     )
 
 
-def _marker(r: _Reader) -> MarkerEntry:
-    marker_id = r.get("id")
-    if isinstance(marker_id, bool) or not isinstance(marker_id, int) or not 0 <= marker_id < 50:
-        r.fail("id", "a DICT_4X4_50 marker id (0..49)", marker_id)
+def _marker(r: JsonReader) -> MarkerEntry:
     return MarkerEntry(
         name=r.text("name"),
-        marker_id=marker_id,
+        marker_id=r.integer("id", lo=0, hi=49),
         size=r.number("size", lo=1e-3, hi=1.0),
-        position=r.numbers("position", 2),  # type: ignore[arg-type]
+        position=r.vector2("position"),
         yaw=r.number("yaw", 0.0),
     )
 
 
-def _object(r: _Reader, fixed: bool) -> ObjectEntry:
-    rnd = r.child("random")
+def _object(r: JsonReader, fixed: bool) -> ObjectEntry:
     ranges: dict[str, tuple[float, float]] = {}
-    for key in rnd.data:
+    for key, span in r.entries("random", "ranges"):
         if key not in ("x", "y", "yaw"):
-            rnd.fail(key, "one of x, y, yaw", key)
-        lo, hi = rnd.numbers(key, 2)
+            span.fail("one of x, y, yaw", repr(key))
+        lo, hi = span.as_vector(2)
         if lo > hi:
-            rnd.fail(key, "a range [lo, hi] with lo <= hi", [lo, hi])
+            span.fail("a range [lo, hi] with lo <= hi")
         ranges[key] = (lo, hi)
     return ObjectEntry(
         name=r.text("name"),
         model=r.text("model"),
-        position=r.numbers("position", 2),  # type: ignore[arg-type]
+        position=r.vector2("position"),
         yaw=r.number("yaw", 0.0),
         random=ranges,
         present_probability=r.number("present_probability", 1.0, lo=0.0, hi=1.0),
@@ -233,68 +175,71 @@ def _object(r: _Reader, fixed: bool) -> ObjectEntry:
     )
 
 
-def _keep_out(r: _Reader) -> KeepOut:
-    x, y = r.numbers("position", 2)
-    return KeepOut(r.text("name"), (x, y), r.number("radius", lo=0.0), r.text("note", ""))
+def _keep_out(r: JsonReader) -> KeepOut:
+    return KeepOut(
+        r.text("name"), r.vector2("position"), r.number("radius", lo=0.0), r.text("note", "")
+    )
 
 
-def _reach(r: _Reader) -> ReachSpec:
+def _reach(r: JsonReader) -> ReachSpec:
     d = ReachSpec()
     return ReachSpec(
-        center=r.numbers("center", 2, d.center),  # type: ignore[arg-type]
+        center=r.vector2("center", d.center),
         min_radius=r.number("min_radius", d.min_radius, lo=0.0),
         max_radius=r.number("max_radius", d.max_radius, lo=0.0),
         max_angle=r.number("max_angle", d.max_angle, lo=0.0, hi=math.pi),
     )
 
 
-def parse_scene(data: Any, source: str = "<scene>") -> SceneSpec:
-    """Check and convert the JSON content of a scene file; raise SceneFileError."""
-    r = _Reader(data, source, "$")
-    if r.get("format_version") != FORMAT_VERSION:
-        r.fail("format_version", str(FORMAT_VERSION), r.get("format_version"))
+def _scene(r: JsonReader) -> SceneSpec:
+    r.check_version((FORMAT_VERSION,))
     placement = r.child("placement")
-    max_tries = placement.get("max_tries", 200)
-    if isinstance(max_tries, bool) or not isinstance(max_tries, int) or max_tries < 1:
-        placement.fail("max_tries", "a whole number of 1 or more", max_tries)
-    objects = tuple(_object(o, False) for o in r.items("objects"))
-    objects += tuple(_object(o, True) for o in r.items("fixtures"))
+    objects = tuple(_object(o, False) for o in r.items("objects", "objects"))
+    objects += tuple(_object(o, True) for o in r.items("fixtures", "fixtures"))
     seen: set[str] = set()
     for entry in objects:
         if entry.name in seen or entry.name == "table":
-            r.fail(
-                "objects",
-                f"unique object names other than 'table' ({entry.name!r} repeats)",
-                entry.name,
-            )
+            r.fail("unique object names other than 'table'", f"{entry.name!r} again", "objects")
         seen.add(entry.name)
     return SceneSpec(
         name=r.text("name"),
-        source=source,
+        source=r.file,
         description=r.text("description", ""),
         table=_table(r.child("table")),
-        markers=tuple(_marker(m) for m in r.items("markers")),
-        reserved=tuple(_keep_out(k) for k in r.items("reserved")),
+        markers=tuple(_marker(m) for m in r.items("markers", "markers")),
+        reserved=tuple(_keep_out(k) for k in r.items("reserved", "circles")),
         objects=objects,
         reach=_reach(placement.child("reach")),
         clearance=placement.number("clearance", 0.02, lo=0.0),
-        max_tries=max_tries,
+        max_tries=placement.integer("max_tries", 200, lo=1),
     )
 
 
+def parse_scene(data: Any, source: str = "<scene>") -> SceneSpec:
+    """Check and convert the JSON content of a scene file.
+
+    Raises:
+        SceneFileError: a field is off; the message names ``source`` and the JSON path.
+    """
+    try:
+        return _scene(JsonReader(data, source))
+    except JsonFileError as exc:
+        raise SceneFileError(str(exc)) from exc
+
+
 def read_scene(scene: Path | str | dict[str, Any] | SceneSpec) -> SceneSpec:
-    """A SceneSpec from a path, a parsed JSON dict or a SceneSpec (returned as is)."""
+    """A SceneSpec from a path, a parsed JSON dict or a SceneSpec (returned as is).
+
+    Raises:
+        SceneFileError: the file is missing, not JSON or off; the message names the file as
+            given, the JSON path (or line and column) and what was expected.
+    """
     if isinstance(scene, SceneSpec):
         return scene
     if isinstance(scene, dict):
         return parse_scene(scene, "<scene dict>")
-    path = Path(scene)
     try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise SceneFileError(f"{path}: cannot read the scene file: {exc.strerror}") from exc
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise SceneFileError(f"{path}: line {exc.lineno}: not JSON: {exc.msg}") from exc
-    return parse_scene(data, str(path))
+        data = read_json_file(scene, "scene")
+    except JsonFileError as exc:
+        raise SceneFileError(str(exc)) from exc
+    return parse_scene(data, str(scene))

@@ -26,7 +26,6 @@ did, with those times, for tests and scores: :meth:`SimWorker.events`.
 
 from __future__ import annotations
 
-import json
 import math
 import threading
 from dataclasses import dataclass
@@ -37,7 +36,8 @@ import numpy as np
 
 from capabilities.sim.objects import object_frame_pose, set_object_frame_pose
 from capabilities.sim.scene import SceneState, yaw_pose
-from capabilities.sim.scene_spec import SceneFileError, _Reader
+from capabilities.sim.scene_spec import SceneFileError
+from engine.json_reader import JsonFileError, JsonReader, read_json_file
 from engine.types import Pose
 
 __all__ = [
@@ -110,53 +110,55 @@ class WorkerEvent:
     note: str = ""
 
 
-def _range(r: _Reader, key: str, lo: float = 0.0, default: Any = ...) -> Range:
-    a, b = r.numbers(key, 2, default)
+def _range(r: JsonReader, key: str, lo: float = 0.0, default: Range | None = None) -> Range:
+    a, b = r.vector2(key, default)
     if not lo <= a <= b:
-        r.fail(key, f"a range [lo, hi] with {lo:g} <= lo <= hi", [a, b])
+        r.fail(f"a range [lo, hi] with {lo:g} <= lo <= hi", key=key)
     return a, b
 
 
-def _handoff(r: _Reader) -> HandoffSpec:
+def _handoff(r: JsonReader) -> HandoffSpec:
     area = r.child("area")
     ranges = {}
     for key in ("x", "y", "yaw"):
-        ranges[key] = _range(area, key, -math.inf, (0.0, 0.0) if key == "yaw" else ...)
-    cycles = r.get("cycles", 1)
-    if isinstance(cycles, bool) or not isinstance(cycles, int) or cycles < 1:
-        r.fail("cycles", "a whole number of 1 or more", cycles)
+        ranges[key] = _range(area, key, -math.inf, (0.0, 0.0) if key == "yaw" else None)
     return HandoffSpec(
         object=r.text("object"), model=r.text("model"), area=ranges,
-        place_at=_range(r, "place_at"), hold=_range(r, "hold"), cycles=cycles,
+        place_at=_range(r, "place_at"), hold=_range(r, "hold"),
+        cycles=r.integer("cycles", 1, lo=1),
         gap=_range(r, "gap", default=(2.0, 4.0)),
         drop_height=r.number("drop_height", 0.01, lo=0.0, hi=0.5),
     )  # fmt: skip
 
 
-def _nudge(r: _Reader) -> NudgeSpec:
+def _nudge(r: JsonReader) -> NudgeSpec:
     return NudgeSpec(r.text("object"), _range(r, "at"), _range(r, "shift"))
 
 
 def parse_worker(data: Any, source: str = "<scene>") -> WorkerSpec | None:
-    """The ``worker`` block of a parsed scene file, or None if it has none."""
+    """The ``worker`` block of a parsed scene file, or None if it has none.
+
+    Raises:
+        SceneFileError: the block is off; the message names ``source`` and the JSON path.
+    """
     if not isinstance(data, dict) or "worker" not in data:
         return None
-    block = _Reader(data["worker"], source, "$.worker")
-    for key in block.data:
-        if key not in ("handoffs", "nudges"):
-            block.fail(key, "one of handoffs, nudges", key)
-    return WorkerSpec(
-        tuple(_handoff(h) for h in block.items("handoffs")),
-        tuple(_nudge(n) for n in block.items("nudges")),
-    )
+    try:
+        block = JsonReader(data, source).child("worker", ("handoffs", "nudges"), optional=False)
+        return WorkerSpec(
+            tuple(_handoff(h) for h in block.items("handoffs", "handoffs")),
+            tuple(_nudge(n) for n in block.items("nudges", "nudges")),
+        )
+    except JsonFileError as exc:
+        raise SceneFileError(str(exc)) from exc
 
 
 def read_worker(path: Path | str) -> WorkerSpec | None:
     """The worker block of a scene file (None if it has none); raises SceneFileError."""
     try:
-        data = json.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, json.JSONDecodeError) as exc:
-        raise SceneFileError(f"{path}: cannot read the worker block: {exc}") from exc
+        data = read_json_file(path, "scene")
+    except JsonFileError as exc:
+        raise SceneFileError(str(exc)) from exc
     return parse_worker(data, str(path))
 
 

@@ -78,10 +78,10 @@ def _write(tmp_path: Path, data: object) -> Path:
 @pytest.mark.parametrize(
     ("data", "path", "words"),
     [
-        ("{not json", "$", "not JSON (line 1"),
-        ([], "$", "expected a JSON object"),
+        ("{not json", "$", "line 1 column 2: expected valid JSON"),
+        ([], "$", "expected an object with format"),
         ({"format": "other", "format_version": 1, "waypoints": []}, "$.format", "costar-waypoints"),
-        ({"format": FORMAT, "format_version": 2, "waypoints": []}, "$.format_version", "not supported"),
+        ({"format": FORMAT, "format_version": 2, "waypoints": []}, "$.format_version", "written by a newer version"),
         ({"format": FORMAT, "format_version": 1}, "$.waypoints", "a list of waypoints"),
         (
             {"format": FORMAT, "format_version": 1, "waypoints": [
@@ -116,7 +116,7 @@ def test_errors_name_the_file_and_json_path(
 
 
 def test_missing_file_and_unwritable_folder(tmp_path: Path) -> None:
-    with pytest.raises(WaypointFileError, match="cannot read"):
+    with pytest.raises(WaypointFileError, match="expected a waypoint file, got no file at"):
         WaypointLibrary.load(tmp_path / "nothing.json")
     with pytest.raises(WaypointFileError, match="cannot write"):
         _library().save(tmp_path / "no_such_folder" / "x.waypoints.json")

@@ -39,11 +39,13 @@ def test_a_bad_camera_entry_names_its_json_path() -> None:
     import pytest
 
     from capabilities.sim.config import CellConfig
-    from engine.types import ValueError_
+    from capabilities.sim.config import CellConfigError
 
     data = CellConfig().to_json()
     data["cameras"]["shoulder"]["size"] = [640, "tall"]
-    with pytest.raises(ValueError_, match=r"\$\.cameras\.shoulder\.size"):
+    with pytest.raises(
+        CellConfigError, match=r"\$\.cameras\.shoulder\.size\[1\]: expected a whole"
+    ):
         CellConfig.from_json(data)
 
 
