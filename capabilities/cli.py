@@ -35,10 +35,10 @@ __all__ = ["main"]
 EXIT_SUCCESS, EXIT_FAILURE, EXIT_INVALID, EXIT_STOPPED = 0, 1, 2, 3
 
 
-def _print_problems(problems: Sequence[Problem], out: TextIO) -> None:
+def _print_problems(file: str, problems: Sequence[Problem], out: TextIO) -> None:
     for problem in problems:
         where = problem.path + (f" [{problem.field}]" if problem.field else "")
-        print(f"{problem.severity}: {where}: {problem.message}", file=out)
+        print(f"{file}: {problem.severity}: {where}: {problem.message}", file=out)
 
 
 def _load(path: str, registry: CapabilityRegistry, err: TextIO) -> PlanSpec | None:
@@ -68,12 +68,10 @@ def _cmd_validate(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         if plan is None:
             return EXIT_INVALID
         problems = validate_plan(plan, registry)
-    _print_problems(problems, out)
+    _print_problems(args.plan, problems, out)
     if has_errors(problems):
-        print(
-            f"{args.plan}: invalid ({sum(p.severity == 'error' for p in problems)} errors)",
-            file=out,
-        )
+        count = sum(p.severity == "error" for p in problems)
+        print(f"{args.plan}: invalid ({count} error{'' if count == 1 else 's'})", file=out)
         if args.cell == "none" and any("cannot run on this cell" in p.message for p in problems):
             print("hint: some operations need a robot cell; try --cell sim", file=out)
         return EXIT_INVALID
@@ -130,7 +128,7 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             return EXIT_INVALID
         problems = validate_plan(plan, registry)
         if has_errors(problems):
-            _print_problems(problems, err)
+            _print_problems(args.plan, problems, err)
             print(f"{args.plan}: invalid, not started", file=err)
             return EXIT_INVALID
         try:

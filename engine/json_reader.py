@@ -83,8 +83,15 @@ class JsonFileError(EngineError):
         if line is not None:
             where.append(f"line {line} column {column}")
         if json_path:
-            where.append(json_path)
+            where.append(_short(json_path))
         super().__init__(f"{': '.join(where)}: expected {expected}, got {got}")
+
+
+def _short(path: str) -> str:
+    """A JSON path short enough for a message (a path 800 levels deep is not read by anyone)."""
+    if len(path) <= 200:
+        return path
+    return f"{path[:120]}...{path[-60:]}"
 
 
 ErrorClass = Callable[..., JsonFileError]
@@ -392,12 +399,8 @@ class JsonReader:
     def as_vector(self, n: int) -> tuple[float, ...]:
         """This value as a list of ``n`` numbers."""
         value = self.value
-        if (
-            not isinstance(value, list)
-            or len(value) != n
-            or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
-        ):
-            self.fail(f"a list of {n} numbers")
+        if not isinstance(value, list) or len(value) != n or not all(_finite(v) for v in value):
+            self.fail(f"a list of {n} finite numbers")
         return tuple(float(v) for v in value)
 
     def as_typed(self, ptype: ParamType) -> Any:
@@ -570,6 +573,10 @@ class JsonReader:
         if isinstance(value, bool) or value not in versions:
             self.fail(f"one of the format versions {readable}", describe(value), key)
         return int(value)
+
+
+def _finite(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
 
 
 def _range_text(what: str, lo: float, hi: float, above: bool) -> str:

@@ -22,6 +22,7 @@ from engine.events import (
     RunFinished,
     StatusChanged,
 )
+from engine.json_reader import JsonFileError, parse_json
 from engine.spec import PlanSpec
 from engine.status import Status
 from engine.types import encode_value
@@ -102,9 +103,14 @@ class TraceRecorder:
         self._write(header)
 
     def _write(self, record: dict[str, Any]) -> None:
+        try:
+            line = json.dumps(record, separators=(",", ":"))
+        except (TypeError, ValueError, RecursionError) as exc:  # never drop an event silently
+            kept = {k: v for k, v in record.items() if k != "value"}
+            line = json.dumps(kept | {"value": f"<not written: {exc}>"}, separators=(",", ":"))
         with self._lock:
             if self._file is not None:
-                self._file.write(json.dumps(record, separators=(",", ":")) + "\n")
+                self._file.write(line + "\n")
 
     def __call__(self, event: Event) -> None:
         self._write(_event_record(event))
@@ -144,17 +150,21 @@ def read_trace(path: str | os.PathLike[str]) -> Trace:
     """Load a trace; raises TraceError naming the file and line of anything wrong."""
     path = Path(path)
     try:
-        lines = path.read_text(encoding="utf-8").splitlines()
+        lines = path.read_bytes().decode("utf-8").splitlines()
     except OSError as exc:
         raise TraceError(f"{path}: cannot read: {exc.strerror or exc}") from exc
+    except UnicodeDecodeError as exc:
+        raise TraceError(
+            f"{path}: not a trace file: a byte that is not UTF-8 at offset {exc.start}"
+        ) from exc
     records: list[tuple[int, dict[str, Any]]] = []  # (line number in the file, record)
     for number, line in enumerate(lines, start=1):
         if not line.strip():
             continue
         try:
-            record = json.loads(line)
-        except json.JSONDecodeError as exc:
-            raise TraceError(f"{path}:{number}: not JSON ({exc.msg})") from exc
+            record = parse_json(line, f"{path}:{number}", "trace")
+        except JsonFileError as exc:
+            raise TraceError(str(exc)) from exc
         if not isinstance(record, dict):
             raise TraceError(f"{path}:{number}: expected a JSON object")
         records.append((number, record))

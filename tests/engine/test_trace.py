@@ -95,7 +95,8 @@ def write(tmp_path: Path, text: str) -> Path:
 @pytest.mark.parametrize(
     ("text", "where", "what"),
     [
-        (HEADER + "\n\n{not json\n", ":3:", "not JSON"),
+        (HEADER + "\n\n{not json\n", ":3:", "expected valid JSON"),
+        (HEADER + '\n{"event":"log","tick":NaN}\n', ":2:", "$.tick: expected a finite number"),
         (HEADER + "\n[1, 2]\n", ":2:", "expected a JSON object"),
         (HEADER + '\n\n{"event":"log"}\n{"tick":1}\n', ":4:", "expected an 'event' field"),
         ('{"format":"something else"}\n', ":1:", "expected a header with format 'costar-trace'"),
