@@ -138,7 +138,7 @@ def measure_ngqt_create(count: int = 1000) -> float:
     """Seconds for NodeGraphQt's plain ``create_node`` (defaults) ``count`` times."""
     from NodeGraphQt import BaseNode, NodeGraph
 
-    class PeerNode(BaseNode):  # type: ignore[misc]
+    class PeerNode(BaseNode):
         __identifier__ = "bench.peer"
         NODE_NAME = "node"
 

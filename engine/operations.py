@@ -14,6 +14,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+from engine.errors import EngineError
 from engine.status import FAILURE, RUNNING, SUCCESS, Status
 from engine.types import ParamType
 
@@ -235,7 +236,7 @@ class Operation(Protocol):
 OperationFactory = Callable[[], Operation]
 
 
-class OperationNotFound(LookupError):
+class OperationNotFound(EngineError, LookupError):
     """No operation of that id (or alias) is registered."""
 
 
@@ -269,5 +270,5 @@ class OperationSource(Protocol):
         ...
 
 
-class OperationFailed(Exception):
+class OperationFailed(EngineError):
     """Raised by an operation to fail its node with exactly this message."""

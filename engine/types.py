@@ -98,6 +98,19 @@ class Pose:
         if len(self.position) != 3:
             raise ValueError(f"position must have 3 values, got {self.position}")
 
+    @classmethod
+    def of(
+        cls, position: Sequence[float], orientation: Sequence[float] = (0.0, 0.0, 0.0, 1.0)
+    ) -> Pose:
+        """A pose from any sequences of numbers (a list, a numpy array); lengths are checked."""
+        if len(position) != 3 or len(orientation) != 4:
+            raise ValueError(
+                f"a pose needs 3 + 4 numbers, got {len(position)} + {len(orientation)}"
+            )
+        x, y, z = (float(v) for v in position)
+        qx, qy, qz, qw = (float(v) for v in orientation)
+        return cls((x, y, z), (qx, qy, qz, qw))
+
     def compose(self, other: Pose) -> Pose:
         """This transform followed by ``other`` (``self * other``)."""
         rotated = _rotate(self.orientation, other.position)

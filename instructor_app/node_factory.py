@@ -14,6 +14,7 @@ from typing import Any
 from engine.kinds import KIND_CONFIG, KIND_DOC
 from engine.operations import OperationKind, OperationManifest, OperationNotFound, OperationSource
 from engine.spec import KIND_CATEGORY, Category, NodeKind, NodeSpec
+from instructor_app.errors import InstructorError
 
 __all__ = [
     "PALETTE_MIME",
@@ -42,7 +43,7 @@ LOGIC_GROUPS: dict[Category, str] = {
 _SETTING_DEFAULTS: dict[str, Any] = {"count": 2, "seconds": 5.0, "wait_seconds": 1.0}
 
 
-class NodeFactoryError(Exception):
+class NodeFactoryError(InstructorError):
     """A palette item or dropped payload that names no known kind or operation."""
 
 

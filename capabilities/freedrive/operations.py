@@ -102,7 +102,7 @@ def build_freedrive_capability() -> Capability:
     )
 
     def backend(env: CapabilityEnv) -> FreedriveBackend:
-        return env.interface(FREEDRIVE)  # type: ignore[no-any-return]
+        return env.interface(FREEDRIVE)
 
     cap.add(START, lambda env: SetFreedrive(backend(env), True))
     cap.add(STOP, lambda env: SetFreedrive(backend(env), False))

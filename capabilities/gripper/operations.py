@@ -73,7 +73,7 @@ def build_gripper_capability() -> Capability:
     cap = Capability(CAP, "Opens and closes the parallel gripper.", requires=(GRIPPER,))
 
     def gripper(env: CapabilityEnv) -> GripperBackend:
-        return env.interface(GRIPPER)  # type: ignore[no-any-return]
+        return env.interface(GRIPPER)
 
     cap.add(OPEN, lambda env: Open(gripper(env)))
     cap.add(CLOSE, lambda env: Close(gripper(env)))

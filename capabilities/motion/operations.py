@@ -189,7 +189,7 @@ class IsHome:
 
 def _world(env: CapabilityEnv) -> WorldBackend | None:
     try:
-        return env.interface(WORLD)  # type: ignore[no-any-return]
+        return env.interface(WORLD)
     except CapabilityError:
         return None  # relative waypoints then need their reference bound
 
@@ -203,7 +203,7 @@ def build_motion_capability(symmetries: SymmetryTable | None = None) -> Capabili
     m = mf.MANIFESTS
 
     def arm(env: CapabilityEnv) -> ArmBackend:
-        return env.interface(ARM)  # type: ignore[no-any-return]
+        return env.interface(ARM)
 
     cap.add(m["move_to"], lambda env: MoveTo(arm(env), TargetResolver(_world(env), table)))
     cap.add(m["move_joints"], lambda env: MoveJoints(arm(env)))

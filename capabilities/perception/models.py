@@ -60,16 +60,16 @@ class ModelCloud:
 def fpfh(cloud: Any, voxel: float) -> Any:
     """FPFH features of a cloud that has normals (radius five voxels)."""
     search = o3d.geometry.KDTreeSearchParamHybrid(radius=5 * voxel, max_nn=100)
-    return o3d.pipelines.registration.compute_fpfh_feature(cloud, search)  # type: ignore[call-arg]
+    return o3d.pipelines.registration.compute_fpfh_feature(cloud, search)  # type: ignore[call-arg]  # open3d stubs list only keyword arguments
 
 
 def _tensor(array: np.ndarray) -> Any:
     """An Open3D tensor sharing a C-contiguous float64 copy of ``array``."""
-    return o3d.core.Tensor(np.ascontiguousarray(array, dtype=np.float64))  # type: ignore[call-overload]
+    return o3d.core.Tensor(np.ascontiguousarray(array, dtype=np.float64))  # type: ignore[call-overload]  # open3d stubs lack the ndarray overload
 
 
 def _load(spec: ObjectModelSpec, voxel: float) -> ModelCloud:
-    mesh = o3d.io.read_triangle_mesh(str(spec.mesh_file))  # type: ignore[arg-type]
+    mesh = o3d.io.read_triangle_mesh(str(spec.mesh_file))  # type: ignore[arg-type]  # open3d stubs want os.PathLike; str works
     if len(mesh.triangles) == 0:
         raise PerceptionError(f"{spec.mesh_file}: no triangles to sample")
     mesh.compute_triangle_normals()

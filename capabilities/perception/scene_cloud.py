@@ -63,7 +63,7 @@ class Cluster:
 
     @property
     def center(self) -> np.ndarray:
-        return self.points.mean(axis=0)  # type: ignore[no-any-return]
+        return self.points.mean(axis=0)
 
 
 @dataclass
@@ -89,7 +89,7 @@ class SceneCloud:
 
     @property
     def camera_in_table(self) -> np.ndarray:
-        return np.linalg.inv(self.T_camera_table)[:3, 3]  # type: ignore[no-any-return]
+        return np.linalg.inv(self.T_camera_table)[:3, 3]
 
 
 def _world_grid(frame: FrameLike) -> np.ndarray:
@@ -102,7 +102,7 @@ def _world_grid(frame: FrameLike) -> np.ndarray:
     v = (np.arange(h) - k[1, 2]) / k[1, 1]
     cam = np.stack((u[None, :] * z, v[:, None] * z, z), axis=-1)
     t = pose_to_matrix(frame.T_world_camera)
-    return cam @ t[:3, :3].T + t[:3, 3]  # type: ignore[no-any-return]
+    return cam @ t[:3, :3].T + t[:3, 3]
 
 
 def _fit_table(points: np.ndarray, config: RecognitionConfig) -> np.ndarray:

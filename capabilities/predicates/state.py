@@ -64,7 +64,7 @@ class PredicatesState:
         found = self.world.best(name)
         if found is None:
             raise PredicateError(f"{name} has not been seen")
-        return found  # type: ignore[no-any-return]
+        return found
 
     def height(self, name: str) -> float:
         """Bounding-box height of a model (0 for a model the library does not know)."""
@@ -85,7 +85,7 @@ class PredicatesState:
     def tool_pose(self) -> Pose:
         if self.arm is None:
             raise PredicateError("the cell has no arm: the tool's pose is unknown")
-        return self.arm.tcp_pose()  # type: ignore[no-any-return]
+        return self.arm.tcp_pose()
 
     def collision(self) -> CollisionWorld:
         with self._lock:

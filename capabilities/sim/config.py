@@ -175,7 +175,7 @@ class CellConfig:
         }
 
 
-FIELDS = ("format_version", "_comment", "robot_base", "home_joints", "tcp_offsets")
+FIELDS: tuple[str, ...] = ("format_version", "_comment", "robot_base", "home_joints", "tcp_offsets")
 FIELDS += ("holster_pose", "handle_grasp", "table", "stand_size", "cameras", "capabilities")
 CAMERA_FIELDS = ("pose", "on_wrist", "size", "fov_y_deg", "near", "far")
 

@@ -26,7 +26,7 @@ _ATTACH_FORCE = 400.0  # N: holds a few kg through fast moves
 
 
 def _matrix(position: tuple[float, ...], orientation: tuple[float, ...]) -> np.ndarray:
-    return pose_to_matrix(Pose(position, orientation))  # type: ignore[arg-type]
+    return pose_to_matrix(Pose.of(position, orientation))
 
 
 def body_frame_matrix(client: int, body: int) -> np.ndarray:

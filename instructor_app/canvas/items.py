@@ -105,7 +105,7 @@ def paint_port(painter: QPainter, rect: QRectF, info: dict[str, Any]) -> None:
     painter.restore()
 
 
-class TreePort(CustomPortItem):  # type: ignore[misc]
+class TreePort(CustomPortItem):
     """A port whose change hook costs one comparison unless the port moved (Qt calls it for
     every change of every item: tens of times per node while a plan opens)."""
 
@@ -115,7 +115,7 @@ class TreePort(CustomPortItem):  # type: ignore[misc]
         return value
 
 
-class _TitleEditor(NodeTextItem):  # type: ignore[misc]
+class _TitleEditor(NodeTextItem):
     """NodeGraphQt's title editor, shown only while renaming; it reports the new name
     through ``NodeViewer.node_name_changed`` and then goes away."""
 
@@ -132,7 +132,7 @@ class _TitleEditor(NodeTextItem):  # type: ignore[misc]
             node.update()
 
 
-class TreeNodeItem(NodeItem):  # type: ignore[misc]
+class TreeNodeItem(NodeItem):
     """The QGraphicsItem of one plan node."""
 
     def __init__(self, name: str = "node", parent: QGraphicsItem | None = None) -> None:
@@ -298,12 +298,12 @@ class TreeNodeItem(NodeItem):  # type: ignore[misc]
     def _tooltip_disable(self, state: bool) -> None:
         return
 
-    @AbstractNodeItem.name.setter  # type: ignore[misc]
+    @AbstractNodeItem.name.setter
     def name(self, name: str = "") -> None:
         AbstractNodeItem.name.fset(self, name)
         self.update()
 
-    @AbstractNodeItem.disabled.setter  # type: ignore[misc]
+    @AbstractNodeItem.disabled.setter
     def disabled(self, state: bool = False) -> None:
         AbstractNodeItem.disabled.fset(self, state)
         self.update()
@@ -380,7 +380,7 @@ class TreeNodeItem(NodeItem):  # type: ignore[misc]
             painter.drawText(box, Qt.AlignmentFlag.AlignCenter, f"+{self.hidden_count}")
 
 
-class TreeNode(BaseNode):  # type: ignore[misc]
+class TreeNode(BaseNode):
     """NodeGraphQt node of one plan node; its id is the plan node's id."""
 
     __identifier__ = "costar.canvas"

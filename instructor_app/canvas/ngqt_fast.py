@@ -36,7 +36,7 @@ _TEMP_KEYS = (
 )
 
 
-class TreeGraph(NodeGraph):  # type: ignore[misc]
+class TreeGraph(NodeGraph):
     """A NodeGraph for a top-down tree whose viewer's signals the canvas handles itself."""
 
     def __init__(self, viewer: Any, parent: Any = None) -> None:

@@ -16,7 +16,7 @@ from PySide6.QtGui import QPainterPath
 __all__ = ["TreePipe"]
 
 
-class TreePipe(PipeItem):  # type: ignore[misc]
+class TreePipe(PipeItem):
     """A link between two ports, drawn as vertical - horizontal - vertical lines."""
 
     def __init__(self) -> None:

@@ -222,7 +222,7 @@ class CanvasView(QWidget):
         self.mirror.restore_link(node_id)
         self.mirror.relayout()
 
-    def _on_connection_changed(self, disconnected: list, connected: list) -> None:  # type: ignore[type-arg]
+    def _on_connection_changed(self, disconnected: list, connected: list) -> None:
         touched = {port.node.id for pair in disconnected + connected for port in pair}
         for first, second in connected:
             child, parent = (first, second) if first.name == PARENT_PORT else (second, first)

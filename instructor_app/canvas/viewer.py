@@ -34,7 +34,7 @@ __all__ = ["CanvasViewer", "PALETTE_MIME"]
 PALETTE_MIME = "application/x-costar-palette-item"
 
 
-class CanvasViewer(NodeViewer):  # type: ignore[misc]
+class CanvasViewer(NodeViewer):
     """NodeViewer that accepts palette items and leaves context menus to the canvas.
 
     Signals:
@@ -71,7 +71,7 @@ class CanvasViewer(NodeViewer):  # type: ignore[misc]
             event.ignore()
 
     def dragMoveEvent(self, event: QDragMoveEvent) -> None:
-        self.dragEnterEvent(event)  # type: ignore[arg-type]
+        self.dragEnterEvent(event)  # type: ignore[arg-type]  # a move event is handled like an enter event: only mimeData is read
 
     def dropEvent(self, event: QDropEvent) -> None:
         if not event.mimeData().hasFormat(PALETTE_MIME):

@@ -23,6 +23,7 @@ from pathlib import Path
 from PySide6.QtCore import QObject, QStandardPaths, QTimer, Signal
 
 from instructor_app.document.model import DocumentError, PlanDocument
+from instructor_app.errors import InstructorError
 
 __all__ = [
     "AutosaveError",
@@ -40,7 +41,7 @@ _SIDECAR_SUFFIX = ".recovery.json"
 _FORMAT = "costar-recovery"
 
 
-class AutosaveError(Exception):
+class AutosaveError(InstructorError):
     """A recovery file could not be read or written."""
 
 

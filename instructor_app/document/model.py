@@ -29,6 +29,7 @@ from instructor_app.document.commands import (
     SetParamCommand,
     SetPlanFieldCommand,
 )
+from instructor_app.errors import InstructorError
 
 __all__ = ["DocumentError", "PlanDocument", "SUBTREE_MIME"]
 
@@ -36,7 +37,7 @@ SUBTREE_MIME = "application/x-costar-subtree+json"
 SUBTREE_FORMAT = "costar-subtree"
 
 
-class DocumentError(Exception):
+class DocumentError(InstructorError):
     """An edit or file operation that could not be done; the message says why."""
 
 

@@ -7,6 +7,7 @@ import uuid
 from collections.abc import Iterator
 
 from engine.spec import Category, NodeLayout, NodeSpec, PlanSpec
+from instructor_app.errors import InstructorError
 
 __all__ = [
     "TreeEditError",
@@ -19,7 +20,7 @@ __all__ = [
 ]
 
 
-class TreeEditError(Exception):
+class TreeEditError(InstructorError):
     """An edit that the tree cannot take (a decorator with two children, a loop)."""
 
 

@@ -17,12 +17,13 @@ from PySide6.QtWidgets import QDoubleSpinBox, QHBoxLayout, QWidget
 
 from engine.operations import PortSpec
 from engine.types import ParamType, Waypoint
+from instructor_app.errors import InstructorError
 from instructor_app.inspectors.units import DisplayUnit
 
 __all__ = ["EditorContext", "ParamEditor", "UnitSpinBox", "InspectorError"]
 
 
-class InspectorError(Exception):
+class InspectorError(InstructorError):
     """An editor was asked for something it cannot show."""
 
 

@@ -83,7 +83,7 @@ class PoseEditor(ParamEditor):
 
     def _position_edited(self) -> None:
         position = tuple(_kept(self.position_spins, self._current().position))
-        self._commit(Pose(position, self._current().orientation))  # type: ignore[arg-type]
+        self._commit(Pose.of(position, self._current().orientation))
 
     def _angles_edited(self) -> None:
         stored = quaternion_to_rpy(self._current().orientation)
@@ -114,7 +114,7 @@ class RegionEditor(ParamEditor):
     def _edited(self) -> None:
         current = self._value if isinstance(self._value, Region) else self.DEFAULT
         values = _kept([*self.center_spins, self.radius_spin], (*current.center, current.radius))
-        self._commit(Region(tuple(values[:3]), values[3]))  # type: ignore[arg-type]
+        self._commit(Region((values[0], values[1], values[2]), values[3]))
 
 
 class JointConfigEditor(ParamEditor):

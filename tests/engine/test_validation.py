@@ -329,7 +329,7 @@ def test_settings_of_logic_nodes() -> None:
 def test_unknown_kind_and_duplicate_ids() -> None:
     odd = NodeSpec(NodeKind.WAIT, "dance", config={"seconds": 1})
     # a spec built by hand, not read from a file, can hold any kind
-    odd.kind = "dance"  # type: ignore[assignment]
+    odd.kind = "dance"  # type: ignore[assignment]  # a wrong kind on purpose
     twin = find("twin")
     twin.id = "same"
     other = find("other")

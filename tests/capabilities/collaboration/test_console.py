@@ -40,7 +40,7 @@ def _in_threads(fn: object, count: int) -> None:
 
     def run() -> None:
         barrier.wait()
-        fn()  # type: ignore[operator]
+        fn()  # type: ignore[operator]  # the callers pass functions
 
     threads = [threading.Thread(target=run) for _ in range(count)]
     for thread in threads:

@@ -142,7 +142,7 @@ def test_halting_the_wait_stops_its_camera_thread(tmp_path: Path) -> None:
                 frames.set()
                 return session.cameras["shoulder"].capture()
 
-        job = HandoffJob(CountingCamera(), object_markers(library.get("kit_bin")),  # type: ignore[arg-type]
+        job = HandoffJob(CountingCamera(), object_markers(library.get("kit_bin")),  # type: ignore[arg-type]  # a duck-typed camera
                          HANDOFF_AREA, session.world_model, session.clock,
                          HandoffSettings())  # fmt: skip
         assert frames.wait(DEADLINE)

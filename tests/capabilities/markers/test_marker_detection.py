@@ -108,7 +108,7 @@ def test_world_and_object_poses() -> None:
     obs_pose = Pose((0.1, 0.0, 0.5), UPRIGHT)
     camera = Pose((1.0, 2.0, 0.8), (0.0, 0.7071, 0.0, 0.7071))
     obs = type("Obs", (), {"pose": obs_pose})()
-    world = marker_pose_world(obs, camera)  # type: ignore[arg-type]
+    world = marker_pose_world(obs, camera)  # type: ignore[arg-type]  # a stand-in observation with only a pose
     assert np.allclose(pose_to_matrix(world), pose_to_matrix(camera) @ pose_to_matrix(obs_pose))
     marker_in_object = Pose((0.0, 0.0, 0.03), (0.0, 0.0, 0.3826834, 0.9238795))
     obj = object_pose_from_marker(world, marker_in_object)
@@ -131,7 +131,7 @@ def test_empty_image_gives_no_markers(k: NDArray[np.float64]) -> None:
 )
 def test_bad_image_raises(k: NDArray[np.float64], image: object) -> None:
     with pytest.raises(MarkerError):
-        detect_markers(image, k, 0.05)  # type: ignore[arg-type]
+        detect_markers(image, k, 0.05)  # type: ignore[arg-type]  # a bad image on purpose
 
 
 @pytest.mark.parametrize(
@@ -152,4 +152,4 @@ def test_bad_camera_or_length_raises(
 ) -> None:
     image = np.full((HEIGHT, WIDTH, 3), 128, np.uint8)
     with pytest.raises(MarkerError):
-        detect_markers(image, k if camera is None else camera, lengths, dist)  # type: ignore[arg-type]
+        detect_markers(image, k if camera is None else camera, lengths, dist)  # type: ignore[arg-type]  # bad arguments on purpose

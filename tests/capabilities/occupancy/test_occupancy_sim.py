@@ -43,7 +43,7 @@ def registry(session: SimCellSession) -> CapabilityRegistry:
 
 def _random_rotation(rng: np.random.Generator) -> tuple[float, float, float, float]:
     q = rng.normal(size=4)
-    return tuple(q / np.linalg.norm(q))  # type: ignore[return-value]
+    return tuple(q / np.linalg.norm(q))  # type: ignore[return-value]  # numpy cannot tell the length is 4
 
 
 def _placement(rng: np.random.Generator, centre: tuple[float, float, float]) -> Pose:
@@ -58,7 +58,7 @@ def _placement(rng: np.random.Generator, centre: tuple[float, float, float]) -> 
         offset = rng.uniform(-reach, reach, 3)
         point = np.add(centre, offset)
         if np.linalg.norm(offset) <= reach and point[2] >= HALF_DIAGONAL + 0.002:
-            return Pose(tuple(point), _random_rotation(rng))  # type: ignore[arg-type]
+            return Pose.of(point, _random_rotation(rng))
 
 
 def _occupied_after(registry: CapabilityRegistry, session: SimCellSession, since: float,

@@ -141,7 +141,7 @@ class _ArmWithFlange(_ArmWithFk):
     def flange_pose(self) -> Pose:
         return self._kin.forward(self.joint_positions())
 
-    forward_kinematics = None  # type: ignore[assignment]
+    forward_kinematics = None  # type: ignore[assignment]  # an arm without forward kinematics on purpose
 
 
 def test_robot_base_is_found_from_the_arm_or_settings() -> None:

@@ -155,7 +155,7 @@ def _feed(cell: FakeCell, registry: CapabilityRegistry, name: str, times: np.nda
     """Detections at ``times``, each evaluated once (as a reactive plan would each tick)."""
     for t, xyz in zip(times, positions, strict=True):
         cell.now = float(t)
-        cell.put(name, Pose(tuple(xyz)), stamp=float(t))  # type: ignore[arg-type]
+        cell.put(name, Pose.of(xyz), stamp=float(t))
         check(registry, "predicates.is_moving", object=name)
 
 
@@ -243,7 +243,7 @@ def test_convex_hull_models_collide_by_their_mesh(tmp_path: Path) -> None:
     cell.arm.tcp = Pose((0.5, 0.0, 0.12), DOWN)
     holds, message = check(registry, "predicates.tool_near_collision", object="hull_cup")
     # 20 mm above the rim, fingertips 15 mm lower: 5 mm (pybullet's hull margin takes ~1 mm).
-    gap = float(re.search(r"([-\d.]+) mm apart", message).group(1))  # type: ignore[union-attr]
+    gap = float(re.findall(r"([-\d.]+) mm apart", message)[0])
     assert holds and 3.0 <= gap <= 6.0, message
     cell.arm.tcp = Pose((0.5, 0.0, 0.2), DOWN)
     assert not check(registry, "predicates.tool_near_collision", object="hull_cup")[0]
