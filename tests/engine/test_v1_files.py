@@ -50,3 +50,12 @@ class _InterfacesOnly:
 
     def clock(self) -> float:
         return 0.0
+
+
+@pytest.mark.parametrize("path", V1_PLANS, ids=lambda p: p.relative_to(V1).as_posix())
+def test_v1_file_means_what_the_shipped_v2_file_means(path: Path) -> None:
+    """The reader turns "config" and timing.wait into the ports and Wait node of format 2."""
+    shipped = Path(__file__).resolve().parents[2] / "resources" / "examples" / path.relative_to(V1)
+    assert '"format_version": 1' in path.read_text(encoding="utf-8")
+    assert '"format_version": 2' in shipped.read_text(encoding="utf-8")
+    assert load_plan(path) == load_plan(shipped)
