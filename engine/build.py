@@ -30,7 +30,7 @@ from engine.decorators import (
     Timeout,
 )
 from engine.errors import EngineError
-from engine.kinds import KIND_CONFIG, check_config
+from engine.kinds import settings_of
 from engine.leaves import OperationLeaf, Wait
 from engine.node import Node
 from engine.operations import Direction, OperationNotFound, OperationSource
@@ -60,30 +60,37 @@ class BuildError(EngineError):
         super().__init__(f"{path}: {message}")
 
 
-def _settings(spec: NodeSpec) -> dict[str, Any]:
-    # The same check as validation: a Repeat without a count must not become an endless loop.
-    problems = check_config(spec.kind, spec.config)
-    if problems:
-        raise ValueError(problems[0][1])
-    values = {f.name: f.default for f in KIND_CONFIG.get(spec.kind, ())}
-    values.update({k: v for k, v in spec.config.items() if v is not None})
-    return values
+def _whole_or_none(value: float) -> int | None:
+    """A count or limit of 0 means none."""
+    return int(value) or None
+
+
+def _policy(value: str | float) -> str | int:
+    return value if isinstance(value, str) else int(value)
 
 
 def _logic_node(spec: NodeSpec, ctx: TreeContext) -> Node:
     simple = _SIMPLE.get(spec.kind)
     if simple is not None:
         return simple(ctx, spec.id, spec.label)
-    cfg = _settings(spec)
+    # The same checks as validation: a Repeat without a count must not become an endless loop.
+    cfg = settings_of(spec.kind, spec.params)
     label = spec.label
     factories: dict[NodeKind, Callable[[], Node]] = {
         NodeKind.PARALLEL: lambda: Parallel(
-            ctx, spec.id, label, ParallelPolicy(cfg["success"], cfg["failure"])
+            ctx,
+            spec.id,
+            label,
+            ParallelPolicy(_policy(cfg["success"]), _policy(cfg["failure"])),
         ),
-        NodeKind.ITERATOR: lambda: Iterator(ctx, spec.id, label, cfg["count"], cfg["timeout"]),
-        NodeKind.ENFORCE: lambda: Enforce(ctx, spec.id, label, cfg["count"], cfg["timeout"]),
-        NodeKind.REPEAT: lambda: Repeat(ctx, spec.id, label, cfg["count"]),
-        NodeKind.RETRY: lambda: Retry(ctx, spec.id, label, cfg["count"]),
+        NodeKind.ITERATOR: lambda: Iterator(
+            ctx, spec.id, label, _whole_or_none(cfg["count"]), float(cfg["timeout"]) or None
+        ),
+        NodeKind.ENFORCE: lambda: Enforce(
+            ctx, spec.id, label, _whole_or_none(cfg["count"]), float(cfg["timeout"]) or None
+        ),
+        NodeKind.REPEAT: lambda: Repeat(ctx, spec.id, label, int(cfg["count"])),
+        NodeKind.RETRY: lambda: Retry(ctx, spec.id, label, int(cfg["count"])),
         NodeKind.TIMEOUT: lambda: Timeout(ctx, spec.id, label, float(cfg["seconds"])),
         NodeKind.WAIT: lambda: Wait(ctx, spec.id, label, float(cfg["seconds"])),
     }

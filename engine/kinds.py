@@ -1,66 +1,89 @@
-"""Settings of the logic node kinds: what each kind's ``config`` may hold.
+"""The manifests of the engine's own node kinds: the typed ports of logic nodes and decorators.
 
-One table serves validation, file reading, the builder and the Instructor's inspector, so a
-setting is described once.
+A logic node's settings (a Parallel's policy, a count, a timeout, the seconds of a Wait) are
+ports like an operation's parameters, bound in ``NodeSpec.params`` to fixed values (as in
+BehaviorTree.CPP, where a node's manifest lists its ports). This table is the one place their
+types, defaults and docs live; validation, the builder and the inspector read it.
+
+Ports of logic nodes take fixed values only: the tree is built from them once, so a
+reference would be read at no defined moment. Validation says so when a file binds one.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Mapping
 from typing import Any
 
-from engine.spec import NodeKind
+from engine.operations import PortSpec
+from engine.spec import Binding, NodeKind
+from engine.types import ParamType
 
-__all__ = ["ConfigField", "KIND_CONFIG", "KIND_DOC", "check_config"]
+__all__ = [
+    "KIND_PORTS",
+    "KIND_DOC",
+    "POLICY_WORDS",
+    "check_setting",
+    "kind_port",
+    "setting",
+    "settings_of",
+]
 
-
-@dataclass(frozen=True)
-class ConfigField:
-    """One setting of a logic node.
-
-    Attributes:
-        name: key in ``NodeSpec.config``.
-        kind: "count" (int >= 1), "seconds" (number > 0, or >= 0 for Wait), "policy_success"
-            ("all", "any" or a count), "policy_failure" ("any" or a count).
-        required: must be present.
-        default: used when absent (None: off).
-        doc: one line for the inspector.
-    """
-
-    name: str
-    kind: str
-    required: bool = False
-    default: Any = None
-    doc: str = ""
+_N, _D, _T = ParamType.NUMBER, ParamType.DURATION, ParamType.TEXT
+# A Parallel's policy: the words, or a count of children (a Number).
+POLICY_WORDS: dict[str, tuple[str, ...]] = {"success": ("all", "any"), "failure": ("any",)}
 
 
-KIND_CONFIG: dict[NodeKind, tuple[ConfigField, ...]] = {
+def _count(name: str, doc: str, default: float | None = None) -> PortSpec:
+    return PortSpec(name, (_N,), default=default, doc=doc)
+
+
+def _seconds(name: str, doc: str, default: float | None = None) -> PortSpec:
+    return PortSpec(name, (_D,), default=default, unit="s", doc=doc)
+
+
+KIND_PORTS: dict[NodeKind, tuple[PortSpec, ...]] = {
     NodeKind.PARALLEL: (
-        ConfigField(
+        PortSpec(
             "success",
-            "policy_success",
+            (_T, _N),
             default="all",
             doc="succeed when all, any, or this many children succeeded",
+            choices=POLICY_WORDS["success"],
         ),
-        ConfigField(
+        PortSpec(
             "failure",
-            "policy_failure",
+            (_T, _N),
             default="any",
             doc="fail when any, or this many children failed",
+            choices=POLICY_WORDS["failure"],
         ),
     ),
     NodeKind.ITERATOR: (
-        ConfigField("count", "count", doc="stop with SUCCESS after this many successes"),
-        ConfigField("timeout", "seconds", doc="stop with SUCCESS after this many seconds"),
+        _count("count", "stop with SUCCESS after this many successes (0: no limit)", 0.0),
+        _seconds("timeout", "stop with SUCCESS after this many seconds (0: no limit)", 0.0),
     ),
     NodeKind.ENFORCE: (
-        ConfigField("count", "count", doc="give up with FAILURE after this many failures"),
-        ConfigField("timeout", "seconds", doc="give up with FAILURE after this many seconds"),
+        _count("count", "give up with FAILURE after this many failures (0: no limit)", 0.0),
+        _seconds("timeout", "give up with FAILURE after this many seconds (0: no limit)", 0.0),
     ),
-    NodeKind.REPEAT: (ConfigField("count", "count", required=True, doc="how many times"),),
-    NodeKind.RETRY: (ConfigField("count", "count", required=True, doc="how many attempts"),),
-    NodeKind.TIMEOUT: (ConfigField("seconds", "seconds", required=True, doc="time limit"),),
-    NodeKind.WAIT: (ConfigField("seconds", "wait_seconds", required=True, doc="how long to wait"),),
+    NodeKind.REPEAT: (_count("count", "how many times"),),
+    NodeKind.RETRY: (_count("count", "how many attempts"),),
+    NodeKind.TIMEOUT: (_seconds("seconds", "time limit"),),
+    NodeKind.WAIT: (_seconds("seconds", "how long to wait"),),
+}
+
+# What a fixed value of each port must be beyond its type: (minimum, whole number).
+_LIMITS: dict[tuple[NodeKind, str], tuple[float, bool]] = {
+    (NodeKind.ITERATOR, "count"): (0, True),
+    (NodeKind.ITERATOR, "timeout"): (0, False),
+    (NodeKind.ENFORCE, "count"): (0, True),
+    (NodeKind.ENFORCE, "timeout"): (0, False),
+    (NodeKind.REPEAT, "count"): (1, True),
+    (NodeKind.RETRY, "count"): (1, True),
+    (NodeKind.WAIT, "seconds"): (0, False),
+    (NodeKind.TIMEOUT, "seconds"): (0, False),
+    (NodeKind.PARALLEL, "success"): (1, True),
+    (NodeKind.PARALLEL, "failure"): (1, True),
 }
 
 KIND_DOC: dict[NodeKind, str] = {
@@ -84,42 +107,72 @@ KIND_DOC: dict[NodeKind, str] = {
 }
 
 
-def _is_number(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
+def kind_port(kind: NodeKind, name: str) -> PortSpec | None:
+    """The port ``name`` of a logic node kind, or None."""
+    return next((p for p in KIND_PORTS.get(kind, ()) if p.name == name), None)
 
 
-def _check_field(spec: ConfigField, value: Any) -> str | None:
-    """None when ``value`` fits, else what was expected."""
-    is_count = isinstance(value, int) and not isinstance(value, bool) and value >= 1
-    if spec.kind == "count":
-        return None if is_count else "a whole number of at least 1"
-    if spec.kind == "seconds":
-        return None if _is_number(value) and value > 0 else "a number of seconds above 0"
-    if spec.kind == "wait_seconds":
-        return None if _is_number(value) and value >= 0 else "a number of seconds, 0 or more"
-    if spec.kind == "policy_success":
-        return (
-            None if value in ("all", "any") or is_count else "'all', 'any' or a count of at least 1"
-        )
-    if spec.kind == "policy_failure":
-        return None if value == "any" or is_count else "'any' or a count of at least 1"
-    return f"a value of unknown setting kind {spec.kind}"
+def setting(kind: NodeKind, name: str, value: str | float) -> Binding:
+    """A fixed binding of a logic node's port: a word as Text, a number as the port's type.
+
+    Raises:
+        ValueError: ``value`` is neither a text nor a number.
+    """
+    if isinstance(value, str):
+        return Binding.fixed(value, ParamType.TEXT)
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ValueError(f"a setting is a number or a text, not {value!r}")
+    port = kind_port(kind, name)
+    return Binding.fixed(float(value), port.types[-1] if port is not None else ParamType.NUMBER)
 
 
-def check_config(kind: NodeKind, config: dict[str, Any]) -> list[tuple[str, str]]:
-    """Problems with a node's settings as (setting name, sentence); empty when fine."""
-    fields = {f.name: f for f in KIND_CONFIG.get(kind, ())}
-    problems: list[tuple[str, str]] = []
-    for name in config:
-        if name not in fields:
-            allowed = ", ".join(fields) or "none"
-            problems.append((name, f"{kind.value} has no setting {name!r} (settings: {allowed})"))
-    for name, spec in fields.items():
-        if name not in config or config[name] is None:
-            if spec.required:
-                problems.append((name, f"{kind.value} needs the setting {name!r} ({spec.doc})"))
-            continue
-        expected = _check_field(spec, config[name])
+def check_setting(kind: NodeKind, name: str, value: Any) -> str | None:
+    """None when a fixed value of the right type is also in range, else what was expected."""
+    if isinstance(value, str):
+        return None  # a word: checked against the port's choices
+    minimum, whole = _LIMITS.get((kind, name), (0.0, False))
+    strict = kind is NodeKind.TIMEOUT  # a time limit of 0 would fail at once
+    is_number = isinstance(value, (int, float)) and not isinstance(value, bool)
+    if (
+        is_number
+        and (value > minimum if strict else value >= minimum)
+        and (not whole or float(value).is_integer())
+    ):
+        return None
+    if whole:
+        return f"a whole number of at least {minimum:g}"
+    return "a number of seconds above 0" if strict else "a number of seconds, 0 or more"
+
+
+def settings_of(kind: NodeKind, params: Mapping[str, Binding]) -> dict[str, Any]:
+    """The values of a logic node's ports: its fixed bindings, else the manifest's defaults.
+
+    Args:
+        kind: the node's kind.
+        params: its bindings (checked by validation; the builder checks again with this).
+
+    Raises:
+        ValueError: a required port unbound, a reference, or a value out of range; the
+            message says which port and what was expected.
+    """
+    ports = KIND_PORTS.get(kind, ())
+    for name in params:
+        if kind_port(kind, name) is None:
+            allowed = ", ".join(p.name for p in ports) or "none"
+            raise ValueError(f"{kind.value} has no setting {name!r} (settings: {allowed})")
+    values: dict[str, Any] = {}
+    for port in ports:
+        binding = params.get(port.name)
+        if binding is not None and binding.is_ref:
+            raise ValueError(f"{port.name!r} takes a fixed value, not a reference")
+        value = port.default if binding is None or binding.value is None else binding.value
+        if value is None:
+            raise ValueError(f"{kind.value} needs a value for {port.name!r} ({port.doc})")
+        expected = check_setting(kind, port.name, value)
+        if expected is None and isinstance(value, str) and value not in port.choices:
+            expected = f"one of {', '.join(port.choices)} or a count"
         if expected is not None:
-            problems.append((name, f"setting {name!r} must be {expected}, not {config[name]!r}"))
-    return problems
+            shown = f"{value:g}" if isinstance(value, float) else repr(value)
+            raise ValueError(f"{port.name!r} must be {expected}, not {shown}")
+        values[port.name] = value
+    return values

@@ -21,8 +21,10 @@ __all__ = [
 ]
 
 FORMAT = "costar-plan"
-FORMAT_VERSION = 1
-READABLE_VERSIONS: tuple[int, ...] = (1,)
+# 2: the settings of logic nodes are typed port bindings in "params" (1: a "config" object);
+# the operation timing.wait is the Wait node.
+FORMAT_VERSION = 2
+READABLE_VERSIONS: tuple[int, ...] = (1, 2)
 PLAN_SUFFIX = ".costar.json"
 # Python's JSON reader and writer recurse about twice per tree level; 400 levels stay well
 # inside the default recursion limit of 1000 even when called from a deep GUI stack.
@@ -37,7 +39,8 @@ KIND_ALIASES: Mapping[str, str] = types.MappingProxyType(
 
 TOP_FIELDS: tuple[str, ...] = ("format", "format_version", "id", "name", "description")
 TOP_FIELDS += ("run_policy", "reset_cell", "parameters", "tree", "waypoints", "objects", "layout")
-NODE_FIELDS = ("id", "kind", "name", "op", "params", "config", "children")
+NODE_FIELDS = ("id", "kind", "name", "op", "params", "children")
+NODE_FIELDS_V1 = ("id", "kind", "name", "op", "params", "config", "children")
 
 
 class PlanFileError(JsonFileError):

@@ -7,6 +7,7 @@ from collections.abc import Mapping
 from typing import Any, NoReturn
 
 from engine.json_reader import JsonReader, parse_json, read_json_file
+from engine.kinds import setting as kind_setting
 from engine.plan_format import (
     FORMAT,
     FORMAT_VERSION,
@@ -14,6 +15,7 @@ from engine.plan_format import (
     MAX_NESTING,
     MAX_TREE_DEPTH,
     NODE_FIELDS,
+    NODE_FIELDS_V1,
     READABLE_VERSIONS,
     TOP_FIELDS,
     PlanFileError,
@@ -36,6 +38,8 @@ from engine.types import ParamType, Waypoint
 
 __all__ = ["load_plan", "loads_plan"]
 
+V1_WAIT_OP = "timing.wait"  # format 1's operation for what is the Wait node
+
 
 class _Reader:
     """Turns a parsed document into a PlanSpec, failing at the first thing that is off."""
@@ -44,6 +48,7 @@ class _Reader:
         self.file = file
         self.aliases = aliases
         self.ids: dict[str, str] = {}  # node id -> JSON path of the node that has it
+        self.version: object = FORMAT_VERSION  # of the file, known after check_format
 
     def fail(self, path: str, expected: str, got: str) -> NoReturn:
         raise PlanFileError(self.file, path, expected, got)
@@ -112,7 +117,8 @@ class _Reader:
     def node(self, value: Any, path: str, depth: int) -> NodeSpec:
         if depth > MAX_TREE_DEPTH:
             self.fail(path, f"a tree at most {MAX_TREE_DEPTH} levels deep", "a deeper tree")
-        obj = self.fields(value, path, NODE_FIELDS, required=("id", "kind"))
+        names = NODE_FIELDS_V1 if self.version == 1 else NODE_FIELDS
+        obj = self.fields(value, path, names, required=("id", "kind"))
         node_id = self.text(obj["id"], at(path, "id"), nonempty=True)
         if node_id in self.ids:
             self.fail(
@@ -125,18 +131,16 @@ class _Reader:
         node = NodeSpec(kind, name=self.text(obj.get("name", ""), at(path, "name")), id=node_id)
         if kind is NodeKind.OPERATION:
             node.op = self.operation_id(obj.get("op"), at(path, "op"))
-        elif "op" in obj or "params" in obj:
-            field = "op" if "op" in obj else "params"
+        elif "op" in obj:
             self.fail(
-                at(path, field),
-                f"no {field}: only operation nodes have one",
-                f"a {kind.value} node with {field}",
+                at(path, "op"), "no op: only operation nodes have one", f"a {kind.value} node"
             )
         params = self.mapping(obj.get("params", {}), at(path, "params"), "port -> binding")
         node.params = {
             port: self.binding(b, at(at(path, "params"), port)) for port, b in params.items()
         }
-        node.config = self.config(obj.get("config", {}), at(path, "config"))
+        if self.version == 1:
+            self.v1_settings(node, obj.get("config", {}), at(path, "config"))
         children = self.items(obj.get("children", []), at(path, "children"), "nodes")
         self.check_children(kind, len(children), at(path, "children"))
         for index, child in enumerate(children):
@@ -182,12 +186,17 @@ class _Reader:
         ptype = self.ptype(obj["type"], at(path, "type"))
         return Binding.fixed(self.value(ptype, obj["value"], at(path, "value")), ptype)
 
-    def config(self, value: Any, path: str) -> dict[str, Any]:
-        obj = self.mapping(value, path, "setting -> value")
-        for key, setting in obj.items():
-            if isinstance(setting, (list, dict)):
-                self.fail(at(path, key), "a number, text, true/false or null", describe(setting))
-        return dict(obj)
+    def v1_settings(self, node: NodeSpec, value: Any, path: str) -> None:
+        """Version 1 kept logic-node settings in "config" and had the operation timing.wait."""
+        if node.op == V1_WAIT_OP:
+            node.kind, node.op = NodeKind.WAIT, None
+        for key, setting in self.mapping(value, path, "setting -> value").items():
+            if setting is None:
+                continue
+            try:
+                node.params[key] = kind_setting(node.kind, key, setting)
+            except ValueError:
+                self.fail(at(path, key), "a number or a text", describe(setting))
 
     def parameters(self, value: Any, path: str) -> list[ParameterDecl]:
         decls: list[ParameterDecl] = []
@@ -245,6 +254,7 @@ class _Reader:
         if doc.get("format") != FORMAT:
             self.fail("$.format", repr(FORMAT), describe(doc.get("format")))
         version = doc.get("format_version")
+        self.version = version
         readable = ", ".join(str(v) for v in READABLE_VERSIONS)
         if isinstance(version, int) and not isinstance(version, bool) and version > FORMAT_VERSION:
             self.fail(

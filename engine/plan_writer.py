@@ -63,8 +63,6 @@ def _encode_node(node: NodeSpec, depth: int) -> dict[str, Any]:
     }
     if params:
         out["params"] = {port: _encode_binding(params[port]) for port in sorted(params)}
-    if node.config:
-        out["config"] = {key: encode_value(node.config[key]) for key in sorted(node.config)}
     if node.children:
         out["children"] = [_encode_node(child, depth + 1) for child in node.children]
     return out

@@ -83,7 +83,7 @@ KIND_CATEGORY: dict[NodeKind, Category] = {
 
 @dataclass(frozen=True)
 class Binding:
-    """An operation parameter's binding: a fixed value or a reference to a named parameter.
+    """A port's binding: a fixed value or a reference to a named parameter.
 
     Attributes:
         value: the literal (a Python value of ``type``) when fixed.
@@ -117,8 +117,8 @@ class NodeSpec:
         name: the label users gave it (may be empty: the UI shows the kind or operation).
         id: stable uuid, kept through edits, saves and copies within a document.
         op: operation id, for kind OPERATION.
-        params: operation port -> binding.
-        config: settings of logic nodes (Parallel policy, counts, timeouts, Wait seconds).
+        params: port -> binding; the ports of an operation (its manifest) or of a logic
+            node kind (engine.kinds.KIND_PORTS: Parallel policy, counts, timeouts, seconds).
         children: in tick order.
     """
 
@@ -127,7 +127,6 @@ class NodeSpec:
     id: str = field(default_factory=new_id)
     op: str | None = None
     params: dict[str, Binding] = field(default_factory=dict)
-    config: dict[str, Any] = field(default_factory=dict)
     children: list[NodeSpec] = field(default_factory=list)
 
     @property

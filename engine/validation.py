@@ -18,9 +18,9 @@ from __future__ import annotations
 import difflib
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Any, Literal
 
-from engine.kinds import check_config
+from engine.kinds import KIND_PORTS, check_setting, kind_port
 from engine.operations import (
     Direction,
     OperationKind,
@@ -176,25 +176,76 @@ def _check_structure(check: _Check, node: NodeSpec) -> None:
         check.add(ERROR, node, f"{label!r} has no nodes below it: add some or remove it.")
     elif category is Category.LEAF and count:
         check.add(ERROR, node, f"{label!r} cannot have nodes below it; it has {count}.")
-    for name, message in check_config(node.kind, node.config):
-        check.add(ERROR, node, f"{label!r}: {message}.", name)
+    if node.kind is not NodeKind.OPERATION:
+        _check_kind_ports(check, node)
     if node.kind is NodeKind.PARALLEL and count:
         _check_parallel_policy(check, node)
-    if node.kind is not NodeKind.OPERATION and (node.op or node.params):
-        check.add(
-            WARNING, node, f"{label!r} is not an operation; its operation settings are ignored."
-        )
+    if node.kind is not NodeKind.OPERATION and node.op:
+        check.add(WARNING, node, f"{label!r} is not an operation; its operation is ignored.")
+
+
+def _stated(params: dict[str, Binding]) -> dict[str, Binding]:
+    """The bindings that say something: an empty one (files leave it out) counts as unbound."""
+    return {
+        k: b for k, b in params.items() if b.is_ref or b.type is not None or b.value is not None
+    }
+
+
+def _setting(node: NodeSpec, name: str) -> Any:
+    """A logic node port's fixed value, else its manifest default."""
+    binding = node.params.get(name)
+    if binding is not None and not binding.is_ref and binding.value is not None:
+        return binding.value
+    port = kind_port(node.kind, name)
+    return None if port is None else port.default
+
+
+def _check_kind_ports(check: _Check, node: NodeSpec) -> None:
+    """The ports of a logic node (engine.kinds.KIND_PORTS): fixed values of the right type."""
+    ports = KIND_PORTS.get(node.kind, ())
+    params = _stated(node.params)
+    for name, binding in params.items():
+        port = kind_port(node.kind, name)
+        if port is None:
+            names = [p.name for p in ports]
+            hint = _close(name, names) or f" (it has {', '.join(names) or 'none'})"
+            check.add(ERROR, node, f"{node.kind.value} has no setting {name!r}{hint}.", name)
+        elif binding.is_ref:
+            check.add(
+                ERROR,
+                node,
+                f"{name!r} of {node.label!r} takes a fixed value, not a reference "
+                f"to {binding.ref}: the settings of logic nodes are fixed when the plan starts.",
+                name,
+            )
+        elif _check_fixed(check, node, name, binding, port.types, port.choices):
+            expected = check_setting(node.kind, name, binding.value)
+            if expected is not None:
+                check.add(
+                    ERROR,
+                    node,
+                    f"{name!r} of {node.label!r} must be {expected}, not {binding.value!r}.",
+                    name,
+                )
+    for port in ports:
+        if port.required and port.name not in params:
+            check.add(
+                ERROR,
+                node,
+                f"{node.label!r} needs a value for {port.name!r} ({port.doc}).",
+                port.name,
+            )
 
 
 def _check_parallel_policy(check: _Check, node: NodeSpec) -> None:
     count = len(node.children)
     for name in ("success", "failure"):
-        wanted = node.config.get(name)
-        if isinstance(wanted, int) and not isinstance(wanted, bool) and wanted > count:
+        wanted = _setting(node, name)
+        if isinstance(wanted, (int, float)) and not isinstance(wanted, bool) and wanted > count:
             check.add(
                 ERROR,
                 node,
-                f"{node.label!r} waits for {wanted} children to end with "
+                f"{node.label!r} waits for {wanted:g} children to end with "
                 f"{name} but has only {count}.",
                 name,
             )
@@ -214,12 +265,7 @@ def _check_operation(check: _Check, node: NodeSpec) -> None:
     if not availability.available:
         reason = availability.reason or "its capability is not available"
         check.add(ERROR, node, f"{node.label!r} cannot run on this cell: {reason}.")
-    # An empty binding says nothing (files leave it out): the port counts as unbound.
-    params = {
-        k: b
-        for k, b in node.params.items()
-        if b.is_ref or b.type is not None or b.value is not None
-    }
+    params = _stated(node.params)
     _check_bound_ports(check, node, manifest, params)
     _check_unbound_ports(check, node, manifest, params)
 
@@ -287,7 +333,8 @@ def _check_fixed(
     binding: Binding,
     types: tuple[ParamType, ...],
     choices: tuple[str, ...],
-) -> None:
+) -> bool:
+    """Check a fixed value against a port's types and choices; True when it fits."""
     ptype = ParamType(binding.type) if binding.type is not None else None
     if ptype is None or not check_value(ptype, binding.value):
         check.add(
@@ -304,7 +351,7 @@ def _check_fixed(
             f"set to {_type_names((ptype,))}.",
             port,
         )
-    elif choices and binding.value not in choices:
+    elif choices and ptype is ParamType.TEXT and binding.value not in choices:
         check.add(
             ERROR,
             node,
@@ -312,6 +359,9 @@ def _check_fixed(
             f"{', '.join(choices)}, not {binding.value!r}.",
             port,
         )
+    else:
+        return True
+    return False
 
 
 def _check_writer_types(check: _Check) -> None:
@@ -344,7 +394,7 @@ def _check_reads(check: _Check, node: NodeSpec, available: frozenset[str]) -> fr
         return _parallel_guarantee(node, results)
     if node.kind in (NodeKind.SELECTOR, NodeKind.REACTIVE_SELECTOR):
         return frozenset.intersection(*results) if results else frozenset()
-    if node.kind is NodeKind.ITERATOR and node.config.get("timeout") is not None:
+    if node.kind is NodeKind.ITERATOR and _setting(node, "timeout"):
         return frozenset()
     if node.kind in _PASS_CHILD and len(results) == 1:
         return results[0]
@@ -354,9 +404,9 @@ def _check_reads(check: _Check, node: NodeSpec, available: frozenset[str]) -> fr
 def _parallel_guarantee(node: NodeSpec, results: list[frozenset[str]]) -> frozenset[str]:
     """A name is guaranteed when any set of children that meets the success policy has a
     child that writes it, i.e. fewer children than the policy needs leave it unwritten."""
-    policy = node.config.get("success", "all")
+    policy = _setting(node, "success")
     need = len(results) if policy == "all" else 1 if policy == "any" else policy
-    if not isinstance(need, int):
+    if not isinstance(need, (int, float)) or isinstance(need, bool):
         return frozenset()
     every = frozenset().union(*results)
     return frozenset(n for n in every if sum(n not in r for r in results) < need)

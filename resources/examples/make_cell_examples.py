@@ -16,6 +16,7 @@ from typing import Any
 
 from capabilities.waypoints import WaypointLibrary, waypoints_path_for
 from engine.files import save_plan
+from engine.kinds import setting
 from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec, RunPolicy
 from engine.types import JointConfig, ObjectModel, ParamType, Pose, Waypoint, WaypointFrame
 
@@ -60,7 +61,7 @@ class _Maker:
         return uuid.uuid5(_NAMESPACE, f"{self.example}/{self.count}").hex
 
     def node(self, kind: NodeKind, name: str, *children: NodeSpec, **config: Any) -> NodeSpec:
-        return NodeSpec(kind, name, self._id(), config=config, children=list(children))
+        return NodeSpec(kind, name, self._id(), params={k: setting(kind, k, v) for k, v in config.items()}, children=list(children))
 
     def op(self, op: str, name: str, **params: Binding) -> NodeSpec:
         return NodeSpec(NodeKind.OPERATION, name, self._id(), op=op, params=params)
@@ -99,7 +100,7 @@ def _figure3_tree(m: _Maker, finder: str, detect: str, title: str) -> NodeSpec:
     )  # fmt: skip
     wait = m.node(
         NodeKind.FORCE_FAILURE, "then look again",
-        m.op("timing.wait", "WAIT", seconds=Binding.fixed(1.0, ParamType.DURATION)),
+        m.node(NodeKind.WAIT, "WAIT", seconds=1.0),
     )  # fmt: skip
     return m.node(
         NodeKind.SEQUENCE, title,

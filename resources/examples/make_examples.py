@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from engine.files import save_plan
+from engine.kinds import setting
 from engine.spec import Binding, NodeKind, NodeSpec, ParameterDecl, PlanSpec, RunPolicy
 from engine.types import ParamType, Pose
 
@@ -40,7 +41,7 @@ class _Maker:
         self.ids = _Ids(example)
 
     def node(self, kind: NodeKind, name: str = "", *children: NodeSpec, **config: Any) -> NodeSpec:
-        return NodeSpec(kind, name, self.ids(), config=config, children=list(children))
+        return NodeSpec(kind, name, self.ids(), params={k: setting(kind, k, v) for k, v in config.items()}, children=list(children))
 
     def op(self, op: str, label: str = "", **params: Binding) -> NodeSpec:
         return NodeSpec(NodeKind.OPERATION, label, self.ids(), op=f"debug.{op}", params=params)
@@ -134,7 +135,7 @@ def _one(
         title,
         text,
         RunPolicy.ONCE,
-        parameters or [],
+        parameters=parameters or [],
         id=uuid.uuid5(_NAMESPACE, example).hex,
     )
 

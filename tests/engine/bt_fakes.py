@@ -15,6 +15,7 @@ from typing import Any
 from engine.blackboard import Blackboard
 from engine.context import TreeContext
 from engine.events import Event, StatusChanged
+from engine.kinds import setting
 from engine.leaves import OperationLeaf
 from engine.node import Node
 from engine.operations import Job, OperationCall, OperationKind, StartResult
@@ -224,9 +225,22 @@ def _ptype(value: Any) -> ParamType:
     return ParamType.ANY
 
 
+def settings(kind: NodeKind, **values: Any) -> dict[str, Binding]:
+    """Port bindings of a logic node from plain values (None: unbound; odd values kept as Any)."""
+    out: dict[str, Binding] = {}
+    for name, value in values.items():
+        if value is None:
+            continue
+        try:
+            out[name] = setting(kind, name, value)
+        except ValueError:
+            out[name] = Binding.fixed(value, ParamType.ANY)
+    return out
+
+
 def logic(kind: NodeKind, *children: NodeSpec, name: str = "", **config: Any) -> NodeSpec:
     """A logic node with children and settings."""
-    return NodeSpec(kind, name=name, config=dict(config), children=list(children))
+    return NodeSpec(kind, name=name, params=settings(kind, **config), children=list(children))
 
 
 def plan(tree: NodeSpec, policy: RunPolicy = RunPolicy.ONCE, **kwargs: Any) -> PlanSpec:

@@ -185,14 +185,14 @@ def test_a_decorator_with_two_children(registry: CapabilityRegistry) -> None:
 @pytest.mark.parametrize(
     ("kind", "config", "match"),
     [
-        (NodeKind.REPEAT, {"count": 0}, "setting 'count' must be a whole number of at least 1"),
+        (NodeKind.REPEAT, {"count": 0}, "'count' must be a whole number of at least 1, not 0"),
         (NodeKind.TIMEOUT, {"seconds": -1}, "must be a number of seconds above 0, not -1"),
         (
             NodeKind.PARALLEL,
             {"success": "most"},
-            "'all', 'any' or a count of at least 1, not 'most'",
+            "'success' must be one of all, any or a count, not 'most'",
         ),
-        (NodeKind.REPEAT, {}, "repeat needs the setting 'count'"),
+        (NodeKind.REPEAT, {}, "repeat needs a value for 'count'"),
         (NodeKind.RETRY, {"count": 2, "tries": 3}, "retry has no setting 'tries'"),
     ],
 )

@@ -11,6 +11,7 @@ from typing import Any
 
 import jsonschema
 import pytest
+from bt_fakes import settings
 
 from engine import plan_writer
 from engine.files import (
@@ -80,9 +81,13 @@ def full_plan() -> PlanSpec:
     move = NodeSpec(
         NodeKind.OPERATION, op="test.move_to", params={"target": Binding.reference("CUP_POSE")}
     )
-    retry = NodeSpec(NodeKind.RETRY, config={"count": 3}, children=[move])
-    wait = NodeSpec(NodeKind.WAIT, "pause", config={"seconds": 0.5})
-    parallel = NodeSpec(NodeKind.PARALLEL, config={"success": "any", "failure": 2}, children=[wait])
+    retry = NodeSpec(NodeKind.RETRY, params=settings(NodeKind.RETRY, count=3), children=[move])
+    wait = NodeSpec(NodeKind.WAIT, "pause", params=settings(NodeKind.WAIT, seconds=0.5))
+    parallel = NodeSpec(
+        NodeKind.PARALLEL,
+        params=settings(NodeKind.PARALLEL, success="any", failure=2),
+        children=[wait],
+    )
     tree = NodeSpec(NodeKind.SEQUENCE, "Transfer", children=[*ops, find, retry, parallel])
     return PlanSpec(
         tree=tree,
@@ -104,7 +109,7 @@ def node_doc(node_id: str, kind: str, **extra: Any) -> dict[str, Any]:
 
 
 def plan_doc(tree: Any = None, **extra: Any) -> dict[str, Any]:
-    return {"format": "costar-plan", "format_version": 1, "tree": tree, **extra}
+    return {"format": "costar-plan", "format_version": 2, "tree": tree, **extra}
 
 
 def root(plan: PlanSpec) -> NodeSpec:
@@ -137,7 +142,7 @@ def test_save_load_save_is_byte_identical(tmp_path: Path) -> None:
     save_plan(load_plan(first), second)
     assert first.read_bytes() == second.read_bytes()
     text = first.read_text("utf-8")
-    assert text.endswith("}\n") and '\n  "format_version": 1,' in text
+    assert text.endswith("}\n") and '\n  "format_version": 2,' in text
     assert "0.30000000000000004" in text  # floats as repr
     assert "größer" in text  # UTF-8, not escapes
 
@@ -156,7 +161,6 @@ def test_output_order_is_canonical() -> None:
     plan = full_plan()
     node = root(plan).children[0]
     node.params = {"b": Binding.reference("B"), "a": Binding.reference("A")}
-    node.config = {"z": 1, "a": 2}
     again = loads_plan(dump_plan(plan))
     assert list(root(again).children[0].params) == ["a", "b"]
     # layout in tree order, whatever order the editor inserted it in
@@ -243,7 +247,7 @@ BAD: list[tuple[str, Any, str, str]] = [
     ("not an object", [], "$", "costar-plan object"),
     ("other format", {"format": "word", "format_version": 1}, "$.format", "'costar-plan'"),
     ("no version", {"format": "costar-plan"}, "$.format_version", "versions 1"),
-    ("newer version", plan_doc(format_version=2), "$.format_version", "newer CoSTAR Instructor"),
+    ("newer version", plan_doc(format_version=3), "$.format_version", "newer CoSTAR Instructor"),
     ("version as text", plan_doc(format_version="1"), "$.format_version", "versions 1"),
     ("unknown top field", plan_doc(trea=None), "$.trea", "one of the fields format"),
     ("name a number", plan_doc(name=3), "$.name", "a text"),
@@ -257,7 +261,7 @@ BAD: list[tuple[str, Any, str, str]] = [
      "$.tree.children[1].id", "already the id of $.tree"),
     ("operation without op", plan_doc(node_doc("a", "operation")), "$.tree.op", "operation id"),
     ("op on a wait", plan_doc(node_doc("a", "wait", op="x")), "$.tree.op", "only operation nodes"),
-    ("params on a sequence", plan_doc(node_doc("a", "sequence", params={})), "$.tree.params", "only operation"),
+    ("op on a sequence", plan_doc(node_doc("a", "sequence", op="debug.succeed")), "$.tree.op", "only operation"),
     ("children not a list", plan_doc(node_doc("a", "sequence", children={})), "$.tree.children", "a list of nodes"),
     ("leaf with children", plan_doc(node_doc("a", "sequence", children=[{**OP, "children": [node_doc("b", "wait")]}])),
      "$.tree.children[0].children", "a leaf"),
@@ -274,7 +278,8 @@ BAD: list[tuple[str, Any, str, str]] = [
      "$.tree.params.target.type", "Pose, JointConfig"),
     ("empty ref", plan_doc({**OP, "params": {"target": {"ref": ""}}}), "$.tree.params.target.ref", "non-empty"),
     ("odd port name", plan_doc({**OP, "params": {"a b": 1}}), '$.tree.params["a b"]', "an object with"),
-    ("config list", plan_doc(node_doc("a", "wait", config={"seconds": [1]})), "$.tree.config.seconds", "a number"),
+    ("config list", plan_doc(node_doc("a", "wait", config={"seconds": [1]}), format_version=1), "$.tree.config.seconds", "a number"),
+    ("config in version 2", plan_doc(node_doc("a", "wait", config={"seconds": 1})), "$.tree.config", "one of the fields"),
     ("parameter bad value", plan_doc(parameters=[{"name": "N", "type": "Number", "value": "3"}]),
      "$.parameters[0].value", "finite number"),
     ("parameter twice", plan_doc(parameters=[{"name": "N", "type": "Bool"}, {"name": "N", "type": "Bool"}]),
@@ -337,7 +342,7 @@ def test_invalid_json_gives_line_and_column(name: str, line: int, column: int, g
 
 def test_data_files_of_newer_version_and_duplicate_keys() -> None:
     with pytest.raises(
-        PlanFileError, match=r"newer_version.costar.json: \$.format_version: .*reads \(1\)"
+        PlanFileError, match=r"newer_version.costar.json: \$.format_version: .*reads \(1, 2\)"
     ):
         load_plan(DATA / "newer_version.costar.json")
     with pytest.raises(PlanFileError) as info:
@@ -405,7 +410,7 @@ def test_save_keeps_permissions_and_refuses_missing_folder(tmp_path: Path) -> No
 
 
 def chain(depth: int) -> NodeSpec:
-    node = NodeSpec(NodeKind.WAIT, config={"seconds": 0})
+    node = NodeSpec(NodeKind.WAIT, params=settings(NodeKind.WAIT, seconds=0))
     for _ in range(depth - 1):
         node = NodeSpec(NodeKind.INVERTER, children=[node])
     return node
@@ -466,7 +471,12 @@ def test_schema_is_valid_and_accepts_examples_and_dumped_plans() -> None:
 
 
 # Uniqueness across a document is beyond JSON Schema; the reader checks it.
-SCHEMA_BAD = [b for b in BAD if b[0] not in ("duplicate ids", "parameter twice", "waypoint twice")]
+# The schema describes format 2 only; version-1 documents are the reader's business.
+SCHEMA_BAD = [
+    b
+    for b in BAD
+    if b[0] not in ("duplicate ids", "parameter twice", "waypoint twice", "config list")
+]
 
 
 @pytest.mark.parametrize(

@@ -6,6 +6,7 @@ from collections.abc import Mapping
 from typing import Any
 
 import pytest
+from bt_fakes import settings
 
 from engine.operations import (
     Availability,
@@ -70,7 +71,7 @@ def op(op_id: str | None, name: str = "", **params: Binding) -> NodeSpec:
 def seq(
     *children: NodeSpec, name: str = "", kind: NodeKind = NodeKind.SEQUENCE, **config: Any
 ) -> NodeSpec:
-    return NodeSpec(kind, name, config=config, children=list(children))
+    return NodeSpec(kind, name, params=settings(kind, **config), children=list(children))
 
 
 def ref(name: str) -> Binding:
@@ -296,7 +297,12 @@ def test_structure_problems() -> None:
         seq(kind=NodeKind.INVERTER),
         seq(find(), move(), kind=NodeKind.RETRY, count=2),
         seq(kind=NodeKind.SELECTOR),
-        NodeSpec(NodeKind.WAIT, "pause", config={"seconds": 1}, children=[find("inner")]),
+        NodeSpec(
+            NodeKind.WAIT,
+            "pause",
+            params=settings(NodeKind.WAIT, seconds=1),
+            children=[find("inner")],
+        ),
         name="T",
     )
     problems = [p for p in check(tree) if p.severity == ERROR]
@@ -311,14 +317,14 @@ def test_structure_problems() -> None:
 def test_settings_of_logic_nodes() -> None:
     tree = seq(
         seq(find(), kind=NodeKind.RETRY),
-        NodeSpec(NodeKind.WAIT, config={"seconds": -1, "secs": 2}),
+        NodeSpec(NodeKind.WAIT, params=settings(NodeKind.WAIT, seconds=-1, secs=2)),
         seq(find(), move(), kind=NodeKind.PARALLEL, success=3),
     )
     problems = check(tree)
     assert [(p.severity, p.path, p.field) for p in problems if p.severity == ERROR] == [
         (ERROR, "sequence/retry[0]", "count"),
-        (ERROR, "sequence/wait[1]", "secs"),
         (ERROR, "sequence/wait[1]", "seconds"),
+        (ERROR, "sequence/wait[1]", "secs"),
         (ERROR, "sequence/parallel[2]", "success"),
     ]
     assert (
@@ -326,8 +332,26 @@ def test_settings_of_logic_nodes() -> None:
     )
 
 
+def test_ports_of_logic_nodes_take_typed_fixed_values() -> None:
+    retry = seq(find(), kind=NodeKind.RETRY)
+    retry.params = {"count": Binding.reference("TRIES")}
+    wait = NodeSpec(NodeKind.WAIT, "pause", params={"seconds": Binding.fixed("1", ParamType.TEXT)})
+    parallel = seq(find(), move(), kind=NodeKind.PARALLEL, success="most", failure=1.5)
+    problems = [p for p in check(seq(retry, wait, parallel)) if p.severity == ERROR]
+    assert [(p.field, p.message) for p in problems] == [
+        (
+            "count",
+            "'count' of 'retry' takes a fixed value, not a reference to TRIES: the settings "
+            "of logic nodes are fixed when the plan starts.",
+        ),
+        ("seconds", "'seconds' of 'pause' needs a Duration, but it is set to a Text."),
+        ("success", "'success' of 'parallel' must be one of all, any, not 'most'."),
+        ("failure", "'failure' of 'parallel' must be a whole number of at least 1, not 1.5."),
+    ]
+
+
 def test_unknown_kind_and_duplicate_ids() -> None:
-    odd = NodeSpec(NodeKind.WAIT, "dance", config={"seconds": 1})
+    odd = NodeSpec(NodeKind.WAIT, "dance", params=settings(NodeKind.WAIT, seconds=1))
     # a spec built by hand, not read from a file, can hold any kind
     odd.kind = "dance"  # type: ignore[assignment]  # a wrong kind on purpose
     twin = find("twin")

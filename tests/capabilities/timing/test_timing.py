@@ -145,7 +145,6 @@ def test_wait_until_the_arm_moves_in_parallel_with_a_move(session: SimCellSessio
     registry = registry_for(session)
     parallel = NodeSpec(
         NodeKind.PARALLEL,
-        config={"success": "all", "failure": "any"},
         children=[
             op("motion.move_to", target=down_at(0.4, -0.2, 0.25), speed=0.3),  # long enough to see
             op("timing.wait_until", "until moving", condition="motion.is_moving", timeout=5.0),
