@@ -26,7 +26,8 @@ from instructor_app.document.autosave import DEFAULT_INTERVAL_MS, Autosaver, off
 from instructor_app.document.model import DocumentError, PlanDocument
 from instructor_app.node_factory import make_node, manifest_or_none
 from instructor_app.panels.operator import OperatorPanel
-from instructor_app.runtime.controller import FINISHED, IDLE, RunController
+from engine.executor import ExecutorState
+from instructor_app.runtime.controller import RunController
 from instructor_app.runtime.run_view import (
     FailureButton,
     RunActions,
@@ -226,7 +227,7 @@ class MainWindow(QMainWindow):
         controller.running_nodes_changed.connect(self.running_panel.set_nodes)
         controller.failure_changed.connect(self.failure_button.show_failure)
         controller.run_state_changed.connect(
-            lambda state: self.cell_combo.setEnabled(state in (IDLE, FINISHED))
+            lambda state: self.cell_combo.setEnabled(state in (ExecutorState.READY, ExecutorState.FINISHED))
         )
         self.run_presenter = RunPresenter(
             controller, views.canvas, views.blackboard, views.log, self.show_message, self
