@@ -24,6 +24,7 @@ from PySide6.QtWidgets import (
 from instructor_app.dialogs import APP_TITLE, DISCARD, SAVE, Dialogs
 from instructor_app.document.autosave import DEFAULT_INTERVAL_MS, Autosaver, offer_recoveries
 from instructor_app.document.model import DocumentError, PlanDocument
+from instructor_app.document.tree_ops import can_have_child
 from instructor_app.node_factory import make_node, manifest_or_none
 from instructor_app.panels.operator import OperatorPanel
 from engine.executor import ExecutorState
@@ -255,23 +256,44 @@ class MainWindow(QMainWindow):
             self.views.canvas.center_on(node_id)
 
     def add_palette_item(self, item: Any) -> str | None:
-        """Add the palette item's node under the selected node (as root when the plan is
-        empty); returns the new node's id, or None with a status-bar message."""
+        """Add the palette item's node where the selection says; returns the new node's id,
+        or None with a status-bar message.
+
+        With a node selected that can take a child, the new node becomes its last child;
+        with a leaf (or a full decorator) selected, it goes right after it, as a sibling.
+        Nothing selected: under the root (as the root when the plan is empty). The new
+        node is selected, so that consecutive inserts with a leaf line up one after the
+        other, and the view scrolls to it.
+        """
         if not item.available:
             self.show_message(f"{item.label} cannot be used on this cell: {item.reason}")
             return None
         node = make_node(item, manifest_or_none(self.session.registry, item.op))
-        plan = self.document.plan
-        parent_id = self.selection[0] if self.selection else None
-        if plan.tree is not None and parent_id is None:
-            parent_id = plan.tree.id
         try:
-            new_id = self.document.add_node(node, parent_id)
+            parent_id, index = self._insertion_point()
+            new_id = self.document.add_node(node, parent_id, index)
         except DocumentError as exc:
-            self.show_message(f"Cannot add {node.label} here: {exc}. Select a composite node.")
+            self.show_message(f"Cannot add {node.label} here: {exc}")
             return None
-        self.views.canvas.select(new_id)
+        canvas = self.views.canvas
+        canvas.select(new_id)
+        canvas.ensure_visible(new_id)
         return new_id
+
+    def _insertion_point(self) -> tuple[str | None, int | None]:
+        """(parent id, index) for a new node from the selection (see add_palette_item)."""
+        plan = self.document.plan
+        if plan.tree is None:
+            return None, None
+        selected = self.selection[0] if self.selection else plan.tree.id
+        if can_have_child(self.document.node(selected)):
+            return selected, None
+        parent_id, index, _ = self.document.locate(selected)
+        if parent_id is None:
+            raise DocumentError(f"{self._node_label(selected)!r} is the root and takes no child")
+        if not can_have_child(self.document.node(parent_id)):
+            raise DocumentError(f"{self._node_label(parent_id)!r} cannot take another child")
+        return parent_id, index + 1
 
     def _on_selection(self, node_ids: list[str]) -> None:
         self.selection = list(node_ids)

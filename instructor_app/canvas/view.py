@@ -136,6 +136,24 @@ class CanvasView(QWidget):
             item = node.item
             self.viewer.centre_on(item.mapToScene(item.shape_rect().center()))
 
+    def ensure_visible(self, node_id: str, margin: float = 40.0) -> None:
+        """Scroll (not zoom) so that the node is in view; nothing moves when it already is."""
+        node = self.mirror.nodes.get(node_id)
+        if node is None:
+            return
+        item = node.item
+        # The mirror may lay the tree out after the insertion signal: place it now.
+        rect = item.sceneBoundingRect().adjusted(-margin, -margin, margin, margin)
+        visible = self.viewer.mapToScene(self.viewer.viewport().rect()).boundingRect()
+        if not visible.contains(rect):
+            self.viewer.centre_on(rect.center())
+
+    def is_visible_in_view(self, node_id: str) -> bool:
+        """Whether the whole node shows in the viewport (tests, the view following edits)."""
+        item = self.mirror.nodes[node_id].item
+        visible = self.viewer.mapToScene(self.viewer.viewport().rect()).boundingRect()
+        return item.isVisible() and visible.contains(item.sceneBoundingRect())
+
     def fit_all(self) -> None:
         """Zoom so that the whole tree shows."""
         rect = QRectF()
