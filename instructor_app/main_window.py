@@ -157,13 +157,19 @@ class MainWindow(QMainWindow):
         files.addSeparator()
         files.addAction(self._action("quit", "&Quit", self.close, "Ctrl+Q"))
         self._build_edit_menus()
-        bar.addMenu("&Run").addActions(self.run_actions.all())
+        reset = self._action("reset_cell", "Reset &Cell", self.reset_cell, "Ctrl+R")
+        reset.setToolTip("Put the robot and the objects back where the scene starts them")
+        run_menu = bar.addMenu("&Run")
+        run_menu.addActions(self.run_actions.all())
+        run_menu.addSeparator()
+        run_menu.addAction(reset)
         help_menu = bar.addMenu("&Help")
         help_menu.addAction(self._action("about", f"&About {APP_TITLE}", self._about))
         toolbar = self.addToolBar("Run")
         toolbar.setObjectName("run_toolbar")
         toolbar.addActions(self.run_actions.all())
         toolbar.addSeparator()
+        toolbar.addAction(reset)
         toolbar.addWidget(self.cell_label)
         toolbar.addWidget(self.cell_combo)
 
@@ -227,9 +233,7 @@ class MainWindow(QMainWindow):
         controller.log_message.connect(views.log.append)
         controller.running_nodes_changed.connect(self.running_panel.set_nodes)
         controller.failure_changed.connect(self.failure_button.show_failure)
-        controller.run_state_changed.connect(
-            lambda state: self.cell_combo.setEnabled(state in (ExecutorState.READY, ExecutorState.FINISHED))
-        )
+        controller.run_state_changed.connect(self._on_run_state)
         self.run_presenter = RunPresenter(
             controller, views.canvas, views.blackboard, views.log, self.show_message, self
         )
@@ -318,6 +322,19 @@ class MainWindow(QMainWindow):
         return self.document.plan.path_of(node_id)
 
     # ------------------------------------------------------------------ cell
+
+    def _on_run_state(self, state: ExecutorState) -> None:
+        idle = state in (ExecutorState.READY, ExecutorState.FINISHED)
+        self.cell_combo.setEnabled(idle)
+        self.actions_by_name["reset_cell"].setEnabled(idle)
+
+    def reset_cell(self) -> None:
+        """Put robot and objects back to the scene's start (not while a plan runs)."""
+        if self.controller.reset_cell():
+            self.views.canvas.clear_statuses()
+            self.show_message(f"The {self.session.name} cell was reset")
+        else:
+            self.show_message("Stop the run before resetting the cell.")
 
     def switch_cell(self, name: str) -> None:
         """Open another cell (not while a plan runs)."""

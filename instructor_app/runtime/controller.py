@@ -175,8 +175,18 @@ class RunController(QObject):
 
     # ------------------------------------------------------------------ starting
 
+    def reset_cell(self) -> bool:
+        """Put the cell back to its start (see CellSession.reset); False while a plan runs."""
+        if self.is_running:
+            return False
+        self.session.reset()
+        self.log_message.emit(f"The {self.session.name} cell was reset", "info")
+        return True
+
     def _start(self, paused: bool) -> bool:
         plan = copy.deepcopy(self.document.plan)  # edits during the run do not reach it
+        if plan.reset_cell:
+            self.reset_cell()
         registry = self.session.registry
         problems = validate_plan(plan, registry)
         if has_errors(problems):
