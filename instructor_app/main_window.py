@@ -36,7 +36,7 @@ from instructor_app.runtime.run_view import (
     RunPresenter,
 )
 from instructor_app.runtime.session import CellSession
-from instructor_app.settings import AppSettings, RecentFilesMenu
+from instructor_app.settings import AppSettings, RecentFilesMenu, app_version, is_shipped_example
 from instructor_app.views import Views, make_views
 
 __all__ = ["APP_TITLE", "DISCARD", "Dialogs", "MainWindow", "Views", "make_views"]
@@ -395,12 +395,16 @@ class MainWindow(QMainWindow):
         return True
 
     def save_plan(self) -> bool:
-        if self.document.path is None:
+        """Save to the plan's file; asks for a new one (Save As) when it has none or when
+        it is a shipped example, which stays as shipped (also after a crash recovery)."""
+        path = self.document.path
+        if path is None or is_shipped_example(path):
             return self.save_plan_as()
-        return self._save_to(self.document.path)
+        return self._save_to(path)
 
     def save_plan_as(self) -> bool:
-        folder = Path(self.settings.last_dir() or Path.home())
+        last = self.settings.last_dir()
+        folder = Path(last) if last and not is_shipped_example(Path(last) / "x") else Path.home()
         chosen = self.dialogs.save_path(self, str(folder / f"{self._display_name()}"))
         if not chosen:
             return False
@@ -435,7 +439,7 @@ class MainWindow(QMainWindow):
     def _about(self) -> None:
         self.dialogs.about(
             self,
-            f"<b>{APP_TITLE}</b><p>Teach a robot a task by composing a behavior tree "
+            f"<b>{APP_TITLE}</b> {app_version()}<p>Teach a robot a task by composing a behavior tree "
             "(after CoSTAR, Guerin et al., ICRA 2015).</p>",
         )
 
