@@ -82,6 +82,10 @@ class CanvasView(QWidget):
         """How palette drops and "Add child" make nodes: ``factory(kind, op) -> NodeSpec``."""
         self.commands.node_factory = factory or default_node_factory
 
+    def set_operations(self, groups: Mapping[str, list[tuple[str, str]]]) -> None:
+        """What "Add child" offers besides logic nodes: capability title -> [(label, op)]."""
+        self.commands.operations = {title: list(ops) for title, ops in groups.items()}
+
     def set_operation_kinds(self, kinds: Mapping[str, OperationKind]) -> None:
         """Operation id -> kind, so that leaves get their action/query/condition colour."""
         table = dict(kinds)
