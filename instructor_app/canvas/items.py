@@ -45,7 +45,8 @@ from instructor_app.canvas.style import RGB, STATUS_COLOURS, NodeLook
 __all__ = ["TreeNode", "TreeNodeItem", "NODE_WIDTH", "DETAIL_LOD", "PARENT_PORT", "CHILD_PORT"]
 
 NODE_WIDTH = 180.0
-DETAIL_LOD = 0.4  # below this zoom only coloured boxes are drawn
+DETAIL_LOD = 0.4  # below this zoom: coloured boxes with the title drawn larger (see paint)
+OVERVIEW_TITLE_PX = 11.0  # the title's height on screen when zoomed out: still readable
 PARENT_PORT = "parent"
 CHILD_PORT = "children"
 
@@ -55,6 +56,7 @@ _TITLE_H = 24.0
 _LINE_H = 14.0
 _BORDER = QColor(70, 70, 70)
 _SELECTED = QColor(30, 110, 230)
+_BROKEN = QColor(200, 30, 30)
 _TEXT = QColor(20, 20, 20)
 _BADGE = QColor(60, 60, 60)
 _WHITE = QColor(255, 255, 255)
@@ -165,7 +167,10 @@ class TreeNodeItem(NodeItem):  # type: ignore[misc]
         self._elided = _Fonts.title_metrics.elidedText(
             look.title, Qt.TextElideMode.ElideRight, room
         )
-        self.setToolTip(look.title if self._elided != look.title else "")
+        tip = look.title if self._elided != look.title else ""
+        if look.broken:
+            tip = f"{look.title}\n{look.broken}".strip()
+        self.setToolTip(tip)
         self.draw_node()
 
     def set_status(self, status: Status | None) -> None:
@@ -325,11 +330,19 @@ class TreeNodeItem(NodeItem):  # type: ignore[misc]
         base = look.fill if look is not None else (200, 200, 200)
         fill = _qcolor(STATUS_COLOURS[self.status]) if self.status is not None else _qcolor(base)
         rect = QRectF(0.0, 0.0, self._width, self._height)
-        if painter.worldTransform().m11() < DETAIL_LOD:  # the view neither rotates nor shears
+        scale = painter.worldTransform().m11()  # the view neither rotates nor shears
+        if scale < DETAIL_LOD:
             painter.fillRect(rect, _SELECTED if self.isSelected() else fill)
+            if look is not None and look.broken:
+                painter.setPen(QPen(_BROKEN, 4.0 / max(scale, 0.05), Qt.PenStyle.DashLine))
+                painter.drawRect(rect)
+            self._paint_overview_title(painter, scale)
             return
         painter.save()
-        painter.setPen(QPen(_SELECTED, 3.0) if self.isSelected() else QPen(_BORDER, 1.0))
+        pen = QPen(_SELECTED, 3.0) if self.isSelected() else QPen(_BORDER, 1.0)
+        if look is not None and look.broken and not self.isSelected():
+            pen = QPen(_BROKEN, 2.5, Qt.PenStyle.DashLine)
+        painter.setPen(pen)
         painter.setBrush(QBrush(fill))
         painter.drawRoundedRect(rect, 6.0, 6.0)
         if self.status is not None and look is not None:
@@ -338,6 +351,23 @@ class TreeNodeItem(NodeItem):  # type: ignore[misc]
         if look is not None:
             self._paint_text(painter, look)
         self._paint_badges(painter)
+        painter.restore()
+
+    def _paint_overview_title(self, painter: QPainter, scale: float) -> None:
+        """Zoomed out, the title alone, with a font as tall on screen as OVERVIEW_TITLE_PX
+        (larger in the scene), elided to the box: never a blank box."""
+        font = QFont(_Fonts.title)
+        font.setPixelSize(max(1, round(OVERVIEW_TITLE_PX / max(scale, 0.01))))
+        room = QRectF(4.0, 0.0, self._width - 8.0, self._height)
+        text = QFontMetricsF(font).elidedText(
+            self.look.title if self.look is not None else "",
+            Qt.TextElideMode.ElideRight,
+            room.width(),
+        )
+        painter.save()
+        painter.setFont(font)
+        painter.setPen(_WHITE if self.isSelected() else _TEXT)
+        painter.drawText(room, Qt.AlignmentFlag.AlignCenter, text)
         painter.restore()
 
     def _paint_text(self, painter: QPainter, look: NodeLook) -> None:

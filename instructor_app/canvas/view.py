@@ -90,6 +90,7 @@ class CanvasView(QWidget):
         """Operation id -> kind, so that leaves get their action/query/condition colour."""
         table = dict(kinds)
         self.mirror.op_kind = table.get
+        self.mirror.kinds_known = True
         self.mirror.restyle()
 
     def set_statuses(self, mapping: Mapping[str, Status]) -> None:
