@@ -30,6 +30,7 @@ from PySide6.QtGui import (
     QFontMetricsF,
     QKeyEvent,
     QPainter,
+    QPainterPath,
     QPen,
 )
 from PySide6.QtWidgets import (
@@ -47,6 +48,8 @@ __all__ = ["TreeNode", "TreeNodeItem", "NODE_WIDTH", "DETAIL_LOD", "PARENT_PORT"
 NODE_WIDTH = 180.0
 DETAIL_LOD = 0.4  # below this zoom: coloured boxes with the title drawn larger (see paint)
 OVERVIEW_TITLE_PX = 11.0  # the title's height on screen when zoomed out: still readable
+_OVERVIEW_GROW = 30.0  # how far a zoomed-out box may grow up and down (inside its bounds)
+_OVERVIEW_LINES = 2  # a zoomed-out title wraps onto this many lines at most
 PARENT_PORT = "parent"
 CHILD_PORT = "children"
 
@@ -94,6 +97,14 @@ class _Fonts:
         cls.small.setPointSize(8)
         cls.title_metrics = QFontMetricsF(cls.title)
         cls.ready = True
+
+
+def _bounds(width: float, height: float) -> QRectF:
+    """The item's bounding rect: badges around the body, room above and below for the
+    taller zoomed-out box."""
+    top = -max(12.0, _OVERVIEW_GROW)
+    bottom = height + max(10.0, _OVERVIEW_GROW)
+    return QRectF(-12.0, top, width + 14.0, bottom - top)
 
 
 def paint_port(painter: QPainter, rect: QRectF, info: dict[str, Any]) -> None:
@@ -155,7 +166,7 @@ class TreeNodeItem(NodeItem):  # type: ignore[misc]
         self.index_badge = 0  # 1-based place among its parent's children; 0: none
         self.hidden_count = 0  # descendants hidden by collapsing; 0: expanded
         self._elided = ""
-        self._bounds = QRectF(-12.0, -12.0, self._width + 14.0, self._height + 22.0)
+        self._bounds = _bounds(self._width, self._height)
 
     # ------------------------------------------------------------------ content
 
@@ -258,7 +269,7 @@ class TreeNodeItem(NodeItem):  # type: ignore[misc]
         self._width = NODE_WIDTH
         self._height = 2.0 + _TITLE_H + lines * _LINE_H + _PAD
         # Room for the badges that stick out of the body.
-        self._bounds = QRectF(-12.0, -12.0, self._width + 14.0, self._height + 22.0)
+        self._bounds = _bounds(self._width, self._height)
         for port in self._input_items:
             rect = port.boundingRect()
             port.setPos((self._width - rect.width()) / 2, -rect.height() / 2)
@@ -317,7 +328,14 @@ class TreeNodeItem(NodeItem):  # type: ignore[misc]
 
     def boundingRect(self) -> QRectF:
         # Qt asks several times per item and frame: computed once per size in draw_node.
+        # It leaves room for the taller box of the zoomed-out look (see overview_rect).
         return self._bounds
+
+    def shape(self) -> QPainterPath:
+        """Body and badges: what clicks and rubber bands hit (not the overview's room)."""
+        path = QPainterPath()
+        path.addRect(QRectF(-12.0, -12.0, self._width + 14.0, self._height + 22.0))
+        return path
 
     def shape_rect(self) -> QRectF:
         """The body without the badges (hit tests for drops)."""
@@ -332,11 +350,7 @@ class TreeNodeItem(NodeItem):  # type: ignore[misc]
         rect = QRectF(0.0, 0.0, self._width, self._height)
         scale = painter.worldTransform().m11()  # the view neither rotates nor shears
         if scale < DETAIL_LOD:
-            painter.fillRect(rect, _SELECTED if self.isSelected() else fill)
-            if look is not None and look.broken:
-                painter.setPen(QPen(_BROKEN, 4.0 / max(scale, 0.05), Qt.PenStyle.DashLine))
-                painter.drawRect(rect)
-            self._paint_overview_title(painter, scale)
+            self._paint_overview(painter, scale, fill)
             return
         painter.save()
         pen = QPen(_SELECTED, 3.0) if self.isSelected() else QPen(_BORDER, 1.0)
@@ -353,21 +367,60 @@ class TreeNodeItem(NodeItem):  # type: ignore[misc]
         self._paint_badges(painter)
         painter.restore()
 
-    def _paint_overview_title(self, painter: QPainter, scale: float) -> None:
-        """Zoomed out, the title alone, with a font as tall on screen as OVERVIEW_TITLE_PX
-        (larger in the scene), elided to the box: never a blank box."""
+    def overview_rect(self, scale: float) -> QRectF:
+        """Zoomed out, the box grows in height (within the item's bounds) to hold a title
+        of up to two lines OVERVIEW_TITLE_PX tall on screen."""
+        lines = len(self._overview_lines(scale))
+        wanted = OVERVIEW_TITLE_PX * (1.25 * lines + 0.3) / max(scale, 0.01)
+        grow = min(_OVERVIEW_GROW, max(0.0, (wanted - self._height) / 2))
+        return QRectF(0.0, -grow, self._width, self._height + 2 * grow)
+
+    def _overview_font(self, scale: float) -> QFont:
         font = QFont(_Fonts.title)
-        font.setPixelSize(max(1, round(OVERVIEW_TITLE_PX / max(scale, 0.01))))
-        room = QRectF(4.0, 0.0, self._width - 8.0, self._height)
-        text = QFontMetricsF(font).elidedText(
-            self.look.title if self.look is not None else "",
-            Qt.TextElideMode.ElideRight,
-            room.width(),
-        )
+        most = (self._height + 2 * _OVERVIEW_GROW) / (1.25 * _OVERVIEW_LINES + 0.3)
+        font.setPixelSize(max(1, round(min(OVERVIEW_TITLE_PX / max(scale, 0.01), most))))
+        return font
+
+    def _overview_lines(self, scale: float) -> list[str]:
+        """The title wrapped at word breaks onto at most _OVERVIEW_LINES lines, the last
+        elided."""
+        title = self.look.title if self.look is not None else ""
+        metrics = QFontMetricsF(self._overview_font(scale))
+        room = self._width - 8.0
+        lines: list[str] = []
+        words = title.split()
+        while words and len(lines) < _OVERVIEW_LINES - 1:
+            count = 1
+            while count < len(words) and metrics.horizontalAdvance(
+                " ".join(words[: count + 1])
+            ) <= room:
+                count += 1
+            line = " ".join(words[:count])
+            if metrics.horizontalAdvance(line) > room:
+                break  # one word too long for a line: elide it on the last line
+            lines.append(line)
+            words = words[count:]
+        if words:
+            lines.append(metrics.elidedText(" ".join(words), Qt.TextElideMode.ElideRight, room))
+        return lines or [""]
+
+    def _paint_overview(self, painter: QPainter, scale: float, fill: QColor) -> None:
+        """Zoomed out: the box and its title alone, the title drawn larger in the scene so
+        that it stays about OVERVIEW_TITLE_PX tall on screen, wrapped onto two lines and
+        elided to the box: never a blank box."""
+        look = self.look
+        rect = self.overview_rect(scale)
+        painter.fillRect(rect, _SELECTED if self.isSelected() else fill)
+        if look is None:
+            return
         painter.save()
-        painter.setFont(font)
+        if look.broken:
+            painter.setPen(QPen(_BROKEN, 3.0 / max(scale, 0.05), Qt.PenStyle.DashLine))
+            painter.drawRect(rect)
+        painter.setFont(self._overview_font(scale))
         painter.setPen(_WHITE if self.isSelected() else _TEXT)
-        painter.drawText(room, Qt.AlignmentFlag.AlignCenter, text)
+        room = rect.adjusted(4.0, 0.0, -4.0, 0.0)
+        painter.drawText(room, Qt.AlignmentFlag.AlignCenter, "\n".join(self._overview_lines(scale)))
         painter.restore()
 
     def _paint_text(self, painter: QPainter, look: NodeLook) -> None:

@@ -25,7 +25,10 @@ from instructor_app.canvas.viewer import PALETTE_MIME, CanvasViewer
 from instructor_app.document.model import DocumentError, PlanDocument
 from instructor_app.document.tree_ops import can_have_child
 
-__all__ = ["CanvasView", "PALETTE_MIME"]
+__all__ = ["CanvasView", "PALETTE_MIME", "MIN_FIT_ZOOM"]
+
+# Fit never zooms out further: titles still show as two lines of about 8 characters.
+MIN_FIT_ZOOM = 0.25
 
 
 class CanvasView(QWidget):
@@ -160,13 +163,29 @@ class CanvasView(QWidget):
         return item.isVisible() and visible.contains(item.sceneBoundingRect())
 
     def fit_all(self) -> None:
-        """Zoom so that the whole tree shows."""
+        """Zoom so that the whole tree shows, but not below MIN_FIT_ZOOM, where titles would
+        be too small to read: a tree too large for that shows its top, around the root (the
+        rest is a scroll away)."""
         rect = QRectF()
         for node in self.mirror.nodes.values():
             if node.item.isVisible():
                 rect = rect.united(node.item.sceneBoundingRect())
-        if not rect.isNull():
-            self.viewer.show_rect(rect.adjusted(-40, -40, 40, 40))
+        if rect.isNull():
+            return
+        rect = rect.adjusted(-40, -40, 40, 40)
+        port = self.viewer.viewport().rect()
+        width, height = port.width() / MIN_FIT_ZOOM, port.height() / MIN_FIT_ZOOM
+        # Before it is shown the viewport has no real size yet: show all, the viewer keeps
+        # the rect in view when it gets its size.
+        if not self.viewer.isVisible() or (rect.width() <= width and rect.height() <= height):
+            self.viewer.show_rect(rect)
+            return
+        root = self.document.plan.tree
+        centre = rect.center().x()
+        if root is not None and root.id in self.mirror.nodes:
+            centre = self.mirror.nodes[root.id].item.sceneBoundingRect().center().x()
+        left = min(max(centre - width / 2, rect.left()), max(rect.left(), rect.right() - width))
+        self.viewer.show_rect(QRectF(left, rect.top(), width, height))
 
     def item(self, node_id: str) -> TreeNodeItem:
         """The graphics item of a node (tests, the failing-node display)."""
