@@ -18,6 +18,7 @@ from PySide6.QtWidgets import (
     QDockWidget,
     QLabel,
     QMainWindow,
+    QStackedWidget,
     QWidget,
 )
 
@@ -27,6 +28,7 @@ from instructor_app.document.model import DocumentError, PlanDocument
 from instructor_app.document.tree_ops import can_have_child
 from instructor_app.node_factory import make_node, manifest_or_none
 from instructor_app.panels.operator import OperatorPanel
+from instructor_app.panels.start_page import StartPage, find_examples
 from engine.executor import ExecutorState
 from instructor_app.runtime.controller import RunController
 from instructor_app.runtime.run_view import (
@@ -36,7 +38,13 @@ from instructor_app.runtime.run_view import (
     RunPresenter,
 )
 from instructor_app.runtime.session import CellSession
-from instructor_app.settings import AppSettings, RecentFilesMenu, app_version, is_shipped_example
+from instructor_app.settings import (
+    EXAMPLES_DIR,
+    AppSettings,
+    RecentFilesMenu,
+    app_version,
+    is_shipped_example,
+)
 from instructor_app.views import Views, make_views
 
 __all__ = ["APP_TITLE", "DISCARD", "Dialogs", "MainWindow", "Views", "make_views"]
@@ -89,7 +97,14 @@ class MainWindow(QMainWindow):
     # ------------------------------------------------------------------ layout
 
     def _build_layout(self) -> None:
-        self.setCentralWidget(self.views.canvas)
+        # The start page until there is a plan to show (new, open, a first node, recovery).
+        self.start_page = StartPage(find_examples(EXAMPLES_DIR), self.settings.recent_files)
+        self.start_page.new_requested.connect(self.new_plan)
+        self.start_page.open_requested.connect(lambda path: self.open_plan(path or None))
+        self.central = QStackedWidget(self)
+        self.central.addWidget(self.start_page)
+        self.central.addWidget(self.views.canvas)
+        self.setCentralWidget(self.central)
         self.docks: dict[str, QDockWidget] = {}
         area = Qt.DockWidgetArea
         self._dock("palette", "Palette", self.views.palette, area.LeftDockWidgetArea)
@@ -149,6 +164,7 @@ class MainWindow(QMainWindow):
         files = bar.addMenu("&File")
         files.addAction(self._action("new", "&New", self.new_plan, "Ctrl+N"))
         files.addAction(self._action("open", "&Open…", lambda: self.open_plan(), "Ctrl+O"))
+        files.addAction(self._action("start_page", "Start &Page", self.show_start_page))
         self.recent_menu = RecentFilesMenu(self.settings, self.open_plan, self)
         files.addMenu(self.recent_menu)
         files.addSeparator()
@@ -224,6 +240,7 @@ class MainWindow(QMainWindow):
         document.dirty_changed.connect(lambda _: self._update_title())
         document.path_changed.connect(lambda _: self._update_title())
         document.plan_reset.connect(self._on_plan_reset)
+        document.plan_changed.connect(self._leave_start_page_when_a_plan_shows)
         views.validation.revalidate()  # its first summary came before these connections
 
     def _wire_run(self) -> None:
@@ -308,7 +325,28 @@ class MainWindow(QMainWindow):
         parts += [f"{warnings} warning{'s' * (warnings != 1)}"] if warnings else []
         self.problems_label.setText(", ".join(parts) or "No problems")
 
+    # ------------------------------------------------------------------ start page
+
+    @property
+    def start_page_shown(self) -> bool:
+        return self.central.currentWidget() is self.start_page
+
+    def show_start_page(self) -> None:
+        self.start_page.refresh()
+        self.central.setCurrentWidget(self.start_page)
+
+    def show_canvas(self) -> None:
+        if not self.start_page_shown:
+            return
+        self.central.setCurrentWidget(self.views.canvas)
+        self.views.canvas.fit_all()
+
+    def _leave_start_page_when_a_plan_shows(self) -> None:
+        if self.document.plan.tree is not None or self.document.path is not None:
+            self.show_canvas()
+
     def _on_plan_reset(self) -> None:
+        self._leave_start_page_when_a_plan_shows()
         self.selection = []
         self.views.inspector.show_node(None)
         self.views.canvas.clear_statuses()
@@ -376,6 +414,7 @@ class MainWindow(QMainWindow):
     def new_plan(self) -> None:
         if self.maybe_save():
             self.document.new()
+            self.show_canvas()
 
     def open_plan(self, path: str | Path | None = None) -> bool:
         """Open a plan (asks for the file when ``path`` is None); False when not opened."""
