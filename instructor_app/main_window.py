@@ -22,6 +22,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from engine.executor import ExecutorState
 from instructor_app.dialogs import APP_TITLE, DISCARD, SAVE, Dialogs
 from instructor_app.document.autosave import DEFAULT_INTERVAL_MS, Autosaver, offer_recoveries
 from instructor_app.document.model import DocumentError, PlanDocument
@@ -29,7 +30,6 @@ from instructor_app.document.tree_ops import can_have_child
 from instructor_app.node_factory import make_node, manifest_or_none
 from instructor_app.panels.operator import OperatorPanel
 from instructor_app.panels.start_page import StartPage, find_examples
-from engine.executor import ExecutorState
 from instructor_app.runtime.controller import RunController
 from instructor_app.runtime.run_view import (
     FailureButton,
@@ -361,7 +361,7 @@ class MainWindow(QMainWindow):
 
     # ------------------------------------------------------------------ cell
 
-    def _on_run_state(self, state: ExecutorState) -> None:
+    def _on_run_state(self, state: object) -> None:
         idle = state in (ExecutorState.READY, ExecutorState.FINISHED)
         self.cell_combo.setEnabled(idle)
         self.actions_by_name["reset_cell"].setEnabled(idle)

@@ -16,8 +16,8 @@ from PySide6.QtWidgets import QMenu, QWidget
 from engine.spec import KIND_CATEGORY, Category, NodeKind, NodeLayout, NodeSpec
 from instructor_app.canvas.style import default_title
 from instructor_app.canvas.sync import has_position
-from instructor_app.document.tree_ops import can_have_child
 from instructor_app.document.model import SUBTREE_MIME, DocumentError, PlanDocument
+from instructor_app.document.tree_ops import can_have_child
 
 __all__ = ["CanvasActions", "NodeFactory", "default_node_factory", "LOGIC_KINDS"]
 
@@ -229,9 +229,7 @@ class CanvasActions(QObject):
                 action = group.addAction(label)
                 action.setData(op)
                 action.triggered.connect(
-                    self._guard(
-                        functools.partial(self._add_to, node_id, NodeKind.OPERATION, op)
-                    )
+                    self._guard(functools.partial(self._add_to, node_id, NodeKind.OPERATION, op))
                 )
 
     def _add_to(self, parent_id: str, kind: NodeKind, op: str | None = None) -> None:

@@ -391,9 +391,10 @@ class TreeNodeItem(NodeItem):  # type: ignore[misc]
         words = title.split()
         while words and len(lines) < _OVERVIEW_LINES - 1:
             count = 1
-            while count < len(words) and metrics.horizontalAdvance(
-                " ".join(words[: count + 1])
-            ) <= room:
+            while (
+                count < len(words)
+                and metrics.horizontalAdvance(" ".join(words[: count + 1])) <= room
+            ):
                 count += 1
             line = " ".join(words[:count])
             if metrics.horizontalAdvance(line) > room:

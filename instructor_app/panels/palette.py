@@ -297,8 +297,8 @@ class PalettePanel(QWidget):
             )
             for _rank, _index, item in ranked:
                 self.hits.addItem(self._hit_row(item))
-            first = next((i for i, (_r, _n, it) in enumerate(ranked) if it.available), -1)
-            self.hits.setCurrentRow(first)
+            first_hit = next((i for i, (_r, _n, it) in enumerate(ranked) if it.available), -1)
+            self.hits.setCurrentRow(first_hit)
         for row, item in self._rows():
             row.setHidden(not item.matches(text))
         for group in self._group_rows():

@@ -45,7 +45,7 @@ class PlanSettingsPanel(QWidget):
         self.policy_combo.activated.connect(self._policy_chosen)
         self.reset_box = QCheckBox("Reset the cell before each run")
         self.reset_box.setToolTip("Robot and objects go back to the scene's start before a run")
-        self.reset_box.clicked.connect(self._reset_clicked)
+        self.reset_box.clicked.connect(lambda: self._reset_clicked(self.reset_box.isChecked()))
         form = QFormLayout(self)
         form.setContentsMargins(4, 4, 4, 4)
         form.addRow("Name", self.name_field)

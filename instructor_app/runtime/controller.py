@@ -27,7 +27,6 @@ from instructor_app.runtime.session import CellSession
 __all__ = ["RunController", "RunOutcome"]
 
 
-
 @dataclass(frozen=True)
 class RunOutcome:
     """How a run ended.

@@ -58,7 +58,7 @@ class RunActions(QObject):
     def all(self) -> list[QAction]:
         return [self.run, self.pause, self.step, self.stop]
 
-    def update_state(self, state: ExecutorState) -> None:
+    def update_state(self, state: object) -> None:
         idle = state in (ExecutorState.READY, ExecutorState.FINISHED)
         self.run.setEnabled(idle or state == ExecutorState.PAUSED)
         self.pause.setEnabled(state == ExecutorState.RUNNING)
@@ -166,7 +166,7 @@ class RunPresenter(QObject):
         controller.run_refused.connect(self._on_refused)
         controller.run_finished.connect(self._on_finished)
 
-    def _on_state(self, state: ExecutorState) -> None:
+    def _on_state(self, state: object) -> None:
         if state in (ExecutorState.RUNNING, ExecutorState.PAUSED) and not self._active:
             self._active = True  # a new run: last run's colours and values go
             self._canvas.clear_statuses()

@@ -38,7 +38,9 @@ def thirty_node_plan() -> PlanSpec:
         NodeKind.SELECTOR,
         name="transfer or wait",
         children=[
-            _seq("transfer", _seq("pick", *_leaves("pick", 6)), _seq("place", *_leaves("place", 5))),
+            _seq(
+                "transfer", _seq("pick", *_leaves("pick", 6)), _seq("place", *_leaves("place", 5))
+            ),
             NodeSpec(
                 NodeKind.FORCE_FAILURE, name="look again", children=[op("debug.succeed", "WAIT")]
             ),
@@ -118,7 +120,8 @@ def test_fit_of_a_too_wide_plan_stays_readable_around_the_root(
     canvas = window.views.canvas
     assert abs(canvas.viewer.transform().m11() - MIN_FIT_ZOOM) < 0.01
     shown = [i for i in ids if canvas.is_visible_in_view(i)]
-    assert window.document.plan.tree.id in shown and len(shown) >= 8
+    tree = window.document.plan.tree
+    assert tree is not None and tree.id in shown and len(shown) >= 8
     for node_id in shown:
         _assert_label_painted(window, image, node_id)
 
@@ -135,7 +138,9 @@ def test_unknown_operation_is_drawn_broken(
     canvas = window.views.canvas
     item = canvas.item(ghost.id)
     assert "unknown operation" in item.toolTip().lower()
-    fine = canvas.item(window.document.plan.tree.children[1].id)
+    tree = window.document.plan.tree
+    assert tree is not None
+    fine = canvas.item(tree.children[1].id)
     assert fine.toolTip() == "" or "unknown" not in fine.toolTip().lower()
     # The painted border is red (the broken look), the other leaf's is not.
     canvas.center_on(ghost.id)

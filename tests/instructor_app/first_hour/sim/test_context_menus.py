@@ -18,8 +18,9 @@ def _texts(menu: QMenu) -> list[str]:
 
 def _submenu(menu: QMenu, title: str) -> QMenu:
     for action in menu.actions():
-        if action.text() == title and action.menu() is not None:
-            return action.menu()
+        submenu = action.menu()
+        if action.text() == title and isinstance(submenu, QMenu):
+            return submenu
     raise LookupError(f"no submenu {title!r} in {_texts(menu)}")
 
 
