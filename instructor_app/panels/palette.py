@@ -161,7 +161,7 @@ class PalettePanel(QWidget):
     ) -> None:
         super().__init__(parent)
         self.search_field = QLineEdit()
-        self.search_field.setPlaceholderText("Search nodes… (↑↓ choose, Enter inserts)")
+        self.search_field.setPlaceholderText("Search… (↑↓, Enter inserts)")
         self.search_field.setClearButtonEnabled(True)
         self.search_field.textChanged.connect(self._filter)
         self.search_field.returnPressed.connect(self._insert_current_hit)

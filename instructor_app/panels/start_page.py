@@ -71,13 +71,15 @@ def plan_preview(plan: PlanSpec, size: QSize = PREVIEW_SIZE) -> QPixmap:
     right = max(x for x, _ in positions.values()) + width
     bottom = max(y for _, y in positions.values()) + height
     margin = 8.0
-    scale = min((size.width() - 2 * margin) / right, (size.height() - 2 * margin) / bottom)
-    dx = (size.width() - right * scale) / 2
-    dy = (size.height() - bottom * scale) / 2
+    # Trees are wide and short: the height may stretch (up to 3x) to fill the picture.
+    sx = min((size.width() - 2 * margin) / right, (size.height() - 2 * margin) / bottom)
+    sy = min(3 * sx, (size.height() - 2 * margin) / bottom)
+    dx = (size.width() - right * sx) / 2
+    dy = (size.height() - bottom * sy) / 2
 
     def box(node_id: str) -> QRectF:
         x, y = positions[node_id]
-        return QRectF(dx + x * scale, dy + y * scale, width * scale, height * scale)
+        return QRectF(dx + x * sx, dy + y * sy, width * sx, height * sy)
 
     painter = QPainter(pixmap)
     painter.setRenderHint(QPainter.RenderHint.Antialiasing)
