@@ -41,15 +41,13 @@ from PySide6.QtWidgets import (
 )
 
 from engine.status import Status
+from instructor_app.canvas import overview
 from instructor_app.canvas.style import RGB, STATUS_COLOURS, NodeLook
 
 __all__ = ["TreeNode", "TreeNodeItem", "NODE_WIDTH", "DETAIL_LOD", "PARENT_PORT", "CHILD_PORT"]
 
 NODE_WIDTH = 180.0
 DETAIL_LOD = 0.4  # below this zoom: coloured boxes with the title drawn larger (see paint)
-OVERVIEW_TITLE_PX = 11.0  # the title's height on screen when zoomed out: still readable
-_OVERVIEW_GROW = 30.0  # how far a zoomed-out box may grow up and down (inside its bounds)
-_OVERVIEW_LINES = 2  # a zoomed-out title wraps onto this many lines at most
 PARENT_PORT = "parent"
 CHILD_PORT = "children"
 
@@ -102,8 +100,8 @@ class _Fonts:
 def _bounds(width: float, height: float) -> QRectF:
     """The item's bounding rect: badges around the body, room above and below for the
     taller zoomed-out box."""
-    top = -max(12.0, _OVERVIEW_GROW)
-    bottom = height + max(10.0, _OVERVIEW_GROW)
+    top = -max(12.0, overview.GROW)
+    bottom = height + max(10.0, overview.GROW)
     return QRectF(-12.0, top, width + 14.0, bottom - top)
 
 
@@ -368,61 +366,20 @@ class TreeNodeItem(NodeItem):  # type: ignore[misc]
         painter.restore()
 
     def overview_rect(self, scale: float) -> QRectF:
-        """Zoomed out, the box grows in height (within the item's bounds) to hold a title
-        of up to two lines OVERVIEW_TITLE_PX tall on screen."""
-        lines = len(self._overview_lines(scale))
-        wanted = OVERVIEW_TITLE_PX * (1.25 * lines + 0.3) / max(scale, 0.01)
-        grow = min(_OVERVIEW_GROW, max(0.0, (wanted - self._height) / 2))
-        return QRectF(0.0, -grow, self._width, self._height + 2 * grow)
+        """The box as drawn zoomed out (taller, to hold the title; see canvas.overview)."""
+        return overview.box(self._title(), self._width, self._height, scale)
 
-    def _overview_font(self, scale: float) -> QFont:
-        font = QFont(_Fonts.title)
-        most = (self._height + 2 * _OVERVIEW_GROW) / (1.25 * _OVERVIEW_LINES + 0.3)
-        font.setPixelSize(max(1, round(min(OVERVIEW_TITLE_PX / max(scale, 0.01), most))))
-        return font
-
-    def _overview_lines(self, scale: float) -> list[str]:
-        """The title wrapped at word breaks onto at most _OVERVIEW_LINES lines, the last
-        elided."""
-        title = self.look.title if self.look is not None else ""
-        metrics = QFontMetricsF(self._overview_font(scale))
-        room = self._width - 8.0
-        lines: list[str] = []
-        words = title.split()
-        while words and len(lines) < _OVERVIEW_LINES - 1:
-            count = 1
-            while (
-                count < len(words)
-                and metrics.horizontalAdvance(" ".join(words[: count + 1])) <= room
-            ):
-                count += 1
-            line = " ".join(words[:count])
-            if metrics.horizontalAdvance(line) > room:
-                break  # one word too long for a line: elide it on the last line
-            lines.append(line)
-            words = words[count:]
-        if words:
-            lines.append(metrics.elidedText(" ".join(words), Qt.TextElideMode.ElideRight, room))
-        return lines or [""]
+    def _title(self) -> str:
+        return self.look.title if self.look is not None else ""
 
     def _paint_overview(self, painter: QPainter, scale: float, fill: QColor) -> None:
-        """Zoomed out: the box and its title alone, the title drawn larger in the scene so
-        that it stays about OVERVIEW_TITLE_PX tall on screen, wrapped onto two lines and
-        elided to the box: never a blank box."""
         look = self.look
-        rect = self.overview_rect(scale)
-        painter.fillRect(rect, _SELECTED if self.isSelected() else fill)
-        if look is None:
-            return
-        painter.save()
-        if look.broken:
-            painter.setPen(QPen(_BROKEN, 3.0 / max(scale, 0.05), Qt.PenStyle.DashLine))
-            painter.drawRect(rect)
-        painter.setFont(self._overview_font(scale))
-        painter.setPen(_WHITE if self.isSelected() else _TEXT)
-        room = rect.adjusted(4.0, 0.0, -4.0, 0.0)
-        painter.drawText(room, Qt.AlignmentFlag.AlignCenter, "\n".join(self._overview_lines(scale)))
-        painter.restore()
+        selected = self.isSelected()
+        overview.paint(
+            painter, self._title(), QRectF(0.0, 0.0, self._width, self._height), scale,
+            _SELECTED if selected else fill, _WHITE if selected else _TEXT,
+            _BROKEN if look is not None and look.broken else None,
+        )  # fmt: skip
 
     def _paint_text(self, painter: QPainter, look: NodeLook) -> None:
         painter.setPen(_TEXT)
