@@ -1,6 +1,6 @@
 """``costar-instructor``: the desktop application.
 
-``costar-instructor [PLAN] [--cell sim|none] [--seed N] [--run] [--screenshot PNG]``
+``costar-instructor [PLAN] [--cell sim|none] [--seed N] [--run] [--screenshot PNG] [--size WxH]``
 
 Without ``--screenshot`` it opens the window and runs the event loop. With it, it renders the
 main window to a PNG and exits, after the run finished when ``--run`` is given, so that a
@@ -58,9 +58,24 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--run", action="store_true", help="run the plan once it is open")
     parser.add_argument("--screenshot", metavar="PNG",
                         help="render the window to PNG and exit (after the run with --run)")  # fmt: skip
+    parser.add_argument("--size", type=_size, default=(1920, 1080), metavar="WxH",
+                        help="with --screenshot: the window's size (default 1920x1080)")  # fmt: skip
     parser.add_argument("--timeout", type=float, default=120.0,
                         help="with --screenshot --run: give up after this many seconds (exit 3)")  # fmt: skip
     return parser
+
+
+def _size(text: str) -> tuple[int, int]:
+    """``1400x900`` -> (1400, 900)."""
+    try:
+        width, height = (int(part) for part in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected WIDTHxHEIGHT such as 1400x900, got {text!r}"
+        ) from None
+    if width < 200 or height < 200:
+        raise argparse.ArgumentTypeError(f"{text!r} is too small: at least 200x200")
+    return width, height
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -119,7 +134,7 @@ def _screenshot(args: argparse.Namespace) -> int:
                 except DocumentError as exc:
                     print(f"error: {exc}", file=sys.stderr)
                     return EXIT_BAD_INPUT
-            window.resize(1920, 1080)
+            window.resize(*args.size)
             window.show()
             code = _run_for_picture(window, args.timeout) if args.run else EXIT_OK
             _grab(window, Path(args.screenshot))
@@ -181,12 +196,13 @@ def _grab(window: MainWindow, path: Path) -> None:
     shown = _node_to_show(window)
     if shown is not None:
         window.select_node(shown)
-    window.views.canvas.fit_all()
     # Dock layouts settle over a few event-loop turns (tabified docks re-parent their tab
-    # bars); let them, so that the picture shows the window as a person would see it.
+    # bars); let them, so that the picture shows the window as a person would see it, and
+    # fit the plan to the canvas's settled size.
     settle = QEventLoop()
     QTimer.singleShot(200, settle.quit)
     settle.exec()
+    window.views.canvas.fit_all()
     QApplication.processEvents()
     path.parent.mkdir(parents=True, exist_ok=True)
     if not window.grab().save(str(path), "PNG"):

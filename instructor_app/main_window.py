@@ -18,15 +18,19 @@ from PySide6.QtWidgets import (
     QDockWidget,
     QLabel,
     QMainWindow,
+    QStackedWidget,
     QWidget,
 )
 
+from engine.executor import ExecutorState
 from instructor_app.dialogs import APP_TITLE, DISCARD, SAVE, Dialogs
 from instructor_app.document.autosave import DEFAULT_INTERVAL_MS, Autosaver, offer_recoveries
 from instructor_app.document.model import DocumentError, PlanDocument
+from instructor_app.document.tree_ops import can_have_child
 from instructor_app.node_factory import make_node, manifest_or_none
 from instructor_app.panels.operator import OperatorPanel
-from instructor_app.runtime.controller import FINISHED, IDLE, RunController
+from instructor_app.panels.start_page import StartPage, find_examples
+from instructor_app.runtime.controller import RunController
 from instructor_app.runtime.run_view import (
     FailureButton,
     RunActions,
@@ -34,7 +38,13 @@ from instructor_app.runtime.run_view import (
     RunPresenter,
 )
 from instructor_app.runtime.session import CellSession
-from instructor_app.settings import AppSettings, RecentFilesMenu
+from instructor_app.settings import (
+    EXAMPLES_DIR,
+    AppSettings,
+    RecentFilesMenu,
+    app_version,
+    is_shipped_example,
+)
 from instructor_app.views import Views, make_views
 
 __all__ = ["APP_TITLE", "DISCARD", "Dialogs", "MainWindow", "Views", "make_views"]
@@ -87,7 +97,14 @@ class MainWindow(QMainWindow):
     # ------------------------------------------------------------------ layout
 
     def _build_layout(self) -> None:
-        self.setCentralWidget(self.views.canvas)
+        # The start page until there is a plan to show (new, open, a first node, recovery).
+        self.start_page = StartPage(find_examples(EXAMPLES_DIR), self.settings.recent_files)
+        self.start_page.new_requested.connect(self.new_plan)
+        self.start_page.open_requested.connect(lambda path: self.open_plan(path or None))
+        self.central = QStackedWidget(self)
+        self.central.addWidget(self.start_page)
+        self.central.addWidget(self.views.canvas)
+        self.setCentralWidget(self.central)
         self.docks: dict[str, QDockWidget] = {}
         area = Qt.DockWidgetArea
         self._dock("palette", "Palette", self.views.palette, area.LeftDockWidgetArea)
@@ -147,6 +164,7 @@ class MainWindow(QMainWindow):
         files = bar.addMenu("&File")
         files.addAction(self._action("new", "&New", self.new_plan, "Ctrl+N"))
         files.addAction(self._action("open", "&Open…", lambda: self.open_plan(), "Ctrl+O"))
+        files.addAction(self._action("start_page", "Start &Page", self.show_start_page))
         self.recent_menu = RecentFilesMenu(self.settings, self.open_plan, self)
         files.addMenu(self.recent_menu)
         files.addSeparator()
@@ -155,13 +173,19 @@ class MainWindow(QMainWindow):
         files.addSeparator()
         files.addAction(self._action("quit", "&Quit", self.close, "Ctrl+Q"))
         self._build_edit_menus()
-        bar.addMenu("&Run").addActions(self.run_actions.all())
+        reset = self._action("reset_cell", "Reset &Cell", self.reset_cell, "Ctrl+R")
+        reset.setToolTip("Put the robot and the objects back where the scene starts them")
+        run_menu = bar.addMenu("&Run")
+        run_menu.addActions(self.run_actions.all())
+        run_menu.addSeparator()
+        run_menu.addAction(reset)
         help_menu = bar.addMenu("&Help")
         help_menu.addAction(self._action("about", f"&About {APP_TITLE}", self._about))
         toolbar = self.addToolBar("Run")
         toolbar.setObjectName("run_toolbar")
         toolbar.addActions(self.run_actions.all())
         toolbar.addSeparator()
+        toolbar.addAction(reset)
         toolbar.addWidget(self.cell_label)
         toolbar.addWidget(self.cell_combo)
 
@@ -216,6 +240,7 @@ class MainWindow(QMainWindow):
         document.dirty_changed.connect(lambda _: self._update_title())
         document.path_changed.connect(lambda _: self._update_title())
         document.plan_reset.connect(self._on_plan_reset)
+        document.plan_changed.connect(self._leave_start_page_when_a_plan_shows)
         views.validation.revalidate()  # its first summary came before these connections
 
     def _wire_run(self) -> None:
@@ -225,9 +250,7 @@ class MainWindow(QMainWindow):
         controller.log_message.connect(views.log.append)
         controller.running_nodes_changed.connect(self.running_panel.set_nodes)
         controller.failure_changed.connect(self.failure_button.show_failure)
-        controller.run_state_changed.connect(
-            lambda state: self.cell_combo.setEnabled(state in (IDLE, FINISHED))
-        )
+        controller.run_state_changed.connect(self._on_run_state)
         self.run_presenter = RunPresenter(
             controller, views.canvas, views.blackboard, views.log, self.show_message, self
         )
@@ -254,23 +277,44 @@ class MainWindow(QMainWindow):
             self.views.canvas.center_on(node_id)
 
     def add_palette_item(self, item: Any) -> str | None:
-        """Add the palette item's node under the selected node (as root when the plan is
-        empty); returns the new node's id, or None with a status-bar message."""
+        """Add the palette item's node where the selection says; returns the new node's id,
+        or None with a status-bar message.
+
+        With a node selected that can take a child, the new node becomes its last child;
+        with a leaf (or a full decorator) selected, it goes right after it, as a sibling.
+        Nothing selected: under the root (as the root when the plan is empty). The new
+        node is selected, so that consecutive inserts with a leaf line up one after the
+        other, and the view scrolls to it.
+        """
         if not item.available:
             self.show_message(f"{item.label} cannot be used on this cell: {item.reason}")
             return None
         node = make_node(item, manifest_or_none(self.session.registry, item.op))
-        plan = self.document.plan
-        parent_id = self.selection[0] if self.selection else None
-        if plan.tree is not None and parent_id is None:
-            parent_id = plan.tree.id
         try:
-            new_id = self.document.add_node(node, parent_id)
+            parent_id, index = self._insertion_point()
+            new_id = self.document.add_node(node, parent_id, index)
         except DocumentError as exc:
-            self.show_message(f"Cannot add {node.label} here: {exc}. Select a composite node.")
+            self.show_message(f"Cannot add {node.label} here: {exc}")
             return None
-        self.views.canvas.select(new_id)
+        canvas = self.views.canvas
+        canvas.select(new_id)
+        canvas.ensure_visible(new_id)
         return new_id
+
+    def _insertion_point(self) -> tuple[str | None, int | None]:
+        """(parent id, index) for a new node from the selection (see add_palette_item)."""
+        plan = self.document.plan
+        if plan.tree is None:
+            return None, None
+        selected = self.selection[0] if self.selection else plan.tree.id
+        if can_have_child(self.document.node(selected)):
+            return selected, None
+        parent_id, index, _ = self.document.locate(selected)
+        if parent_id is None:
+            raise DocumentError(f"{self._node_label(selected)!r} is the root and takes no child")
+        if not can_have_child(self.document.node(parent_id)):
+            raise DocumentError(f"{self._node_label(parent_id)!r} cannot take another child")
+        return parent_id, index + 1
 
     def _on_selection(self, node_ids: list[str]) -> None:
         self.selection = list(node_ids)
@@ -281,7 +325,28 @@ class MainWindow(QMainWindow):
         parts += [f"{warnings} warning{'s' * (warnings != 1)}"] if warnings else []
         self.problems_label.setText(", ".join(parts) or "No problems")
 
+    # ------------------------------------------------------------------ start page
+
+    @property
+    def start_page_shown(self) -> bool:
+        return self.central.currentWidget() is self.start_page
+
+    def show_start_page(self) -> None:
+        self.start_page.refresh()
+        self.central.setCurrentWidget(self.start_page)
+
+    def show_canvas(self) -> None:
+        if not self.start_page_shown:
+            return
+        self.central.setCurrentWidget(self.views.canvas)
+        self.views.canvas.fit_all()
+
+    def _leave_start_page_when_a_plan_shows(self) -> None:
+        if self.document.plan.tree is not None or self.document.path is not None:
+            self.show_canvas()
+
     def _on_plan_reset(self) -> None:
+        self._leave_start_page_when_a_plan_shows()
         self.selection = []
         self.views.inspector.show_node(None)
         self.views.canvas.clear_statuses()
@@ -295,6 +360,19 @@ class MainWindow(QMainWindow):
         return self.document.plan.path_of(node_id)
 
     # ------------------------------------------------------------------ cell
+
+    def _on_run_state(self, state: object) -> None:
+        idle = state in (ExecutorState.READY, ExecutorState.FINISHED)
+        self.cell_combo.setEnabled(idle)
+        self.actions_by_name["reset_cell"].setEnabled(idle)
+
+    def reset_cell(self) -> None:
+        """Put robot and objects back to the scene's start (not while a plan runs)."""
+        if self.controller.reset_cell():
+            self.views.canvas.clear_statuses()
+            self.show_message(f"The {self.session.name} cell was reset")
+        else:
+            self.show_message("Stop the run before resetting the cell.")
 
     def switch_cell(self, name: str) -> None:
         """Open another cell (not while a plan runs)."""
@@ -336,6 +414,7 @@ class MainWindow(QMainWindow):
     def new_plan(self) -> None:
         if self.maybe_save():
             self.document.new()
+            self.show_canvas()
 
     def open_plan(self, path: str | Path | None = None) -> bool:
         """Open a plan (asks for the file when ``path`` is None); False when not opened."""
@@ -355,12 +434,16 @@ class MainWindow(QMainWindow):
         return True
 
     def save_plan(self) -> bool:
-        if self.document.path is None:
+        """Save to the plan's file; asks for a new one (Save As) when it has none or when
+        it is a shipped example, which stays as shipped (also after a crash recovery)."""
+        path = self.document.path
+        if path is None or is_shipped_example(path):
             return self.save_plan_as()
-        return self._save_to(self.document.path)
+        return self._save_to(path)
 
     def save_plan_as(self) -> bool:
-        folder = Path(self.settings.last_dir() or Path.home())
+        last = self.settings.last_dir()
+        folder = Path(last) if last and not is_shipped_example(Path(last) / "x") else Path.home()
         chosen = self.dialogs.save_path(self, str(folder / f"{self._display_name()}"))
         if not chosen:
             return False
@@ -395,7 +478,7 @@ class MainWindow(QMainWindow):
     def _about(self) -> None:
         self.dialogs.about(
             self,
-            f"<b>{APP_TITLE}</b><p>Teach a robot a task by composing a behavior tree "
+            f"<b>{APP_TITLE}</b> {app_version()}<p>Teach a robot a task by composing a behavior tree "
             "(after CoSTAR, Guerin et al., ICRA 2015).</p>",
         )
 

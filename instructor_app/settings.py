@@ -7,22 +7,52 @@ that tests use a temporary file and never the user's settings.
 from __future__ import annotations
 
 from collections.abc import Callable
+from importlib import metadata
 from pathlib import Path
 
 from PySide6.QtCore import QByteArray, QSettings
 from PySide6.QtGui import QAction
 from PySide6.QtWidgets import QMenu, QWidget
 
-__all__ = ["AppSettings", "RecentFilesMenu", "ORGANIZATION", "APPLICATION", "MAX_RECENT"]
+__all__ = [
+    "AppSettings",
+    "RecentFilesMenu",
+    "ORGANIZATION",
+    "APPLICATION",
+    "MAX_RECENT",
+    "EXAMPLES_DIR",
+    "app_version",
+    "is_shipped_example",
+]
 
 ORGANIZATION = "CoSTAR"
 APPLICATION = "Instructor"
 MAX_RECENT = 10
 
+# The plans shipped with the application (the start page lists them).
+EXAMPLES_DIR = Path(__file__).resolve().parents[1] / "resources" / "examples"
+DISTRIBUTION = "costar-instructor"
+
 _RECENT = "files/recent"
 _LAST_DIR = "files/last_dir"
 _GEOMETRY = "window/geometry"
 _STATE = "window/state"
+
+
+def app_version() -> str:
+    """The installed package's version ("unknown" when it runs from an uninstalled tree)."""
+    try:
+        return metadata.version(DISTRIBUTION)
+    except metadata.PackageNotFoundError:
+        return "unknown"
+
+
+def is_shipped_example(path: Path) -> bool:
+    """Whether ``path`` is in the shipped examples folder (those files stay as shipped)."""
+    try:
+        return path.resolve().is_relative_to(EXAMPLES_DIR)
+    except OSError:
+        return False
 
 
 class AppSettings:

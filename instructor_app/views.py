@@ -40,6 +40,12 @@ class Views:
         for view in (self.palette, self.inspector, self.validation, self.waypoints):
             view.set_registry(registry)
         self.canvas.set_operation_kinds({m.id: m.kind for m in registry.manifests()})
+        operations: dict[str, list[tuple[str, str]]] = {}
+        for item in self.palette.items():
+            if item.op is not None and item.available:
+                title = item.group.replace("_", " ").capitalize()
+                operations.setdefault(title, []).append((item.label, item.op))
+        self.canvas.set_operations(operations)
         library = registry.cell.interfaces().get("objects")
         self.inspector.set_object_names(library.names() if library is not None else [])
 

@@ -17,12 +17,13 @@ from engine.spec import KIND_CATEGORY, Category, NodeKind, NodeLayout, NodeSpec
 from instructor_app.canvas.style import default_title
 from instructor_app.canvas.sync import has_position
 from instructor_app.document.model import SUBTREE_MIME, DocumentError, PlanDocument
+from instructor_app.document.tree_ops import can_have_child
 
 __all__ = ["CanvasActions", "NodeFactory", "default_node_factory", "LOGIC_KINDS"]
 
 NodeFactory = Callable[[NodeKind, "str | None"], NodeSpec]
 
-# What "Add child" offers: every kind but operations (those come from the palette).
+# What "Add child" offers first: every kind but operations (those follow, by capability).
 LOGIC_KINDS = tuple(kind for kind in NodeKind if kind is not NodeKind.OPERATION)
 
 _SHORTCUTS: dict[str, tuple[str, QKeySequence | QKeySequence.StandardKey | str]] = {
@@ -58,6 +59,8 @@ class CanvasActions(QObject):
         super().__init__(owner)
         self.document = document
         self.selected = selected
+        # capability title -> [(label, operation id)], set from the cell's registry
+        self.operations: dict[str, list[tuple[str, str]]] = {}
         self.node_factory: NodeFactory = default_node_factory
         self.actions: dict[str, QAction] = {}
         handlers: dict[str, Callable[[], None]] = {
@@ -189,22 +192,18 @@ class CanvasActions(QObject):
         """The menu of a right click on ``node_id`` (None: on the empty canvas)."""
         menu = QMenu(parent)
         if node_id is not None:
-            add_menu = menu.addMenu("Add child")
-            previous: Category | None = None
-            for kind in LOGIC_KINDS:
-                if previous is not None and KIND_CATEGORY[kind] is not previous:
-                    add_menu.addSeparator()
-                previous = KIND_CATEGORY[kind]
-                action = add_menu.addAction(default_title(NodeSpec(kind=kind)))
-                action.setData(kind.value)
-                action.triggered.connect(
-                    self._guard(functools.partial(self._add_to, node_id, kind))
-                )
-            menu.addSeparator()
-            for name in ("delete", "duplicate", "copy", "cut", "paste"):
+            takes_child = can_have_child(self.document.node(node_id))
+            if takes_child:
+                self._add_child_menu(menu.addMenu("Add child"), node_id)
+                menu.addSeparator()
+            for name in ("delete", "duplicate", "copy", "cut"):
                 menu.addAction(self.actions[name])
+            if takes_child:
+                menu.addAction(self.actions["paste"])
             menu.addSeparator()
-            for name in ("toggle_collapse", "move_left", "move_right"):
+            if self.document.node(node_id).children:
+                menu.addAction(self.actions["toggle_collapse"])
+            for name in ("move_left", "move_right"):
                 menu.addAction(self.actions[name])
         else:
             menu.addAction(self.actions["paste"])
@@ -212,8 +211,29 @@ class CanvasActions(QObject):
         menu.addAction(self.actions["auto_layout"])
         return menu
 
-    def _add_to(self, parent_id: str, kind: NodeKind) -> None:
-        self.add_child(parent_id, kind)
+    def _add_child_menu(self, add_menu: QMenu, node_id: str) -> None:
+        """Logic nodes by category, then one submenu of operations per capability."""
+        previous: Category | None = None
+        for kind in LOGIC_KINDS:
+            if previous is not None and KIND_CATEGORY[kind] is not previous:
+                add_menu.addSeparator()
+            previous = KIND_CATEGORY[kind]
+            action = add_menu.addAction(default_title(NodeSpec(kind=kind)))
+            action.setData(kind.value)
+            action.triggered.connect(self._guard(functools.partial(self._add_to, node_id, kind)))
+        if self.operations:
+            add_menu.addSeparator()
+        for title, ops in self.operations.items():
+            group = add_menu.addMenu(title)
+            for label, op in ops:
+                action = group.addAction(label)
+                action.setData(op)
+                action.triggered.connect(
+                    self._guard(functools.partial(self._add_to, node_id, NodeKind.OPERATION, op))
+                )
+
+    def _add_to(self, parent_id: str, kind: NodeKind, op: str | None = None) -> None:
+        self.add_child(parent_id, kind, op)
 
     # ------------------------------------------------------------------ helpers
 

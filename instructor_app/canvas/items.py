@@ -30,6 +30,7 @@ from PySide6.QtGui import (
     QFontMetricsF,
     QKeyEvent,
     QPainter,
+    QPainterPath,
     QPen,
 )
 from PySide6.QtWidgets import (
@@ -40,12 +41,13 @@ from PySide6.QtWidgets import (
 )
 
 from engine.status import Status
+from instructor_app.canvas import overview
 from instructor_app.canvas.style import RGB, STATUS_COLOURS, NodeLook
 
 __all__ = ["TreeNode", "TreeNodeItem", "NODE_WIDTH", "DETAIL_LOD", "PARENT_PORT", "CHILD_PORT"]
 
 NODE_WIDTH = 180.0
-DETAIL_LOD = 0.4  # below this zoom only coloured boxes are drawn
+DETAIL_LOD = 0.4  # below this zoom: coloured boxes with the title drawn larger (see paint)
 PARENT_PORT = "parent"
 CHILD_PORT = "children"
 
@@ -55,6 +57,7 @@ _TITLE_H = 24.0
 _LINE_H = 14.0
 _BORDER = QColor(70, 70, 70)
 _SELECTED = QColor(30, 110, 230)
+_BROKEN = QColor(200, 30, 30)
 _TEXT = QColor(20, 20, 20)
 _BADGE = QColor(60, 60, 60)
 _WHITE = QColor(255, 255, 255)
@@ -92,6 +95,14 @@ class _Fonts:
         cls.small.setPointSize(8)
         cls.title_metrics = QFontMetricsF(cls.title)
         cls.ready = True
+
+
+def _bounds(width: float, height: float) -> QRectF:
+    """The item's bounding rect: badges around the body, room above and below for the
+    taller zoomed-out box."""
+    top = -max(12.0, overview.GROW)
+    bottom = height + max(10.0, overview.GROW)
+    return QRectF(-12.0, top, width + 14.0, bottom - top)
 
 
 def paint_port(painter: QPainter, rect: QRectF, info: dict[str, Any]) -> None:
@@ -153,7 +164,7 @@ class TreeNodeItem(NodeItem):
         self.index_badge = 0  # 1-based place among its parent's children; 0: none
         self.hidden_count = 0  # descendants hidden by collapsing; 0: expanded
         self._elided = ""
-        self._bounds = QRectF(-12.0, -12.0, self._width + 14.0, self._height + 22.0)
+        self._bounds = _bounds(self._width, self._height)
 
     # ------------------------------------------------------------------ content
 
@@ -165,7 +176,10 @@ class TreeNodeItem(NodeItem):
         self._elided = _Fonts.title_metrics.elidedText(
             look.title, Qt.TextElideMode.ElideRight, room
         )
-        self.setToolTip(look.title if self._elided != look.title else "")
+        tip = look.title if self._elided != look.title else ""
+        if look.broken:
+            tip = f"{look.title}\n{look.broken}".strip()
+        self.setToolTip(tip)
         self.draw_node()
 
     def set_status(self, status: Status | None) -> None:
@@ -253,7 +267,7 @@ class TreeNodeItem(NodeItem):
         self._width = NODE_WIDTH
         self._height = 2.0 + _TITLE_H + lines * _LINE_H + _PAD
         # Room for the badges that stick out of the body.
-        self._bounds = QRectF(-12.0, -12.0, self._width + 14.0, self._height + 22.0)
+        self._bounds = _bounds(self._width, self._height)
         for port in self._input_items:
             rect = port.boundingRect()
             port.setPos((self._width - rect.width()) / 2, -rect.height() / 2)
@@ -312,7 +326,14 @@ class TreeNodeItem(NodeItem):
 
     def boundingRect(self) -> QRectF:
         # Qt asks several times per item and frame: computed once per size in draw_node.
+        # It leaves room for the taller box of the zoomed-out look (see overview_rect).
         return self._bounds
+
+    def shape(self) -> QPainterPath:
+        """Body and badges: what clicks and rubber bands hit (not the overview's room)."""
+        path = QPainterPath()
+        path.addRect(QRectF(-12.0, -12.0, self._width + 14.0, self._height + 22.0))
+        return path
 
     def shape_rect(self) -> QRectF:
         """The body without the badges (hit tests for drops)."""
@@ -325,11 +346,15 @@ class TreeNodeItem(NodeItem):
         base = look.fill if look is not None else (200, 200, 200)
         fill = _qcolor(STATUS_COLOURS[self.status]) if self.status is not None else _qcolor(base)
         rect = QRectF(0.0, 0.0, self._width, self._height)
-        if painter.worldTransform().m11() < DETAIL_LOD:  # the view neither rotates nor shears
-            painter.fillRect(rect, _SELECTED if self.isSelected() else fill)
+        scale = painter.worldTransform().m11()  # the view neither rotates nor shears
+        if scale < DETAIL_LOD:
+            self._paint_overview(painter, scale, fill)
             return
         painter.save()
-        painter.setPen(QPen(_SELECTED, 3.0) if self.isSelected() else QPen(_BORDER, 1.0))
+        pen = QPen(_SELECTED, 3.0) if self.isSelected() else QPen(_BORDER, 1.0)
+        if look is not None and look.broken and not self.isSelected():
+            pen = QPen(_BROKEN, 2.5, Qt.PenStyle.DashLine)
+        painter.setPen(pen)
         painter.setBrush(QBrush(fill))
         painter.drawRoundedRect(rect, 6.0, 6.0)
         if self.status is not None and look is not None:
@@ -339,6 +364,22 @@ class TreeNodeItem(NodeItem):
             self._paint_text(painter, look)
         self._paint_badges(painter)
         painter.restore()
+
+    def overview_rect(self, scale: float) -> QRectF:
+        """The box as drawn zoomed out (taller, to hold the title; see canvas.overview)."""
+        return overview.box(self._title(), self._width, self._height, scale)
+
+    def _title(self) -> str:
+        return self.look.title if self.look is not None else ""
+
+    def _paint_overview(self, painter: QPainter, scale: float, fill: QColor) -> None:
+        look = self.look
+        selected = self.isSelected()
+        overview.paint(
+            painter, self._title(), QRectF(0.0, 0.0, self._width, self._height), scale,
+            _SELECTED if selected else fill, _WHITE if selected else _TEXT,
+            _BROKEN if look is not None and look.broken else None,
+        )  # fmt: skip
 
     def _paint_text(self, painter: QPainter, look: NodeLook) -> None:
         painter.setPen(_TEXT)

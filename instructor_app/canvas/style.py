@@ -36,6 +36,7 @@ STATUS_COLOURS: dict[Status, RGB] = {
 _COMPOSITE_FILL: RGB = (250, 250, 250)
 _DECORATOR_FILL: RGB = (214, 214, 214)
 _WAIT_FILL: RGB = (205, 214, 228)
+_BROKEN_FILL: RGB = (240, 200, 200)  # an operation the cell does not know
 _OPERATION_FILL: dict[OperationKind, RGB] = {
     OperationKind.ACTION: (160, 196, 244),
     OperationKind.QUERY: (206, 180, 240),
@@ -66,6 +67,7 @@ class NodeLook:
         fill: body colour when no status is shown.
         header: colour of the band that keeps the category visible under a status colour.
         leaf: whether the node takes no children (no child port).
+        broken: why the node cannot run as it is ("" when it can): an unknown operation.
     """
 
     title: str
@@ -75,6 +77,7 @@ class NodeLook:
     fill: RGB
     header: RGB
     leaf: bool
+    broken: str = ""
 
 
 def default_title(node: NodeSpec) -> str:
@@ -112,8 +115,11 @@ def _param_lines(node: NodeSpec) -> tuple[str, ...]:
     return tuple(lines)
 
 
-def look_of(node: NodeSpec, op_kind: OperationKind | None = None) -> NodeLook:
-    """The look of ``node``; ``op_kind`` is its operation's kind when known."""
+def look_of(
+    node: NodeSpec, op_kind: OperationKind | None = None, unknown: bool = False
+) -> NodeLook:
+    """The look of ``node``; ``op_kind`` is its operation's kind when known, ``unknown``
+    says that the cell's registry has no such operation (the node is drawn as broken)."""
     title = node.name or default_title(node)
     category = node.category
     if category is Category.COMPOSITE:
@@ -132,4 +138,10 @@ def look_of(node: NodeSpec, op_kind: OperationKind | None = None) -> NodeLook:
         op_kind or OperationKind.ACTION, _OPERATION_FILL[OperationKind.ACTION]
     )
     subtitle = (node.op or "") if node.name else ""
+    if unknown:
+        broken = f"Unknown operation {node.op!r}: no capability of this cell provides it"
+        return NodeLook(
+            title, "", f"⚠ unknown: {node.op}", _param_lines(node), _BROKEN_FILL, _BROKEN_FILL,
+            True, broken,
+        )  # fmt: skip
     return NodeLook(title, "", subtitle, _param_lines(node), fill, fill, True)

@@ -47,6 +47,7 @@ class GraphMirror:
         self.graph = graph
         self.nodes: dict[str, TreeNode] = {}
         self.op_kind: OpKindLookup = lambda op: None
+        self.kinds_known = False  # set_operation_kinds was called: a missing op is unknown
 
     # ------------------------------------------------------------------ document signals
 
@@ -152,7 +153,8 @@ class GraphMirror:
     # ------------------------------------------------------------------ creating
 
     def _look(self, spec: NodeSpec) -> NodeLook:
-        return look_of(spec, self.op_kind(spec.op) if spec.op else None)
+        kind = self.op_kind(spec.op) if spec.op else None
+        return look_of(spec, kind, unknown=bool(spec.op) and self.kinds_known and kind is None)
 
     def _add_subtree(self, root: NodeSpec, parent_id: str | None) -> None:
         """Create the items of ``root`` and below, place them, then draw their links (a

@@ -25,7 +25,10 @@ from instructor_app.canvas.viewer import PALETTE_MIME, CanvasViewer
 from instructor_app.document.model import DocumentError, PlanDocument
 from instructor_app.document.tree_ops import can_have_child
 
-__all__ = ["CanvasView", "PALETTE_MIME"]
+__all__ = ["CanvasView", "PALETTE_MIME", "MIN_FIT_ZOOM"]
+
+# Fit never zooms out further: titles still show as two lines of about 8 characters.
+MIN_FIT_ZOOM = 0.25
 
 
 class CanvasView(QWidget):
@@ -82,10 +85,15 @@ class CanvasView(QWidget):
         """How palette drops and "Add child" make nodes: ``factory(kind, op) -> NodeSpec``."""
         self.commands.node_factory = factory or default_node_factory
 
+    def set_operations(self, groups: Mapping[str, list[tuple[str, str]]]) -> None:
+        """What "Add child" offers besides logic nodes: capability title -> [(label, op)]."""
+        self.commands.operations = {title: list(ops) for title, ops in groups.items()}
+
     def set_operation_kinds(self, kinds: Mapping[str, OperationKind]) -> None:
         """Operation id -> kind, so that leaves get their action/query/condition colour."""
         table = dict(kinds)
         self.mirror.op_kind = table.get
+        self.mirror.kinds_known = True
         self.mirror.restyle()
 
     def set_statuses(self, mapping: Mapping[str, Status]) -> None:
@@ -136,14 +144,48 @@ class CanvasView(QWidget):
             item = node.item
             self.viewer.centre_on(item.mapToScene(item.shape_rect().center()))
 
+    def ensure_visible(self, node_id: str, margin: float = 40.0) -> None:
+        """Scroll (not zoom) so that the node is in view; nothing moves when it already is."""
+        node = self.mirror.nodes.get(node_id)
+        if node is None:
+            return
+        item = node.item
+        # The mirror may lay the tree out after the insertion signal: place it now.
+        rect = item.sceneBoundingRect().adjusted(-margin, -margin, margin, margin)
+        visible = self.viewer.mapToScene(self.viewer.viewport().rect()).boundingRect()
+        if not visible.contains(rect):
+            self.viewer.centre_on(rect.center())
+
+    def is_visible_in_view(self, node_id: str) -> bool:
+        """Whether the whole node shows in the viewport (tests, the view following edits)."""
+        item = self.mirror.nodes[node_id].item
+        visible = self.viewer.mapToScene(self.viewer.viewport().rect()).boundingRect()
+        return item.isVisible() and visible.contains(item.sceneBoundingRect())
+
     def fit_all(self) -> None:
-        """Zoom so that the whole tree shows."""
+        """Zoom so that the whole tree shows, but not below MIN_FIT_ZOOM, where titles would
+        be too small to read: a tree too large for that shows its top, around the root (the
+        rest is a scroll away)."""
         rect = QRectF()
         for node in self.mirror.nodes.values():
             if node.item.isVisible():
                 rect = rect.united(node.item.sceneBoundingRect())
-        if not rect.isNull():
-            self.viewer.show_rect(rect.adjusted(-40, -40, 40, 40))
+        if rect.isNull():
+            return
+        rect = rect.adjusted(-40, -40, 40, 40)
+        port = self.viewer.viewport().rect()
+        width, height = port.width() / MIN_FIT_ZOOM, port.height() / MIN_FIT_ZOOM
+        # Before it is shown the viewport has no real size yet: show all, the viewer keeps
+        # the rect in view when it gets its size.
+        if not self.viewer.isVisible() or (rect.width() <= width and rect.height() <= height):
+            self.viewer.show_rect(rect)
+            return
+        root = self.document.plan.tree
+        centre = rect.center().x()
+        if root is not None and root.id in self.mirror.nodes:
+            centre = self.mirror.nodes[root.id].item.sceneBoundingRect().center().x()
+        left = min(max(centre - width / 2, rect.left()), max(rect.left(), rect.right() - width))
+        self.viewer.show_rect(QRectF(left, rect.top(), width, height))
 
     def item(self, node_id: str) -> TreeNodeItem:
         """The graphics item of a node (tests, the failing-node display)."""

@@ -19,6 +19,7 @@ from PySide6.QtGui import (
     QDragEnterEvent,
     QDragMoveEvent,
     QDropEvent,
+    QKeyEvent,
     QPainter,
     QPainterPath,
     QPaintEvent,
@@ -88,6 +89,12 @@ class CanvasViewer(NodeViewer):
         item = self.node_item_at(self.mapToScene(event.pos()))
         self.context_requested.emit(item.id if item is not None else "", event.globalPos())
         event.accept()
+
+    def keyPressEvent(self, event: QKeyEvent) -> None:
+        super().keyPressEvent(event)
+        # NodeGraphQt writes modifier hints ("CTRL: Deselect Nodes") on the canvas and hides
+        # them on key release, which never comes when a shortcut opened a dialog: no hints.
+        self._cursor_text.setVisible(False)
 
     def node_item_at(
         self, scene_pos: QPointF, exclude: QGraphicsItem | None = None

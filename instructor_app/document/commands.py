@@ -172,9 +172,18 @@ class SetLayoutCommand(_Command):
 
 
 class SetPlanFieldCommand(_Command):
-    """Change a plan-wide field: name, description, run_policy, parameters, waypoints, objects."""
+    """Change a plan-wide field: name, description, run_policy, reset_cell, parameters,
+    waypoints, objects."""
 
-    FIELDS = ("name", "description", "run_policy", "parameters", "waypoints", "objects")
+    FIELDS = (
+        "name",
+        "description",
+        "run_policy",
+        "reset_cell",
+        "parameters",
+        "waypoints",
+        "objects",
+    )
 
     def __init__(self, document: PlanDocument, field: str, value: Any) -> None:
         if field not in self.FIELDS:

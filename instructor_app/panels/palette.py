@@ -1,8 +1,10 @@
 """The palette: the paper's sidebar of logic nodes and capability operations (Figure 5, 2).
 
 Items come from :func:`instructor_app.node_factory.palette_items`, so a new capability shows
-up by itself. Typing in the search field filters as you type; Enter there inserts the first
-match ("search-to-insert"). Double-click or Enter on an item inserts it, dragging it onto
+up by itself. Typing in the search field replaces the grouped list by the hits, ranked by how
+well the label matches and how relevant the capability is (see :func:`search_rank`), each
+with its capability beside it; Up/Down move through the hits and Enter inserts the current
+one ("search-to-insert"). Double-click or Enter on an item inserts it, dragging it onto
 the canvas drops it there. Operations the cell cannot run are greyed, with the reason as
 tooltip, and cannot be inserted or dragged.
 """
@@ -12,10 +14,12 @@ from __future__ import annotations
 import json
 from collections.abc import Iterable
 
-from PySide6.QtCore import QMimeData, QSize, Qt, Signal
+from PySide6.QtCore import QEvent, QMimeData, QObject, QSize, Qt, Signal
 from PySide6.QtGui import QColor, QIcon, QKeyEvent, QPainter, QPixmap
 from PySide6.QtWidgets import (
     QLineEdit,
+    QListWidget,
+    QListWidgetItem,
     QTreeWidget,
     QTreeWidgetItem,
     QVBoxLayout,
@@ -26,7 +30,7 @@ from engine.operations import OperationKind, OperationSource
 from engine.spec import KIND_CATEGORY, Category, NodeKind
 from instructor_app.node_factory import PALETTE_MIME, PaletteItem, palette_items
 
-__all__ = ["PalettePanel", "item_colour"]
+__all__ = ["PalettePanel", "item_colour", "search_rank"]
 
 _ITEM_ROLE = Qt.ItemDataRole.UserRole + 1
 
@@ -47,6 +51,45 @@ def item_colour(item: PaletteItem) -> QColor:
     if item.op_kind is not None:
         return QColor(_OP_COLOURS[item.op_kind])
     return QColor(_CATEGORY_COLOURS[KIND_CATEGORY[item.kind]])
+
+
+# Capabilities for trying things out rank after those that act on the cell.
+_LOW_RELEVANCE_GROUPS = frozenset({"debug", "template"})
+
+
+def search_rank(item: PaletteItem, text: str) -> tuple[int, int, str] | None:
+    """How well ``item`` answers a search (smaller sorts first); None when it does not match.
+
+    The label counts most (the whole label, then its start, then the phrase, then every
+    word), then the operation id, then the capability name and the description; items of
+    the debug and template capabilities and items the cell cannot run come after the rest
+    of their tier.
+    """
+    if not item.matches(text):
+        return None
+    query = " ".join(text.lower().split())
+    words = query.split()
+    label = item.label.lower()
+    ident = (item.op or item.kind.value).lower().replace("_", " ")
+    if label == query:
+        tier = 0
+    elif label.startswith(query):
+        tier = 1
+    elif query in label:
+        tier = 2
+    elif all(word in label for word in words):
+        tier = 3
+    elif all(word in ident for word in words):
+        tier = 4
+    else:
+        tier = 5
+    penalty = (item.group.lower() in _LOW_RELEVANCE_GROUPS) + 2 * (not item.available)
+    return tier, penalty, label
+
+
+def _capability_title(item: PaletteItem) -> str:
+    is_logic = item.kind is not NodeKind.OPERATION
+    return item.group if is_logic else item.group.replace("_", " ").capitalize()
 
 
 def _icon(colour: QColor, round_shape: bool) -> QIcon:
@@ -87,6 +130,23 @@ class _PaletteTree(QTreeWidget):
         super().keyPressEvent(event)
 
 
+class _HitKeys(QObject):
+    """Up/Down typed in the search field move through the hits."""
+
+    def __init__(self, hits: QListWidget, parent: QObject) -> None:
+        super().__init__(parent)
+        self._hits = hits
+
+    def eventFilter(self, watched: QObject, event: QEvent) -> bool:
+        if event.type() is QEvent.Type.KeyPress and isinstance(event, QKeyEvent):
+            step = {Qt.Key.Key_Down: 1, Qt.Key.Key_Up: -1}.get(Qt.Key(event.key()))
+            if step is not None and self._hits.count():
+                row = max(0, min(self._hits.count() - 1, self._hits.currentRow() + step))
+                self._hits.setCurrentRow(row)
+                return True
+        return False
+
+
 class PalettePanel(QWidget):
     """The sidebar of insertable nodes.
 
@@ -101,10 +161,16 @@ class PalettePanel(QWidget):
     ) -> None:
         super().__init__(parent)
         self.search_field = QLineEdit()
-        self.search_field.setPlaceholderText("Search nodes… (Enter inserts the first match)")
+        self.search_field.setPlaceholderText("Search… (↑↓, Enter inserts)")
         self.search_field.setClearButtonEnabled(True)
         self.search_field.textChanged.connect(self._filter)
-        self.search_field.returnPressed.connect(self._insert_first_match)
+        self.search_field.returnPressed.connect(self._insert_current_hit)
+        self.hits = QListWidget()
+        self.hits.setObjectName("PaletteHits")
+        self.hits.setIconSize(QSize(14, 14))
+        self.hits.itemDoubleClicked.connect(self._activate)
+        self.hits.hide()
+        self.search_field.installEventFilter(_HitKeys(self.hits, self))
         self.tree = _PaletteTree()
         self.tree.setHeaderHidden(True)
         self.tree.setIconSize(QSize(14, 14))
@@ -116,6 +182,7 @@ class PalettePanel(QWidget):
         layout.setContentsMargins(2, 2, 2, 2)
         layout.addWidget(self.search_field)
         layout.addWidget(self.tree)
+        layout.addWidget(self.hits)
         self._items: list[PaletteItem] = []
         if registry is not None:
             self.set_registry(registry)
@@ -140,8 +207,15 @@ class PalettePanel(QWidget):
         return list(self._items)
 
     def visible_items(self) -> list[PaletteItem]:
-        """The items the current search shows, in order."""
+        """The items shown, in order: the ranked hits while searching, else every item."""
+        if self.search_field.text().strip():
+            return [self._hit_item(i) for i in range(self.hits.count())]
         return [item for row, item in self._rows() if not row.isHidden()]
+
+    def current_hit(self) -> PaletteItem | None:
+        """The hit Enter would insert (None when not searching or nothing matches)."""
+        row = self.hits.currentRow()
+        return self._hit_item(row) if self.hits.isVisibleTo(self) and row >= 0 else None
 
     def groups(self) -> list[str]:
         """Titles of the sections, in order."""
@@ -150,9 +224,7 @@ class PalettePanel(QWidget):
     # ------------------------------------------------------------------ building
 
     def _group_row(self, item: PaletteItem, doc: str) -> QTreeWidgetItem:
-        is_logic = item.kind is not NodeKind.OPERATION
-        title = item.group if is_logic else item.group.replace("_", " ").capitalize()
-        row = QTreeWidgetItem(self.tree, [title])
+        row = QTreeWidgetItem(self.tree, [_capability_title(item)])
         row.setFlags(Qt.ItemFlag.ItemIsEnabled)
         font = row.font(0)
         font.setBold(True)
@@ -164,8 +236,7 @@ class PalettePanel(QWidget):
         row = QTreeWidgetItem([item.label])
         row.setData(0, _ITEM_ROLE, item)
         row.setIcon(0, _icon(item_colour(item), item.kind is NodeKind.OPERATION))
-        kind = item.op_kind.value if item.op_kind is not None else "logic"
-        tip = f"{item.op or item.kind.value} ({kind})\n{item.doc}"
+        tip = _tooltip(item)
         if item.available:
             row.setFlags(
                 Qt.ItemFlag.ItemIsEnabled
@@ -174,9 +245,26 @@ class PalettePanel(QWidget):
             )
         else:
             row.setFlags(Qt.ItemFlag.NoItemFlags)
-            tip = f"Not available: {item.reason}\n{tip}"
         row.setToolTip(0, tip)
         return row
+
+    def _hit_row(self, item: PaletteItem) -> QListWidgetItem:
+        # The capability beside the label: "Object found" of perception and of predicates
+        # differ on sight.
+        row = QListWidgetItem(f"{item.label}  —  {_capability_title(item)}")
+        row.setData(_ITEM_ROLE, item)
+        row.setIcon(_icon(item_colour(item), item.kind is NodeKind.OPERATION))
+        row.setToolTip(_tooltip(item))
+        if not item.available:
+            row.setFlags(Qt.ItemFlag.NoItemFlags)
+        return row
+
+    def _hit_item(self, index: int) -> PaletteItem:
+        row = self.hits.item(index)
+        assert row is not None
+        item = row.data(_ITEM_ROLE)
+        assert isinstance(item, PaletteItem)
+        return item
 
     def _group_rows(self) -> list[QTreeWidgetItem]:
         count = self.tree.topLevelItemCount()
@@ -197,6 +285,20 @@ class PalettePanel(QWidget):
     # ------------------------------------------------------------------ behaviour
 
     def _filter(self, text: str) -> None:
+        searching = bool(text.strip())
+        self.tree.setVisible(not searching)
+        self.hits.setVisible(searching)
+        self.hits.clear()
+        if searching:
+            ranked = sorted(
+                (rank, index, item)
+                for index, item in enumerate(self._items)
+                if (rank := search_rank(item, text)) is not None
+            )
+            for _rank, _index, item in ranked:
+                self.hits.addItem(self._hit_row(item))
+            first_hit = next((i for i, (_r, _n, it) in enumerate(ranked) if it.available), -1)
+            self.hits.setCurrentRow(first_hit)
         for row, item in self._rows():
             row.setHidden(not item.matches(text))
         for group in self._group_rows():
@@ -210,15 +312,22 @@ class PalettePanel(QWidget):
         if first is not None and text:
             self.tree.setCurrentItem(first)
 
-    def _insert_first_match(self) -> None:
-        if not self.search_field.text().strip():
-            return
-        for item in self.visible_items():
-            if item.available:
-                self.item_activated.emit(item)
-                return
+    def _insert_current_hit(self) -> None:
+        item = self.current_hit()
+        if item is not None and item.available:
+            self.item_activated.emit(item)
 
     def _activate(self, row: object) -> None:
-        item = row.data(0, _ITEM_ROLE) if isinstance(row, QTreeWidgetItem) else None
+        item: object = None
+        if isinstance(row, QTreeWidgetItem):
+            item = row.data(0, _ITEM_ROLE)
+        elif isinstance(row, QListWidgetItem):
+            item = row.data(_ITEM_ROLE)
         if isinstance(item, PaletteItem) and item.available:
             self.item_activated.emit(item)
+
+
+def _tooltip(item: PaletteItem) -> str:
+    kind = item.op_kind.value if item.op_kind is not None else "logic"
+    tip = f"{item.op or item.kind.value} ({kind}) — {_capability_title(item)}\n{item.doc}"
+    return tip if item.available else f"Not available: {item.reason}\n{tip}"

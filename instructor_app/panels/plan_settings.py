@@ -7,7 +7,7 @@ document (undo, open, new) without echoing edits back.
 
 from __future__ import annotations
 
-from PySide6.QtWidgets import QComboBox, QFormLayout, QLineEdit, QWidget
+from PySide6.QtWidgets import QCheckBox, QComboBox, QFormLayout, QLineEdit, QWidget
 
 from engine.spec import RunPolicy
 from instructor_app.document import PlanDocument
@@ -43,10 +43,14 @@ class PlanSettingsPanel(QWidget):
             "forever: start again after every run"
         )
         self.policy_combo.activated.connect(self._policy_chosen)
+        self.reset_box = QCheckBox("Reset the cell before each run")
+        self.reset_box.setToolTip("Robot and objects go back to the scene's start before a run")
+        self.reset_box.clicked.connect(lambda: self._reset_clicked(self.reset_box.isChecked()))
         form = QFormLayout(self)
         form.setContentsMargins(4, 4, 4, 4)
         form.addRow("Name", self.name_field)
         form.addRow("Run", self.policy_combo)
+        form.addRow("", self.reset_box)
         document.plan_changed.connect(self._refresh)
         document.plan_reset.connect(self._refresh)
         self._refresh()
@@ -61,6 +65,10 @@ class PlanSettingsPanel(QWidget):
         if policy is not RunPolicy(self.document.plan.run_policy):
             self.document.set_plan_field("run_policy", policy)
 
+    def _reset_clicked(self, checked: bool) -> None:
+        if checked != self.document.plan.reset_cell:
+            self.document.set_plan_field("reset_cell", checked)
+
     def _refresh(self) -> None:
         plan = self.document.plan
         if self.name_field.text() != plan.name and not self.name_field.hasFocus():
@@ -68,3 +76,5 @@ class PlanSettingsPanel(QWidget):
         index = self.policy_combo.findData(RunPolicy(plan.run_policy).value)
         if index != self.policy_combo.currentIndex():
             self.policy_combo.setCurrentIndex(index)
+        if self.reset_box.isChecked() != plan.reset_cell:
+            self.reset_box.setChecked(plan.reset_cell)

@@ -16,7 +16,7 @@ from PySide6.QtCore import QObject, QTimer, Signal
 
 from engine.build import BuildError, build_tree
 from engine.events import RunFinished
-from engine.executor import Executor
+from engine.executor import Executor, ExecutorState
 from engine.spec import PlanSpec
 from engine.status import Status
 from engine.validation import ERROR, Problem, has_errors, validate_plan
@@ -24,9 +24,7 @@ from instructor_app.document.model import PlanDocument
 from instructor_app.runtime.pump import Batch, EventPump
 from instructor_app.runtime.session import CellSession
 
-__all__ = ["RunController", "RunOutcome", "IDLE", "RUNNING", "PAUSED", "FINISHED"]
-
-IDLE, RUNNING, PAUSED, FINISHED = "idle", "running", "paused", "finished"
+__all__ = ["RunController", "RunOutcome"]
 
 
 @dataclass(frozen=True)
@@ -63,7 +61,7 @@ class RunController(QObject):
         statuses_changed(dict): node id -> Status, only the nodes changed since last time.
         blackboard_written(str, object): a blackboard key and its newest value.
         log_message(str, str): text and level ("info", "warning", "error").
-        run_state_changed(str): "idle", "running", "paused" or "finished".
+        run_state_changed(object): the run's ExecutorState (READY before the first run).
         running_nodes_changed(list): ids of the nodes now RUNNING, in plan order.
         run_finished(object): a :class:`RunOutcome`.
         run_refused(list): the validation problems (or a build error) that kept it from starting.
@@ -74,7 +72,7 @@ class RunController(QObject):
     statuses_changed = Signal(object)
     blackboard_written = Signal(str, object)
     log_message = Signal(str, str)
-    run_state_changed = Signal(str)
+    run_state_changed = Signal(object)
     running_nodes_changed = Signal(list)
     run_finished = Signal(object)
     run_refused = Signal(list)
@@ -97,24 +95,25 @@ class RunController(QObject):
         self._timer.setInterval(max(1, round(1000 / drain_hz)))
         self._timer.timeout.connect(self._drain)
         self._executor: Executor | None = None
-        self._state = IDLE
+        self._state: ExecutorState = ExecutorState.READY
         self._plan: PlanSpec | None = None
         self._order: dict[str, tuple[int, int]] = {}  # node id -> (depth, plan order)
         self._statuses: dict[str, Status] = {}
         self._messages: dict[str, str] = {}
         self._running: list[str] = []
         self._failure: tuple[str, str] = ("", "")
+        self._stopping = False  # a stop was asked: the halt's IDLE resets are not shown
 
     # ------------------------------------------------------------------ state
 
     @property
-    def state(self) -> str:
+    def state(self) -> ExecutorState:
         return self._state
 
     @property
     def is_running(self) -> bool:
         """True from start until the RunFinished event was handled (paused counts)."""
-        return self._state in (RUNNING, PAUSED)
+        return self._state in (ExecutorState.RUNNING, ExecutorState.PAUSED)
 
     @property
     def statuses(self) -> dict[str, Status]:
@@ -125,36 +124,41 @@ class RunController(QObject):
 
     def run(self) -> bool:
         """Start a run (resume when paused); False when the plan was refused or one runs."""
-        if self._state == PAUSED:
+        if self._state == ExecutorState.PAUSED:
             self.resume()
             return True
-        if self._state == RUNNING:
+        if self._state == ExecutorState.RUNNING:
             return False
         return self._start(paused=False)
 
     def pause(self) -> None:
-        if self._executor is not None and self._state == RUNNING:
+        if self._executor is not None and self._state == ExecutorState.RUNNING:
             self._executor.pause()
-            self._set_state(PAUSED)
+            self._set_state(ExecutorState.PAUSED)
 
     def resume(self) -> None:
-        if self._executor is not None and self._state == PAUSED:
+        if self._executor is not None and self._state == ExecutorState.PAUSED:
             self._executor.resume()
-            self._set_state(RUNNING)
+            self._set_state(ExecutorState.RUNNING)
 
     def step(self) -> None:
         """One tick: starts a paused run when idle, pauses a running one first."""
         if not self.is_running:
             if not self._start(paused=True):
                 return
-        elif self._state == RUNNING:
+        elif self._state == ExecutorState.RUNNING:
             self.pause()
         assert self._executor is not None
         self._executor.step()
 
     def stop(self) -> None:
-        """Halt what runs (an arm in motion stops); the run ends via run_finished."""
+        """Halt what runs (an arm in motion stops); the run ends via run_finished.
+
+        The nodes keep the statuses they had when stopped (the halt resets them to IDLE in the
+        engine; those resets are not shown) until the next run starts.
+        """
         if self._executor is not None and self.is_running:
+            self._stopping = True
             # timeout=0: never join the engine thread from the GUI thread.
             self._executor.stop("stopped", timeout=0)
 
@@ -170,8 +174,18 @@ class RunController(QObject):
 
     # ------------------------------------------------------------------ starting
 
+    def reset_cell(self) -> bool:
+        """Put the cell back to its start (see CellSession.reset); False while a plan runs."""
+        if self.is_running:
+            return False
+        self.session.reset()
+        self.log_message.emit(f"The {self.session.name} cell was reset", "info")
+        return True
+
     def _start(self, paused: bool) -> bool:
         plan = copy.deepcopy(self.document.plan)  # edits during the run do not reach it
+        if plan.reset_cell:
+            self.reset_cell()
         registry = self.session.registry
         problems = validate_plan(plan, registry)
         if has_errors(problems):
@@ -188,7 +202,7 @@ class RunController(QObject):
         self._executor = Executor(tree, self.rate_hz, [self._pump.put], plan_name=plan.name)
         self._executor.start(paused=paused)
         self._timer.start()
-        self._set_state(PAUSED if paused else RUNNING)
+        self._set_state(ExecutorState.PAUSED if paused else ExecutorState.RUNNING)
         # Every node starts the run grey (IDLE), also those the run never reaches; sent after
         # the state change, on which the views clear the last run's colours.
         self.statuses_changed.emit(dict(self._statuses))
@@ -200,6 +214,7 @@ class RunController(QObject):
         self._order = _depth_order(plan)
         self._pump.drain()  # leftovers of an earlier run must not colour this one
         self._statuses, self._messages, self._running = {}, {}, []
+        self._stopping = False
         self._set_failure("", "")
         self._statuses.update({node_id: Status.IDLE for node_id in self._order})
 
@@ -209,7 +224,11 @@ class RunController(QObject):
         batch = self._pump.drain()
         if batch.empty:
             return
-        changed = {k: v for k, v in batch.statuses.items() if k in self._order}
+        changed = {
+            k: v
+            for k, v in batch.statuses.items()
+            if k in self._order and not (self._stopping and v is Status.IDLE)
+        }
         self._statuses.update(changed)
         self._messages.update({k: v for k, v in batch.messages.items() if k in self._order})
         if changed:
@@ -269,7 +288,7 @@ class RunController(QObject):
             self.running_nodes_changed.emit([])
         level = "info" if event.status is Status.SUCCESS else "warning"
         self.log_message.emit(self._summary(event), level)
-        self._set_state(FINISHED)
+        self._set_state(ExecutorState.FINISHED)
         self.run_finished.emit(RunOutcome(event, failed, message, dict(self._statuses)))
 
     def _summary(self, event: RunFinished) -> str:
@@ -282,7 +301,7 @@ class RunController(QObject):
         node = self._plan.find(node_id) if self._plan is not None else None
         return node.label if node is not None else node_id
 
-    def _set_state(self, state: str) -> None:
+    def _set_state(self, state: ExecutorState) -> None:
         if state != self._state:
             self._state = state
             self.run_state_changed.emit(state)

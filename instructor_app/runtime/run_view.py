@@ -10,11 +10,8 @@ from PySide6.QtCore import QObject, Qt, Signal
 from PySide6.QtGui import QAction, QIcon, QKeySequence
 from PySide6.QtWidgets import QListWidget, QListWidgetItem, QPushButton, QStyle, QWidget
 
+from engine.executor import ExecutorState
 from instructor_app.runtime.controller import (
-    FINISHED,
-    IDLE,
-    PAUSED,
-    RUNNING,
     RunController,
     RunOutcome,
 )
@@ -61,12 +58,12 @@ class RunActions(QObject):
     def all(self) -> list[QAction]:
         return [self.run, self.pause, self.step, self.stop]
 
-    def update_state(self, state: str) -> None:
-        idle = state in (IDLE, FINISHED)
-        self.run.setEnabled(idle or state == PAUSED)
-        self.pause.setEnabled(state == RUNNING)
-        self.step.setEnabled(idle or state == PAUSED)
-        self.stop.setEnabled(state in (RUNNING, PAUSED))
+    def update_state(self, state: object) -> None:
+        idle = state in (ExecutorState.READY, ExecutorState.FINISHED)
+        self.run.setEnabled(idle or state == ExecutorState.PAUSED)
+        self.pause.setEnabled(state == ExecutorState.RUNNING)
+        self.step.setEnabled(idle or state == ExecutorState.PAUSED)
+        self.stop.setEnabled(state in (ExecutorState.RUNNING, ExecutorState.PAUSED))
 
 
 class RunningNodesPanel(QListWidget):
@@ -169,15 +166,17 @@ class RunPresenter(QObject):
         controller.run_refused.connect(self._on_refused)
         controller.run_finished.connect(self._on_finished)
 
-    def _on_state(self, state: str) -> None:
-        if state in (RUNNING, PAUSED) and not self._active:
+    def _on_state(self, state: object) -> None:
+        if state in (ExecutorState.RUNNING, ExecutorState.PAUSED) and not self._active:
             self._active = True  # a new run: last run's colours and values go
             self._canvas.clear_statuses()
             self._blackboard.clear()
-        elif state in (IDLE, FINISHED):
+        elif state in (ExecutorState.READY, ExecutorState.FINISHED):
             self._active = False
-        if state in (RUNNING, PAUSED):
-            self._show(f"Run {state}")
+        if state is ExecutorState.RUNNING:
+            self._show("Running…")
+        elif state is ExecutorState.PAUSED:
+            self._show("Paused")
 
     def _on_refused(self, problems: list[Any]) -> None:
         for problem in problems:

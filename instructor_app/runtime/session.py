@@ -91,6 +91,12 @@ class CellSession(QObject):
         self.registry_changed.emit(self.registry)
         return ok
 
+    def reset(self) -> bool:
+        """Put the cell back to its start: the same cell opened again with the same scene
+        and seed (robot at home, objects where the seed places them) and a fresh registry,
+        so that no capability keeps state of an earlier run. Returns as :meth:`open`."""
+        return self.open(self.name)
+
     def clock(self) -> Callable[[], float] | None:
         """The open cell's clock (simulated time on the simulated cell), None if none open."""
         return self.cell.clock if self.cell is not None else None

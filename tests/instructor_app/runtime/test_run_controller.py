@@ -110,7 +110,7 @@ def test_stop_halts_the_running_leaf(qtbot: Any, none_session: CellSession) -> N
     assert seen.running[-1] == [document.plan.tree.id, slow]
     outcome = finish(qtbot, controller, controller.stop)
     assert outcome.event.reason == "stopped"
-    assert outcome.statuses[slow] is Status.IDLE  # halted and reset by the stop
+    assert outcome.statuses[slow] is Status.RUNNING  # halted, shown where it stopped
     assert seen.states[-1] == "finished" and seen.running[-1] == []
 
 

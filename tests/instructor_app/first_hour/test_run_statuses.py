@@ -1,0 +1,36 @@
+"""Stop keeps the last statuses on the canvas until the next run; the status bar says
+"Running…", not "Run running"."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from engine.files import dump_plan
+from engine.status import Status
+from instructor_app.runtime.session import CellSession
+from tests.instructor_app.gui_driver import make_window, node_named
+from tests.instructor_app.runtime.plans import endless_plan
+
+
+def test_stop_keeps_the_last_statuses_until_the_next_run(
+    qtbot: Any, none_session: CellSession, tmp_path: Path
+) -> None:
+    window = make_window(qtbot, none_session, tmp_path)
+    window.document.load_text(dump_plan(endless_plan()), None)
+    canvas = window.views.canvas
+    slow, top = node_named(window, "slow"), node_named(window, "top")
+    window.run_actions.run.trigger()
+    qtbot.waitUntil(lambda: canvas.status_of(slow) is Status.RUNNING)
+    assert window.statusBar().currentMessage() == "Running…"
+    with qtbot.waitSignal(window.controller.run_finished, timeout=10_000):
+        window.run_actions.stop.trigger()
+    # Where the run stopped stays visible: the halt's resets do not grey the nodes.
+    assert canvas.status_of(slow) is Status.RUNNING
+    assert canvas.status_of(top) is Status.RUNNING
+    # The next run starts from grey.
+    window.run_actions.run.trigger()
+    assert canvas.status_of(top) in (Status.IDLE, None)
+    qtbot.waitUntil(lambda: canvas.status_of(slow) is Status.RUNNING)
+    with qtbot.waitSignal(window.controller.run_finished, timeout=10_000):
+        window.run_actions.stop.trigger()
