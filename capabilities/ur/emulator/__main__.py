@@ -97,7 +97,7 @@ def main(argv: list[str] | None = None) -> int:
         emulator = UREmulator(
             args.host, args.version, speed=args.speed, unlock_delay=args.unlock_delay
         )
-        with emulator.start():
+        with emulator:
             if args.protective_stop_at is not None:
                 emulator.protective_stop(at=args.protective_stop_at)
             if args.protective_stop_on_contact:
