@@ -10,12 +10,13 @@ rotation vectors) here and nowhere else.
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import Future
 
 from capabilities.sim.commands import CommandHandle
 from capabilities.sim.kinematics import UR5Kinematics
-from capabilities.ur.connection import URConnection, URState, fault_reason
+from capabilities.ur.connection import NO_SCRIPT, URConnection, URState, fault_reason
 from capabilities.ur.errors import URError
 from capabilities.ur.frames import URFrames
 from capabilities.ur.modes import PolyScopeVersion, RobotMode
@@ -26,6 +27,7 @@ __all__ = ["URArm", "FREEDRIVE_MODE_SINCE", "require_version"]
 FREEDRIVE_MODE_SINCE: PolyScopeVersion = (5, 10)
 _JOINT_TOLERANCE = 0.01  # rad: a finished move this far from its target did not arrive
 _POSITION_TOLERANCE = 0.002  # m
+_SCRIPT_GRACE = 0.06  # s: how long a stopped script must last before it is the reason
 _START_TIMEOUT = 2.0  # s for the controller to report the asynchronous move started
 
 
@@ -142,7 +144,7 @@ class URArm:
             return handle
 
         def run() -> None:
-            ok = self._conn.io.setSpeedSlider(float(fraction))
+            ok = self._conn.with_io(lambda io: io.setSpeedSlider(float(fraction)))
             handle.resolve(bool(ok), "" if ok else "setSpeedSlider refused")
 
         self._submit(handle, run)
@@ -245,23 +247,29 @@ class _Monitor:
         self.arrived = arrived
         self.started = False
         self.deadline = 0.0
+        self.script_gone_at: float | None = None
+
+    def _debounce(self, now: float) -> bool:
+        """True while a stopped script has been seen for less than the grace time."""
+        if self.script_gone_at is None:
+            self.script_gone_at = now
+        return now - self.script_gone_at < _SCRIPT_GRACE
 
     def attach(self, conn: URConnection) -> None:
-        import time
-
         self.deadline = time.monotonic() + _START_TIMEOUT
         conn.add_monitor(self)
 
     def __call__(self, conn: URConnection) -> bool:
-        import time
-
         handle, state = self.handle, conn.state
         if handle.done():
             return True
         problem = fault_reason(state)
+        if problem == NO_SCRIPT and self._debounce(time.monotonic()):
+            return False  # a dropping connection first looks like a stopped script
         if problem:
             handle.resolve(False, f"{handle.name}: {problem}")
             return True
+        self.script_gone_at = None
         if handle.cancel_requested:
             try:
                 getattr(conn.control, self.stop_name)(2.0, True)

@@ -21,12 +21,13 @@ from capabilities.ur.errors import URConnectionLost, URError
 from capabilities.ur.modes import PolyScopeVersion, RobotMode, RuntimeState, SafetyMode
 from capabilities.ur.modes import parse_version
 
-__all__ = ["URConnection", "URState", "fault_reason"]
+__all__ = ["NO_SCRIPT", "URConnection", "URState", "fault_reason"]
 
 _log = logging.getLogger(__name__)
 T = TypeVar("T")
 _EMERGENCY = (SafetyMode.ROBOT_EMERGENCY_STOP, SafetyMode.SYSTEM_EMERGENCY_STOP)
 _MOVING_SPEED = 1e-3  # rad/s
+NO_SCRIPT = "the control script is not running on the controller"
 
 
 @dataclass(frozen=True)
@@ -69,7 +70,7 @@ def fault_reason(state: URState) -> str:
             f"the arm is not running (robot mode {mode})"
         )  # fmt: skip
     if not state.program_running:
-        return "the control script is not running on the controller"
+        return NO_SCRIPT
     return ""
 
 
@@ -99,7 +100,6 @@ class URConnection:
         self.dashboard: Any = None
         self.receive: Any = None
         self.control: Any = None
-        self.io: Any = None
 
     # ---------------------------------------------------------------- lifecycle
 
@@ -190,15 +190,12 @@ class URConnection:
 
     def _connect(self) -> None:
         import dashboard_client
-        import rtde_control
-        import rtde_io
         import rtde_receive
 
         self.dashboard = dashboard_client.DashboardClient(self.host)
         self.dashboard.connect()
         self.version = parse_version(self.dashboard.polyscopeVersion())
         self.receive = rtde_receive.RTDEReceiveInterface(self.host)
-        self.io = rtde_io.RTDEIOInterface(self.host)
         self.refresh()
         if not fault_reason(URState(**{**self.state.__dict__, "program_running": True})):
             self.start_control()
@@ -219,6 +216,35 @@ class URConnection:
         if any(self._tcp):
             self.control.setTcp(self._tcp)
         self.refresh()
+
+    def with_io(self, fn: Callable[[Any], T]) -> T:
+        """(I/O thread) ``fn(RTDEIOInterface)`` on an I/O interface opened for this call.
+
+        ur_rtde's RTDEIOInterface never starts synchronisation, so once its controller is gone
+        its disconnect (and its destructor) throw and abort the process; a short-lived one is
+        closed while the controller still answers.
+        """
+        import rtde_io
+
+        io = rtde_io.RTDEIOInterface(self.host)
+        try:
+            return fn(io)
+        finally:
+            io.disconnect()
+
+    def clear_protective_stop(self) -> None:
+        """(I/O thread) What the operator does after a protective stop: close the popup,
+        unlock it through the dashboard, and upload the control script again.
+
+        Raises:
+            URError: the controller refused to unlock (too early, or another fault).
+        """
+        self.dashboard.closeSafetyPopup()
+        try:
+            self.dashboard.unlockProtectiveStop()
+        except Exception as exc:
+            raise URError(f"unlocking the protective stop failed: {exc}") from exc
+        self.start_control()
 
     def refresh(self) -> None:
         """(I/O thread only) Read the controller's state into :attr:`state` now."""
@@ -256,7 +282,7 @@ class URConnection:
         )
 
     def _disconnect(self) -> None:
-        for name in ("control", "io", "receive", "dashboard"):
+        for name in ("control", "receive", "dashboard"):
             obj = getattr(self, name)
             setattr(self, name, None)
             if obj is None:
