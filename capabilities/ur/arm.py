@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Sequence
+from typing import Any
 from concurrent.futures import Future
 
 from capabilities.sim.commands import CommandHandle
@@ -94,17 +95,21 @@ class URArm:
     def inverse_kinematics(
         self, pose: Pose, near: Sequence[float] | None = None
     ) -> tuple[float, ...] | None:
-        return self._kin.inverse(pose, near if near is not None else self.joint_positions(), self._tcp)
+        return self._kin.inverse(
+            pose, near if near is not None else self.joint_positions(), self._tcp
+        )
 
     # ---------------------------------------------------------------- moves
 
-    def move_joints(self, q: Sequence[float], speed: float = 1.05, accel: float = 1.4) -> CommandHandle:
+    def move_joints(
+        self, q: Sequence[float], speed: float = 1.05, accel: float = 1.4
+    ) -> CommandHandle:
         target = [float(v) for v in q]
         if len(target) != 6 or not all(math.isfinite(v) for v in target):
             return CommandHandle.failed("move_joints", f"moveJ needs 6 finite joints, got {target}")
         return self._move(
             "move_joints", lambda c: c.moveJ(target, speed, accel, True), "stopJ",
-            lambda s: max(abs(a - b) for a, b in zip(s.q, target)) <= _JOINT_TOLERANCE,
+            lambda s: max(abs(a - b) for a, b in zip(s.q, target, strict=False)) <= _JOINT_TOLERANCE,
         )  # fmt: skip
 
     def move_linear(self, pose: Pose, speed: float = 0.25, accel: float = 1.2) -> CommandHandle:
@@ -161,7 +166,7 @@ class URArm:
     def _move(
         self,
         name: str,
-        send: Callable[[object], bool],
+        send: Callable[[Any], bool],
         stop_name: str,
         arrived: Callable[[URState], bool],
     ) -> CommandHandle:
@@ -176,7 +181,9 @@ class URArm:
             before = conn.state.async_op_id
             if not send(conn.control):
                 conn.refresh()
-                handle.resolve(False, f"{name}: {fault_reason(conn.state) or 'refused by the controller'}")
+                handle.resolve(
+                    False, f"{name}: {fault_reason(conn.state) or 'refused by the controller'}"
+                )
                 return
             _Monitor(handle, before, stop_name, arrived).attach(conn)
 

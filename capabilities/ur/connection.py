@@ -18,8 +18,7 @@ from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
 from capabilities.ur.errors import URConnectionLost, URError
-from capabilities.ur.modes import PolyScopeVersion, RobotMode, RuntimeState, SafetyMode
-from capabilities.ur.modes import parse_version
+from capabilities.ur.modes import PolyScopeVersion, RobotMode, SafetyMode, parse_version
 
 __all__ = ["NO_SCRIPT", "URConnection", "URState", "fault_reason"]
 
@@ -118,7 +117,9 @@ class URConnection:
             raise
         except Exception as exc:
             self.close()
-            raise URConnectionLost(f"cannot connect to the UR controller at {self.host}: {exc}")
+            raise URConnectionLost(
+                f"cannot connect to the UR controller at {self.host}: {exc}"
+            ) from exc
 
     def close(self) -> None:
         """Disconnect and stop the I/O thread. Idempotent."""
@@ -215,7 +216,11 @@ class URConnection:
                 time.sleep(0.01)
         if any(self._tcp):
             self.control.setTcp(self._tcp)
+        deadline = time.monotonic() + 2.0
         self.refresh()
+        while not self.state.program_running and time.monotonic() < deadline:
+            time.sleep(0.005)
+            self.refresh()
 
     def with_io(self, fn: Callable[[Any], T]) -> T:
         """(I/O thread) ``fn(RTDEIOInterface)`` on an I/O interface opened for this call.
@@ -270,7 +275,7 @@ class URConnection:
             connected=True,
             robot_mode=int(receive.getRobotMode()),
             safety_mode=int(receive.getSafetyMode()),
-            program_running=running and int(receive.getRuntimeState()) == RuntimeState.PLAYING,
+            program_running=running,
             q=tuple(receive.getActualQ()),
             qd=tuple(receive.getActualQd()),
             tcp=tuple(receive.getActualTCPPose()),

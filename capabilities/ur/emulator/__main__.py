@@ -8,6 +8,7 @@ ur_rtde holds the GIL while it connects, so the emulator always runs in its own 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import signal
 import sys
@@ -108,10 +109,8 @@ def main(argv: list[str] | None = None) -> int:
             else:
                 print(f"UR emulator (PolyScope {args.version}) on {args.host}; Ctrl+C stops it")
                 sys.stdout.flush()
-            try:
+            with contextlib.suppress(KeyboardInterrupt):
                 done.wait()
-            except KeyboardInterrupt:
-                pass
     except EmulatorError as exc:
         print(f"error: {exc}", file=sys.stderr, flush=True)
         return 2

@@ -109,7 +109,7 @@ class EmulatedController:
             delay = next_time - time.monotonic()
             if delay > 0:
                 self._stop_event.wait(delay)
-            else:
+            elif delay < -period:  # more than a period late: drop the backlog, keep the pace
                 next_time = time.monotonic()
 
     def _cycle(self) -> None:
@@ -255,11 +255,15 @@ class EmulatedController:
         return np.asarray(flange @ pose_to_matrix(self.cell.tcp_offset()))
 
     def move_joints(self, q: Sequence[float], speed: float, accel: float) -> CommandHandle:
-        return self._watch(self.cell.robot.move_joints(list(q), speed * self.speed_fraction or 1e-3, accel))
+        return self._watch(
+            self.cell.robot.move_joints(list(q), speed * self.speed_fraction or 1e-3, accel)
+        )
 
     def move_linear(self, tcp_base: np.ndarray, speed: float, accel: float) -> CommandHandle:
         target = matrix_to_pose(self._world_tcp(tcp_base))
-        return self._watch(self.cell.robot.move_linear(target, speed * self.speed_fraction or 1e-3, accel))
+        return self._watch(
+            self.cell.robot.move_linear(target, speed * self.speed_fraction or 1e-3, accel)
+        )
 
     def stop_arm(self, decel: float) -> CommandHandle:
         return self.cell.robot.stop(decel)

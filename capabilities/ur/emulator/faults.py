@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import threading
 from typing import TYPE_CHECKING
 
@@ -57,10 +58,8 @@ class ContactWatch:
 
     def close(self) -> None:
         if self._hooked:
-            try:
+            with contextlib.suppress(Exception):  # the cell may be closed already
                 self._cell.remove_step_hook(post=self._after_step)
-            except Exception:  # the cell may be closed already
-                pass
             self._hooked = False
 
     def _after_step(self, _time: float) -> None:

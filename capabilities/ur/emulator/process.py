@@ -70,14 +70,15 @@ class EmulatorProcess:
     def _read_line(self) -> dict[str, Any]:
         proc = self._proc
         assert proc is not None and proc.stdout is not None
+        stdout = proc.stdout
         result: list[str] = []
-        reader = threading.Thread(target=lambda: result.append(proc.stdout.readline()))
+        reader = threading.Thread(target=lambda: result.append(stdout.readline()))
         reader.daemon = True
         reader.start()
         reader.join(self._timeout)
         line = result[0] if result else ""
         while line and not line.startswith("{"):  # library banners on stdout
-            line = proc.stdout.readline()
+            line = stdout.readline()
         if not line:
             error = ""
             if proc.poll() is not None and proc.stderr is not None:

@@ -5,6 +5,7 @@ Each server accepts on a loopback address only and serves each client on its own
 
 from __future__ import annotations
 
+import contextlib
 import ipaddress
 import logging
 import re
@@ -119,10 +120,8 @@ class Server:
 
 
 def _close(sock: socket.socket) -> None:
-    try:
+    with contextlib.suppress(OSError):
         sock.shutdown(socket.SHUT_RDWR)
-    except OSError:
-        pass
     sock.close()
 
 
@@ -269,7 +268,7 @@ class _RTDESession:
             delay = next_time - time.monotonic()
             if delay > 0:
                 self.stop.wait(delay)
-            else:
+            elif delay < -period:  # more than a period late: drop the backlog, keep the pace
                 next_time = time.monotonic()
 
 

@@ -57,13 +57,30 @@ OUTPUT_TYPES: dict[str, str] = {
     "timestamp": "DOUBLE",
     **{
         name: _V6
-        for name in (
-            "target_q target_qd target_qdd target_current target_moment actual_q actual_qd "
-            "actual_qdd actual_current actual_moment joint_control_output actual_TCP_pose "
-            "actual_TCP_speed actual_TCP_force target_TCP_pose target_TCP_speed "
-            "joint_temperatures actual_joint_voltage ft_raw_wrench payload_inertia "
-            "actual_tool_flange_pose tcp_offset"
-        ).split()
+        for name in [
+            "target_q",
+            "target_qd",
+            "target_qdd",
+            "target_current",
+            "target_moment",
+            "actual_q",
+            "actual_qd",
+            "actual_qdd",
+            "actual_current",
+            "actual_moment",
+            "joint_control_output",
+            "actual_TCP_pose",
+            "actual_TCP_speed",
+            "actual_TCP_force",
+            "target_TCP_pose",
+            "target_TCP_speed",
+            "joint_temperatures",
+            "actual_joint_voltage",
+            "ft_raw_wrench",
+            "payload_inertia",
+            "actual_tool_flange_pose",
+            "tcp_offset",
+        ]
     },
     "actual_digital_input_bits": "UINT64",
     "actual_digital_output_bits": "UINT64",

@@ -63,7 +63,7 @@ def test_power_off_reads_zeros_and_refuses_moves(start_emulator) -> None:
         emulator.power_off()
         assert wait_for(lambda: receive.getRobotMode() == 3)  # POWER_OFF
         assert receive.getActualQ() == [0.0] * 6  # what a real UR reports with the arm off
-        assert not control.isProgramRunning()
+        assert wait_for(lambda: not control.isProgramRunning())
         target = list(before)
         target[0] += 0.2
         assert control.moveJ(target, 1.0, 1.4) is False
