@@ -12,8 +12,8 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Sequence
-from typing import Any
 from concurrent.futures import Future
+from typing import Any
 
 from capabilities.sim.commands import CommandHandle
 from capabilities.sim.kinematics import UR5Kinematics

@@ -8,8 +8,9 @@ import pytest
 
 from capabilities.ur.errors import URError
 from capabilities.ur.modes import RobotMode
+from capabilities.ur.tool_io import DigitalPin, URSuctionCup
 from engine.types import Pose
-from tests.capabilities.ur.conftest import wait_for
+from tests.capabilities.ur.emulators import wait_for
 
 pytestmark = pytest.mark.sim
 
@@ -124,3 +125,43 @@ def test_a_killed_controller_mid_move_is_connection_lost(start_emulator, connect
     assert handle.ok is False and "connection lost" in handle.message
     with pytest.raises(URError, match="connection lost"):
         arm.joint_positions()
+
+
+def test_suction_cup_on_a_tool_digital_output(start_emulator, connect) -> None:
+    emulator = start_emulator("5.12")
+    connection, _ = connect(emulator)
+    cup = URSuctionCup(connection, DigitalPin("tool", 0))
+    handle = cup.suction_on()
+    assert handle.wait(10) and handle.ok, handle.message
+    assert cup.vacuum_on() and cup.has_part()
+    assert emulator.state()["digital_outputs"] == 1 << 16
+    handle = cup.suction_off()
+    assert handle.wait(10) and handle.ok, handle.message
+    assert not cup.vacuum_on()
+    with pytest.raises(URError, match="no holster"):
+        cup.handle_grasp_pose()
+    with pytest.raises(ValueError, match="tool 0-1"):
+        DigitalPin("tool", 2)
+
+
+def test_speed_slider_scales_the_emulated_arm(start_emulator, connect) -> None:
+    emulator = start_emulator("5.12")
+    _, arm = connect(emulator)
+    handle = arm.set_speed_fraction(0.4)
+    assert handle.wait(10) and handle.ok, handle.message
+    assert wait_for(lambda: emulator.state()["speed_fraction"] == pytest.approx(0.4))
+    bad = arm.set_speed_fraction(1.5)
+    assert bad.done() and bad.ok is False and "0..1" in bad.message
+
+
+def test_protective_stop_at_a_set_time(start_emulator, connect) -> None:
+    emulator = start_emulator("5.12")
+    _, arm = connect(emulator)
+    q = arm.joint_positions()
+    far = list(q)
+    far[0] += 1.5
+    emulator.protective_stop(at=emulator.state()["sim_time"] + 0.3)
+    handle = arm.move_joints(far, 0.5, 1.0)
+    assert handle.wait(20)
+    assert handle.ok is False and "protective stop" in handle.message
+    assert abs(emulator.state()["q"][0] - far[0]) > 0.3

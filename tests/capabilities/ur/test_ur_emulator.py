@@ -11,7 +11,7 @@ import rtde_receive
 from capabilities.ur.emulator import UREmulator
 from capabilities.ur.emulator.servers import check_loopback
 from capabilities.ur.errors import EmulatorError
-from tests.capabilities.ur.conftest import wait_for
+from tests.capabilities.ur.emulators import wait_for
 
 pytestmark = pytest.mark.sim
 
