@@ -13,7 +13,7 @@ import math
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import Future
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from capabilities.sim.commands import CommandHandle
 from capabilities.sim.kinematics import UR5Kinematics
@@ -295,3 +295,11 @@ class _Monitor:
             handle.resolve(False, f"{handle.name}: the controller did not start the move")
             return True
         return False
+
+
+if TYPE_CHECKING:  # the arm is both interfaces the capabilities ask a cell for
+    from capabilities.freedrive.backend import FreedriveBackend
+    from capabilities.motion.backend import ArmBackend
+
+    def _conforms(arm: URArm) -> tuple[ArmBackend, FreedriveBackend]:
+        return arm, arm

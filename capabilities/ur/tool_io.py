@@ -9,6 +9,7 @@ flange here (no holster): ``in_hand`` is always True and the holster poses are r
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from capabilities.sim.commands import CommandHandle
 from capabilities.ur.connection import URConnection, fault_reason
@@ -117,3 +118,10 @@ class URSuctionCup:
 
     def holstered_tip_pose(self) -> Pose:
         raise URError("this cell's suction cup is mounted on the flange: it has no holster")
+
+
+if TYPE_CHECKING:
+    from capabilities.tool.backend import SuctionBackend
+
+    def _conforms(cup: URSuctionCup) -> SuctionBackend:
+        return cup

@@ -116,9 +116,9 @@ class UREmulator:
     def protective_stop(self, at: float | None = None, on_contact: bool = False) -> None:
         """A protective stop now, at simulated time ``at``, or (armed) on the arm's next contact."""
         if on_contact:
-            self.ctl._contact.stop_on_contact(True)
+            self.ctl.faults.stop_on_contact(True)
         elif at is not None:
-            self.ctl._contact.stop_at(at)
+            self.ctl.faults.stop_at(at)
         else:
             self.ctl.protective_stop("injected")
 

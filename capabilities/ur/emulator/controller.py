@@ -78,7 +78,7 @@ class EmulatedController:
         self._started = time.monotonic()
         self._base = pose_to_matrix(cell.config.robot_base)
         self._base_inv = np.linalg.inv(self._base)
-        self._contact = ContactWatch(cell, self)
+        self.faults = ContactWatch(cell, self)
         self._snapshot: dict[str, Any] = {}
         self._stop_event = threading.Event()
         self._thread = threading.Thread(target=self._run, name="ur-emulator-ctl", daemon=True)
@@ -93,7 +93,7 @@ class EmulatedController:
         self._stop_event.set()
         if self._thread.is_alive():
             self._thread.join()
-        self._contact.close()
+        self.faults.close()
         with self._lock:
             self._end_program_locked("the controller shut down")
 
@@ -117,7 +117,7 @@ class EmulatedController:
             if self._pending_script is not None and self._can_run():
                 self._program = ControlProgram(self, self._pending_script)
                 self._pending_script = None
-            self._contact.check()
+            self.faults.check()
             if self._program is not None and not self._program.step():
                 self._end_program_locked("the control script ended")
             self._publish()
