@@ -165,3 +165,23 @@ def test_protective_stop_at_a_set_time(start_emulator, connect) -> None:
     assert handle.wait(20)
     assert handle.ok is False and "protective stop" in handle.message
     assert abs(emulator.state()["q"][0] - far[0]) > 0.3
+
+
+def test_dead_script_then_emergency_stop_fail_moves_by_name(start_emulator, connect) -> None:
+    emulator = start_emulator("5.12")
+    connection, arm = connect(emulator)
+    q = arm.joint_positions()
+    far = list(q)
+    far[0] += 1.5
+    handle = arm.move_joints(far, 0.5, 1.0)
+    assert wait_for(lambda: abs(emulator.state()["q"][0] - q[0]) > 0.02)
+    emulator.kill_script()
+    assert handle.wait(10)
+    assert handle.ok is False and "control script is not running" in handle.message
+    connection.call(connection.start_control)  # upload the script again
+    assert connection.state.program_running
+    handle = arm.move_joints(q, 0.5, 1.0)
+    assert wait_for(lambda: emulator.state()["moving"])
+    emulator.emergency_stop()
+    assert handle.wait(10)
+    assert handle.ok is False and "emergency stop" in handle.message
