@@ -1,0 +1,305 @@
+"""The UR arm as the motion and freedrive capabilities see it (ArmBackend, FreedriveBackend).
+
+Moves are ur_rtde's asynchronous moveJ/moveL; a monitor on the connection's I/O thread
+finishes the handle when the controller reports the asynchronous operation done, fails it on a
+protective or emergency stop, power off, a dead control script or a lost connection, and stops
+the arm (stopJ/stopL) when the handle is cancelled. Poses cross into UR terms (base frame,
+rotation vectors) here and nowhere else.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Sequence
+from concurrent.futures import Future
+from typing import TYPE_CHECKING, Any
+
+from capabilities.sim.commands import CommandHandle
+from capabilities.sim.kinematics import UR5Kinematics
+from capabilities.ur.connection import NO_SCRIPT, URConnection, URState, fault_reason
+from capabilities.ur.errors import URError
+from capabilities.ur.frames import URFrames
+from capabilities.ur.modes import PolyScopeVersion, RobotMode
+from engine.types import Pose
+
+__all__ = ["URArm", "FREEDRIVE_MODE_SINCE", "require_version"]
+
+FREEDRIVE_MODE_SINCE: PolyScopeVersion = (5, 10)
+_JOINT_TOLERANCE = 0.01  # rad: a finished move this far from its target did not arrive
+_POSITION_TOLERANCE = 0.002  # m
+_SCRIPT_GRACE = 0.06  # s: how long a stopped script must last before it is the reason
+_START_TIMEOUT = 2.0  # s for the controller to report the asynchronous move started
+
+
+def require_version(connection: URConnection, operation: str, needed: PolyScopeVersion) -> None:
+    """Raise unless the controller runs at least ``needed``.
+
+    Raises:
+        URError: naming the operation, the version it needs and the one the robot runs.
+    """
+    if connection.version < needed:
+        have = ".".join(map(str, connection.version))
+        raise URError(
+            f"{operation} needs PolyScope {needed[0]}.{needed[1]} or newer; "
+            f"the controller runs {have}"
+        )
+
+
+class URArm:
+    """A UR5 through ur_rtde: state, kinematics, moves, stop, speed slider and freedrive.
+
+    Args:
+        connection: the open connection (its I/O thread runs every ur_rtde call).
+        base: world pose of the UR base frame.
+        tcp: the TCP in the flange frame (also set on the controller).
+        home: home joints (rad).
+    """
+
+    def __init__(
+        self, connection: URConnection, base: Pose, tcp: Pose, home: Sequence[float]
+    ) -> None:
+        self._conn = connection
+        self.frames = URFrames(base)
+        self._tcp = tcp
+        self._kin = UR5Kinematics(base)
+        self._home = tuple(float(v) for v in home)
+        self._freedrive = False
+
+    # ---------------------------------------------------------------- state
+
+    def _readable(self) -> URState:
+        state = self._conn.state
+        if not state.connected:
+            raise URError(f"no pose: {fault_reason(state)}")
+        if state.robot_mode < RobotMode.RUNNING:
+            raise URError(
+                f"no pose: the arm is not running (robot mode {RobotMode(state.robot_mode).name})"
+            )
+        return state
+
+    def joint_positions(self) -> tuple[float, ...]:
+        """Measured joints (rad); raises URError while the arm is not running."""
+        return self._readable().q
+
+    def tcp_pose(self) -> Pose:
+        """World pose of the TCP; raises URError while the arm is not running."""
+        return self.frames.from_ur(self._readable().tcp)
+
+    def is_moving(self) -> bool:
+        return self._conn.state.moving
+
+    def home_joints(self) -> tuple[float, ...]:
+        return self._home
+
+    def inverse_kinematics(
+        self, pose: Pose, near: Sequence[float] | None = None
+    ) -> tuple[float, ...] | None:
+        return self._kin.inverse(
+            pose, near if near is not None else self.joint_positions(), self._tcp
+        )
+
+    # ---------------------------------------------------------------- moves
+
+    def move_joints(
+        self, q: Sequence[float], speed: float = 1.05, accel: float = 1.4
+    ) -> CommandHandle:
+        target = [float(v) for v in q]
+        if len(target) != 6 or not all(math.isfinite(v) for v in target):
+            return CommandHandle.failed("move_joints", f"moveJ needs 6 finite joints, got {target}")
+        return self._move(
+            "move_joints", lambda c: c.moveJ(target, speed, accel, True), "stopJ",
+            lambda s: max(abs(a - b) for a, b in zip(s.q, target, strict=False)) <= _JOINT_TOLERANCE,
+        )  # fmt: skip
+
+    def move_linear(self, pose: Pose, speed: float = 0.25, accel: float = 1.2) -> CommandHandle:
+        target = self.frames.to_ur(pose)
+        return self._move(
+            "move_linear", lambda c: c.moveL(target, speed, accel, True), "stopL",
+            lambda s: math.dist(s.tcp[:3], target[:3]) <= _POSITION_TOLERANCE,
+        )  # fmt: skip
+
+    def move_pose_joint_space(
+        self, pose: Pose, speed: float = 1.05, accel: float = 1.4
+    ) -> CommandHandle:
+        try:
+            q = self.inverse_kinematics(pose)
+        except URError as exc:
+            return CommandHandle.failed("move_pose_joint_space", str(exc))
+        if q is None:
+            return CommandHandle.failed("move_pose_joint_space", "unreachable pose")
+        return self.move_joints(q, speed, accel)
+
+    def stop(self, decel: float = 4.0) -> CommandHandle:
+        handle = CommandHandle("stop")
+
+        def run() -> None:
+            if self._conn.control is not None and self._conn.state.program_running:
+                self._conn.control.stopJ(decel)
+            handle.resolve(True, "stopped")
+
+        self._submit(handle, run)
+        return handle
+
+    def set_speed_fraction(self, fraction: float) -> CommandHandle:
+        """The speed slider (0..1) through RTDEIO."""
+        handle = CommandHandle("set_speed_fraction")
+        if not 0.0 <= fraction <= 1.0:
+            handle.resolve(False, f"speed fraction must be within 0..1, got {fraction}")
+            return handle
+
+        def run() -> None:
+            ok = self._conn.with_io(lambda io: io.setSpeedSlider(float(fraction)))
+            handle.resolve(bool(ok), "" if ok else "setSpeedSlider refused")
+
+        self._submit(handle, run)
+        return handle
+
+    def _submit(self, handle: CommandHandle, run: Callable[[], None]) -> None:
+        def fail(future: Future[None]) -> None:
+            exc = future.exception()
+            if exc is not None:
+                handle.resolve(False, f"{handle.name}: {_lost(exc, self._conn)}")
+
+        self._conn.submit(run).add_done_callback(fail)
+
+    def _move(
+        self,
+        name: str,
+        send: Callable[[Any], bool],
+        stop_name: str,
+        arrived: Callable[[URState], bool],
+    ) -> CommandHandle:
+        handle = CommandHandle(name, lambda h: None)  # cancel is seen by the monitor
+        conn = self._conn
+
+        def start() -> None:
+            problem = fault_reason(conn.state)
+            if problem:
+                handle.resolve(False, f"{name}: {problem}")
+                return
+            before = conn.state.async_op_id
+            if not send(conn.control):
+                conn.refresh()
+                handle.resolve(
+                    False, f"{name}: {fault_reason(conn.state) or 'refused by the controller'}"
+                )
+                return
+            _Monitor(handle, before, stop_name, arrived).attach(conn)
+
+        self._submit(handle, start)
+        return handle
+
+    # ---------------------------------------------------------------- freedrive
+
+    def set_freedrive(self, on: bool) -> None:
+        """Hand guiding: freedriveMode on PolyScope 5.10 and later, teachMode before.
+
+        Blocks for the controller's answer (call it off the engine thread).
+
+        Raises:
+            URError: the controller refused, or the robot cannot be hand guided now.
+        """
+
+        def run() -> None:
+            control = self._conn.control
+            problem = fault_reason(self._conn.state)
+            if problem:
+                raise URError(f"freedrive: {problem}")
+            new = self._conn.version >= FREEDRIVE_MODE_SINCE
+            if on:
+                ok = control.freedriveMode() if new else control.teachMode()
+            else:
+                ok = control.endFreedriveMode() if new else control.endTeachMode()
+            if not ok:
+                verb = ("freedriveMode" if on else "endFreedriveMode") if new else (
+                    "teachMode" if on else "endTeachMode"
+                )  # fmt: skip
+                raise URError(f"freedrive: {verb} refused: {fault_reason(self._conn.state)}")
+            self._freedrive = on
+
+        self._conn.call(run)
+
+    def freedrive_active(self) -> bool:
+        return self._freedrive
+
+    def freedrive_status(self) -> int:
+        """getFreedriveStatus (PolyScope 5.10 and later). Blocks for the answer.
+
+        Raises:
+            URError: an older controller (the message names the version needed).
+        """
+        require_version(self._conn, "freedrive status (getFreedriveStatus)", FREEDRIVE_MODE_SINCE)
+        return int(self._conn.call(lambda: self._conn.control.getFreedriveStatus()))
+
+
+def _lost(exc: BaseException, conn: URConnection) -> str:
+    if isinstance(exc, URError):
+        return str(exc)
+    conn.refresh()
+    reason = fault_reason(conn.state)
+    return reason if reason.startswith("connection lost") else f"connection lost ({exc})"
+
+
+class _Monitor:
+    """Watches one asynchronous move on the I/O thread."""
+
+    def __init__(
+        self, handle: CommandHandle, op_before: int, stop_name: str,
+        arrived: Callable[[URState], bool],
+    ) -> None:  # fmt: skip
+        self.handle = handle
+        self.op_before = op_before
+        self.stop_name = stop_name
+        self.arrived = arrived
+        self.started = False
+        self.deadline = 0.0
+        self.script_gone_at: float | None = None
+
+    def _debounce(self, now: float) -> bool:
+        """True while a stopped script has been seen for less than the grace time."""
+        if self.script_gone_at is None:
+            self.script_gone_at = now
+        return now - self.script_gone_at < _SCRIPT_GRACE
+
+    def attach(self, conn: URConnection) -> None:
+        self.deadline = time.monotonic() + _START_TIMEOUT
+        conn.add_monitor(self)
+
+    def __call__(self, conn: URConnection) -> bool:
+        handle, state = self.handle, conn.state
+        if handle.done():
+            return True
+        problem = fault_reason(state)
+        if problem == NO_SCRIPT and self._debounce(time.monotonic()):
+            return False  # a dropping connection first looks like a stopped script
+        if problem:
+            handle.resolve(False, f"{handle.name}: {problem}")
+            return True
+        self.script_gone_at = None
+        if handle.cancel_requested:
+            try:
+                getattr(conn.control, self.stop_name)(2.0, True)
+            finally:
+                handle.resolve(False, f"{handle.name} halted")
+            return True
+        if state.async_op_id != self.op_before:
+            self.started = True
+        if self.started and not state.async_running:
+            if self.arrived(state):
+                handle.resolve(True)
+            else:
+                handle.resolve(False, f"{handle.name}: the move ended away from its target")
+            return True
+        if not self.started and time.monotonic() > self.deadline:
+            handle.resolve(False, f"{handle.name}: the controller did not start the move")
+            return True
+        return False
+
+
+if TYPE_CHECKING:  # the arm is both interfaces the capabilities ask a cell for
+    from capabilities.freedrive.backend import FreedriveBackend
+    from capabilities.motion.backend import ArmBackend
+
+    def _conforms(arm: URArm) -> tuple[ArmBackend, FreedriveBackend]:
+        return arm, arm

@@ -1,0 +1,301 @@
+"""The connection to a UR controller through ur_rtde, on its own I/O thread.
+
+Every ur_rtde call runs on the thread this class starts; callers queue work with
+:meth:`URConnection.submit` (a Future) or :meth:`URConnection.watch` (a monitor polled every
+cycle) and read :attr:`URConnection.state`, a snapshot the thread refreshes each cycle. The
+engine's and the GUI's threads never wait on the robot.
+"""
+
+from __future__ import annotations
+
+import logging
+import queue
+import threading
+import time
+from collections.abc import Callable
+from concurrent.futures import Future
+from dataclasses import dataclass, field
+from typing import Any, TypeVar
+
+from capabilities.ur.errors import URConnectionLost, URError
+from capabilities.ur.modes import PolyScopeVersion, RobotMode, SafetyMode, parse_version
+
+__all__ = ["NO_SCRIPT", "URConnection", "URState", "fault_reason"]
+
+_log = logging.getLogger(__name__)
+T = TypeVar("T")
+_EMERGENCY = (SafetyMode.ROBOT_EMERGENCY_STOP, SafetyMode.SYSTEM_EMERGENCY_STOP)
+_MOVING_SPEED = 1e-3  # rad/s
+NO_SCRIPT = "the control script is not running on the controller"
+
+
+@dataclass(frozen=True)
+class URState:
+    """What the controller reported at the last cycle of the I/O thread."""
+
+    connected: bool = False
+    robot_mode: int = int(RobotMode.DISCONNECTED)
+    safety_mode: int = int(SafetyMode.NORMAL)
+    program_running: bool = False
+    q: tuple[float, ...] = (0.0,) * 6
+    qd: tuple[float, ...] = (0.0,) * 6
+    tcp: tuple[float, ...] = (0.0,) * 6  # UR base frame, [x, y, z, rx, ry, rz]
+    digital_outputs: int = 0
+    digital_inputs: int = 0
+    async_running: bool = False
+    async_op_id: int = -1
+    stamp: float = 0.0
+    problem: str = field(default="")
+
+    @property
+    def moving(self) -> bool:
+        return self.async_running or max(abs(v) for v in self.qd) > _MOVING_SPEED
+
+
+def fault_reason(state: URState) -> str:
+    """Why the robot cannot move now, in words ("" when it can)."""
+    if not state.connected:
+        return "connection lost" + (f" ({state.problem})" if state.problem else "")
+    safety = SafetyMode(state.safety_mode)
+    if safety == SafetyMode.PROTECTIVE_STOP:
+        return "protective stop"
+    if safety in _EMERGENCY:
+        return "emergency stop"
+    if safety not in (SafetyMode.NORMAL, SafetyMode.REDUCED):
+        return f"safety stop ({safety.name})"
+    if state.robot_mode < RobotMode.RUNNING:
+        mode = RobotMode(state.robot_mode).name
+        return "the arm is powered off" if state.robot_mode <= RobotMode.POWER_OFF else (
+            f"the arm is not running (robot mode {mode})"
+        )  # fmt: skip
+    if not state.program_running:
+        return NO_SCRIPT
+    return ""
+
+
+Monitor = Callable[["URConnection"], bool]  # True when done (drop it)
+
+
+class URConnection:
+    """ur_rtde's four interfaces to one controller, owned by one I/O thread.
+
+    Args:
+        host: the controller's address.
+        tcp: the TCP as ``[x, y, z, rx, ry, rz]`` in the flange frame (sent with setTcp).
+        rate: state polls per second.
+    """
+
+    def __init__(self, host: str, tcp: list[float] | None = None, rate: float = 125.0) -> None:
+        self.host = host
+        self.version: PolyScopeVersion = (0, 0)
+        self._tcp = list(tcp) if tcp is not None else [0.0] * 6
+        self._period = 1.0 / rate
+        self.state = URState()
+        self._tasks: queue.Queue[Callable[[], None] | None] = queue.Queue()
+        self._monitors: list[Monitor] = []
+        self._closing = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="costar-ur-io", daemon=True)
+        # ur_rtde objects: touched on the I/O thread only.
+        self.dashboard: Any = None
+        self.receive: Any = None
+        self.control: Any = None
+
+    # ---------------------------------------------------------------- lifecycle
+
+    def open(self, timeout: float = 30.0) -> None:
+        """Start the I/O thread and connect (blocks the caller up to ``timeout`` s).
+
+        Raises:
+            URConnectionLost: the controller does not answer.
+        """
+        self._thread.start()
+        future = self.submit(self._connect)
+        try:
+            future.result(timeout)
+        except URError:
+            self.close()
+            raise
+        except Exception as exc:
+            self.close()
+            raise URConnectionLost(
+                f"cannot connect to the UR controller at {self.host}: {exc}"
+            ) from exc
+
+    def close(self) -> None:
+        """Disconnect and stop the I/O thread. Idempotent."""
+        if self._closing.is_set():
+            return
+        self._closing.set()
+        if self._thread.is_alive():
+            self._tasks.put(None)
+            self._thread.join(timeout=10.0)
+
+    # ---------------------------------------------------------------- work for the I/O thread
+
+    def submit(self, fn: Callable[[], T]) -> Future[T]:
+        """Run ``fn()`` on the I/O thread; its result or exception lands in the Future."""
+        future: Future[T] = Future()
+        if self._closing.is_set():
+            future.set_exception(URConnectionLost("the UR connection is closed"))
+            return future
+
+        def run() -> None:
+            if not future.set_running_or_notify_cancel():
+                return
+            try:
+                future.set_result(fn())
+            except BaseException as exc:
+                future.set_exception(exc)
+
+        self._tasks.put(run)
+        return future
+
+    def watch(self, monitor: Monitor) -> None:
+        """Poll ``monitor(self)`` on the I/O thread every cycle until it returns True."""
+        self.submit(lambda: self._monitors.append(monitor))
+
+    def add_monitor(self, monitor: Monitor) -> None:
+        """(I/O thread only) Poll ``monitor(self)`` every cycle until it returns True."""
+        self._monitors.append(monitor)
+
+    def call(self, fn: Callable[[], T], timeout: float = 10.0) -> T:
+        """Run ``fn()`` on the I/O thread and wait for it (never from the engine thread)."""
+        return self.submit(fn).result(timeout)
+
+    # ---------------------------------------------------------------- the I/O thread
+
+    def _run(self) -> None:
+        next_poll = time.monotonic()
+        while True:
+            timeout = max(0.0, next_poll - time.monotonic())
+            try:
+                task = self._tasks.get(timeout=timeout)
+            except queue.Empty:
+                task = None if self._closing.is_set() else _POLL
+            if task is None and self._closing.is_set():
+                break
+            if task is not None and task is not _POLL:
+                task()
+                continue
+            next_poll = time.monotonic() + self._period
+            self.refresh()
+            for monitor in list(self._monitors):
+                try:
+                    finished = monitor(self)
+                except Exception:
+                    _log.exception("a UR monitor failed")
+                    finished = True
+                if finished:
+                    self._monitors.remove(monitor)
+        self._disconnect()
+
+    def _connect(self) -> None:
+        import dashboard_client
+        import rtde_receive
+
+        self.dashboard = dashboard_client.DashboardClient(self.host)
+        self.dashboard.connect()
+        self.version = parse_version(self.dashboard.polyscopeVersion())
+        self.receive = rtde_receive.RTDEReceiveInterface(self.host)
+        self.refresh()
+        if not fault_reason(URState(**{**self.state.__dict__, "program_running": True})):
+            self.start_control()
+
+    def start_control(self) -> None:
+        """(I/O thread) Connect the control interface, or upload its script again."""
+        import rtde_control
+
+        if self.control is None:
+            self.control = rtde_control.RTDEControlInterface(self.host)
+        elif not self.control.isProgramRunning():
+            if not self.control.isConnected():
+                self.control.reconnect()
+            self.control.reuploadScript()
+            deadline = time.monotonic() + 5.0
+            while not self.control.isProgramRunning() and time.monotonic() < deadline:
+                time.sleep(0.01)
+        if any(self._tcp):
+            self.control.setTcp(self._tcp)
+        deadline = time.monotonic() + 2.0
+        self.refresh()
+        while not self.state.program_running and time.monotonic() < deadline:
+            time.sleep(0.005)
+            self.refresh()
+
+    def with_io(self, fn: Callable[[Any], T]) -> T:
+        """(I/O thread) ``fn(RTDEIOInterface)`` on an I/O interface opened for this call.
+
+        ur_rtde's RTDEIOInterface never starts synchronisation, so once its controller is gone
+        its disconnect (and its destructor) throw and abort the process; a short-lived one is
+        closed while the controller still answers.
+        """
+        import rtde_io
+
+        io = rtde_io.RTDEIOInterface(self.host)
+        try:
+            return fn(io)
+        finally:
+            io.disconnect()
+
+    def clear_protective_stop(self) -> None:
+        """(I/O thread) What the operator does after a protective stop: close the popup,
+        unlock it through the dashboard, and upload the control script again.
+
+        Raises:
+            URError: the controller refused to unlock (too early, or another fault).
+        """
+        self.dashboard.closeSafetyPopup()
+        try:
+            self.dashboard.unlockProtectiveStop()
+        except Exception as exc:
+            raise URError(f"unlocking the protective stop failed: {exc}") from exc
+        self.start_control()
+
+    def refresh(self) -> None:
+        """(I/O thread only) Read the controller's state into :attr:`state` now."""
+        try:
+            self.state = self._read_state()
+        except Exception as exc:
+            self.state = URState(connected=False, problem=str(exc))
+
+    def _read_state(self) -> URState:
+        receive, control = self.receive, self.control
+        if receive is None:
+            return URState(connected=False, problem="not connected")
+        connected = bool(receive.isConnected()) and (control is None or control.isConnected())
+        if not connected:
+            return URState(connected=False, problem="the controller closed the connection")
+        running = False
+        async_running, op_id = False, -1
+        if control is not None:
+            running = bool(control.isProgramRunning())
+            status = control.getAsyncOperationProgressEx()
+            async_running, op_id = bool(status.isAsyncOperationRunning()), status.operationId()
+        return URState(
+            connected=True,
+            robot_mode=int(receive.getRobotMode()),
+            safety_mode=int(receive.getSafetyMode()),
+            program_running=running,
+            q=tuple(receive.getActualQ()),
+            qd=tuple(receive.getActualQd()),
+            tcp=tuple(receive.getActualTCPPose()),
+            digital_outputs=int(receive.getActualDigitalOutputBits()),
+            digital_inputs=int(receive.getActualDigitalInputBits()),
+            async_running=async_running,
+            async_op_id=op_id,
+            stamp=time.monotonic(),
+        )
+
+    def _disconnect(self) -> None:
+        for name in ("control", "receive", "dashboard"):
+            obj = getattr(self, name)
+            setattr(self, name, None)
+            if obj is None:
+                continue
+            try:
+                obj.disconnect()
+            except Exception:  # a dead controller: nothing more to close
+                _log.debug("disconnecting %s failed", name, exc_info=True)
+
+
+_POLL: Callable[[], None] = lambda: None  # noqa: E731  (marks a poll turn of the loop)

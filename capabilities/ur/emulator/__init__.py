@@ -1,0 +1,141 @@
+"""A loopback UR controller backed by the simulated cell, for ur_rtde without a robot.
+
+It serves the dashboard (29999), the script port (30003) and RTDE (30004) on a loopback
+address, speaks ur_rtde's register handshake (the command registers are interpreted, the
+URScript is not) and moves the simulated arm. Faults can be injected from a test or the
+command line. Example::
+
+    with UREmulator("127.0.0.2", version="5.12") as emulator:
+        control = rtde_control.RTDEControlInterface("127.0.0.2")
+        ...
+        emulator.protective_stop()
+"""
+
+from __future__ import annotations
+
+from types import TracebackType
+
+from capabilities.sim.cell import SimCell
+from capabilities.ur.emulator.controller import VERSIONS, EmulatedController
+from capabilities.ur.emulator.servers import (
+    Server,
+    check_loopback,
+    dashboard_client,
+    rtde_client,
+    script_client,
+)
+
+__all__ = ["UREmulator", "VERSIONS", "DASHBOARD_PORT", "SCRIPT_PORT", "RTDE_PORT"]
+
+DASHBOARD_PORT, SCRIPT_PORT, RTDE_PORT = 29999, 30003, 30004
+
+
+class UREmulator:
+    """The loopback UR controller; a context manager.
+
+    Args:
+        host: a loopback address (127.0.0.0/8); anything else is refused.
+        version: the PolyScope version to answer as: "3.15", "5.9" or "5.12".
+        cell: the simulated cell to drive (default: a new one, closed with the emulator).
+        speed: real-time factor of a new cell (1.0: a real robot's pace).
+        unlock_delay: seconds after a protective stop before the dashboard unlocks it.
+    """
+
+    def __init__(
+        self,
+        host: str = "127.0.0.2",
+        version: str = "5.12",
+        cell: SimCell | None = None,
+        speed: float | None = 1.0,
+        unlock_delay: float = 5.0,
+    ) -> None:
+        self.host = check_loopback(host)
+        if version not in VERSIONS:
+            raise ValueError(f"version must be one of {sorted(VERSIONS)}, got {version!r}")
+        self._own_cell = cell is None
+        self.cell = cell if cell is not None else SimCell(speed=speed)
+        self.controller: EmulatedController | None = None
+        self._servers: list[Server] = []
+        self._version = version
+        self._unlock_delay = unlock_delay
+
+    # ---------------------------------------------------------------- lifecycle
+
+    def start(self) -> UREmulator:
+        """Start the cell (if owned), the controller and the three servers."""
+        if self._own_cell:
+            self.cell.start()
+        try:
+            self.controller = EmulatedController(self.cell, self._version, self._unlock_delay)
+            self.controller.start()
+            for port, handler in (
+                (DASHBOARD_PORT, dashboard_client),
+                (SCRIPT_PORT, script_client),
+                (RTDE_PORT, rtde_client),
+            ):
+                self._servers.append(Server(self.host, port, self.controller, handler))
+        except BaseException:
+            self.close()
+            raise
+        return self
+
+    def close(self) -> None:
+        """Stop serving (clients see the connection closed) and stop the cell if owned.
+
+        Idempotent; this is also the "killed controller" fault.
+        """
+        servers, self._servers = self._servers, []
+        for server in servers:
+            server.close()
+        if self.controller is not None:
+            self.controller.close()
+        if self._own_cell:
+            self.cell.close()
+
+    kill = close
+
+    def __enter__(self) -> UREmulator:
+        return self.start()
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()
+
+    # ---------------------------------------------------------------- faults
+
+    @property
+    def ctl(self) -> EmulatedController:
+        if self.controller is None:
+            raise RuntimeError("the emulator is not started")
+        return self.controller
+
+    def protective_stop(self, at: float | None = None, on_contact: bool = False) -> None:
+        """A protective stop now, at simulated time ``at``, or (armed) on the arm's next contact."""
+        if on_contact:
+            self.ctl.faults.stop_on_contact(True)
+        elif at is not None:
+            self.ctl.faults.stop_at(at)
+        else:
+            self.ctl.protective_stop("injected")
+
+    def emergency_stop(self) -> None:
+        self.ctl.emergency_stop()
+
+    def release_emergency_stop(self) -> None:
+        self.ctl.release_emergency_stop()
+
+    def power_off(self) -> None:
+        self.ctl.power_off()
+
+    def kill_script(self) -> None:
+        """The control script stops (as after a script error); safety stays normal."""
+        self.ctl.end_program("the control script died")
+
+    def disconnect(self) -> None:
+        """Close every client connection; the servers keep listening (clients may reconnect)."""
+        for server in self._servers:
+            server.drop_clients()

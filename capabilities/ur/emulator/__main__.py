@@ -1,0 +1,121 @@
+"""``python -m capabilities.ur.emulator --host 127.0.0.2 --version 5.12``: run the emulator.
+
+With ``--control stdin`` it reads fault commands from standard input, one a line, and answers
+each with one JSON line (see :mod:`capabilities.ur.emulator.process`, which drives it so).
+ur_rtde holds the GIL while it connects, so the emulator always runs in its own process.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import signal
+import sys
+import threading
+from typing import Any
+
+from capabilities.ur.emulator import VERSIONS, UREmulator
+from capabilities.ur.errors import EmulatorError
+
+__all__ = ["main", "run_command"]
+
+
+def run_command(emulator: UREmulator, line: str) -> dict[str, Any]:
+    """Do one control command; the answer is a JSON-able dict with "ok"."""
+    words = line.split()
+    if not words:
+        return {"ok": False, "error": "empty command"}
+    name, args = words[0], words[1:]
+    ctl = emulator.ctl
+    if name == "protective_stop":
+        if args and args[0] == "on_contact":
+            emulator.protective_stop(on_contact=True)
+        elif args and args[0].startswith("at="):
+            emulator.protective_stop(at=float(args[0][3:]))
+        else:
+            emulator.protective_stop()
+    elif name in ("emergency_stop", "release_emergency_stop", "power_off", "kill_script",
+                  "disconnect"):  # fmt: skip
+        getattr(emulator, name)()
+    elif name == "state":
+        snap = ctl.snapshot()
+        return {
+            "ok": True, "robot_mode": snap["robot_mode"], "safety_mode": snap["safety_mode"],
+            "program_running": ctl.program_running(), "q": list(snap["actual_q"]),
+            "digital_outputs": ctl.digital_outputs(), "freedrive": ctl.freedrive_on,
+            "speed_fraction": ctl.speed_fraction, "sim_time": emulator.cell.time(),
+            "moving": ctl.arm_moving(), "messages": ctl.messages[-5:],
+        }  # fmt: skip
+    elif name != "quit":
+        return {"ok": False, "error": f"unknown command {name!r}"}
+    return {"ok": True}
+
+
+def _serve_stdin(emulator: UREmulator, done: threading.Event) -> None:
+    for line in sys.stdin:
+        try:
+            answer = run_command(emulator, line.strip())
+        except Exception as exc:  # a bad command is answered, never fatal
+            answer = {"ok": False, "error": f"{type(exc).__name__}: {exc}"}
+        print(json.dumps(answer), flush=True)
+        if line.strip() == "quit":
+            break
+    done.set()
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python -m capabilities.ur.emulator",
+        description="A loopback UR controller (dashboard, script port, RTDE) backed by the "
+        "simulated cell.",
+    )
+    parser.add_argument("--host", default="127.0.0.2", help="a loopback address (127.0.0.0/8)")
+    parser.add_argument("--version", default="5.12", choices=sorted(VERSIONS))
+    parser.add_argument(
+        "--speed", type=float, default=1.0, help="real-time factor of the simulation (1.0)"
+    )
+    parser.add_argument(
+        "--unlock-delay", type=float, default=5.0,
+        help="seconds before a protective stop can be unlocked (default 5, as on a UR)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--protective-stop-at", type=float, default=None, metavar="SECONDS",
+        help="inject a protective stop at this simulated time",
+    )  # fmt: skip
+    parser.add_argument(
+        "--protective-stop-on-contact", action="store_true",
+        help="a protective stop when the arm touches something",
+    )  # fmt: skip
+    parser.add_argument(
+        "--control", choices=("none", "stdin"), default="none",
+        help="stdin: read fault commands from standard input (for tests)",
+    )  # fmt: skip
+    args = parser.parse_args(argv)
+    done = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *_: done.set())
+    try:
+        emulator = UREmulator(
+            args.host, args.version, speed=args.speed, unlock_delay=args.unlock_delay
+        )
+        with emulator:
+            if args.protective_stop_at is not None:
+                emulator.protective_stop(at=args.protective_stop_at)
+            if args.protective_stop_on_contact:
+                emulator.protective_stop(on_contact=True)
+            if args.control == "stdin":
+                print(json.dumps({"ok": True, "ready": args.host}), flush=True)
+                threading.Thread(target=_serve_stdin, args=(emulator, done), daemon=True).start()
+            else:
+                print(f"UR emulator (PolyScope {args.version}) on {args.host}; Ctrl+C stops it")
+                sys.stdout.flush()
+            with contextlib.suppress(KeyboardInterrupt):
+                done.wait()
+    except EmulatorError as exc:
+        print(f"error: {exc}", file=sys.stderr, flush=True)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
