@@ -37,7 +37,6 @@ from engine.operations import (
     OperationKind,
     OperationManifest,
     PortSpec,
-    StartResult,
 )
 from engine.status import RUNNING, Status
 from engine.types import ObjectModel, ParamType, Region
@@ -103,7 +102,7 @@ class Confirm:
     def __init__(self, console: OperatorConsole) -> None:
         self._console = console
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         text = str(call.args.get("prompt", "")).strip()
         if not text:
             raise OperationFailed("confirm needs the text of the question")
@@ -120,8 +119,8 @@ class ButtonPressed:
     def __init__(self, console: OperatorConsole) -> None:
         self._console = console
 
-    def start(self, call: OperationCall) -> StartResult:
-        return self._console.consume(str(call.args.get("button", "continue")))
+    def start(self, call: OperationCall) -> Job:
+        return Job.answer(self._console.consume(str(call.args.get("button", "continue"))))
 
 
 class _ButtonJob(Job):
@@ -159,7 +158,7 @@ class WaitForButton:
     def __init__(self, console: OperatorConsole) -> None:
         self._console = console
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         button = str(call.args.get("button", "continue"))
         if not call.args.get("earlier_press_counts", False):
             self._console.clear(button)
@@ -175,7 +174,7 @@ class WaitForHandoff:
     def __init__(self, env: CapabilityEnv) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         what = "wait_for_handoff"
         camera_name = str(call.args.get("camera", "shoulder"))
         if camera_name not in CAMERAS:
@@ -209,15 +208,15 @@ class ObjectInRegion:
     def __init__(self, env: CapabilityEnv) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         world: WorldModel = _interface(self._env, "world", "object_in_region")
         detection = latest(world, _object_name(call.args["object"]))
         if detection is None:
-            return False
+            return Job.answer(False)
         max_age = _seconds(call, "max_age")
         if max_age > 0 and call.clock() - detection.stamp > max_age:
-            return False
-        return in_region(detection.pose, call.args["region"])
+            return Job.answer(False)
+        return Job.answer(in_region(detection.pose, call.args["region"]))
 
 
 # ---------------------------------------------------------------------- manifests

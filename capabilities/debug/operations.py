@@ -17,7 +17,6 @@ from engine.operations import (
     OperationKind,
     OperationManifest,
     PortSpec,
-    StartResult,
 )
 from engine.status import FAILURE, RUNNING, SUCCESS, Status
 from engine.types import ParamType
@@ -34,12 +33,12 @@ def _manifest(op: str, kind: OperationKind, doc: str, *ports: PortSpec) -> Opera
 
 
 class _Succeed:
-    def start(self, call: OperationCall) -> StartResult:
-        return True
+    def start(self, call: OperationCall) -> Job:
+        return Job.done()
 
 
 class _Fail:
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         raise OperationFailed(str(call.args.get("message") or "failed on purpose"))
 
 
@@ -69,7 +68,7 @@ def _then_status(value: Any) -> Status:
 
 
 class _Running:
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         ticks = int(call.args["ticks"])
         if ticks < 0:
             raise OperationFailed(f"ticks must be 0 or more, not {ticks}")
@@ -77,31 +76,31 @@ class _Running:
 
 
 class _PretendMove:
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         call.log(f"moving to {call.args['target']}")
         return _TickJob(int(call.args["ticks"]), SUCCESS, "")
 
 
 class _SetParam:
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         call.write("name", call.args["value"])
-        return True
+        return Job.done()
 
 
 class _Query:
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         call.write("result", call.args["value"])
-        return True
+        return Job.done()
 
 
 class _CheckParam:
-    def start(self, call: OperationCall) -> StartResult:
-        return bool(call.args["value"] == call.args["expected"])
+    def start(self, call: OperationCall) -> Job:
+        return Job.answer(bool(call.args["value"] == call.args["expected"]))
 
 
 class _Condition:
-    def start(self, call: OperationCall) -> StartResult:
-        return bool(call.args["result"])
+    def start(self, call: OperationCall) -> Job:
+        return Job.answer(bool(call.args["result"]))
 
 
 class _SucceedAfter:
@@ -110,15 +109,15 @@ class _SucceedAfter:
     def __init__(self) -> None:
         self.evaluations = 0
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         self.evaluations += 1
-        return self.evaluations > int(call.args["failures"])
+        return Job.answer(self.evaluations > int(call.args["failures"]))
 
 
 class _Log:
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         call.log(str(call.args["message"]))
-        return True
+        return Job.done()
 
 
 def _maker(cls: type) -> Any:

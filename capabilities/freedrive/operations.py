@@ -15,7 +15,6 @@ from engine.operations import (
     OperationKind,
     OperationManifest,
     PortSpec,
-    StartResult,
 )
 from engine.types import JointConfig, ParamType, Waypoint, WaypointFrame
 
@@ -68,7 +67,7 @@ class SetFreedrive:
         self._backend = backend
         self._on = on
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         describe = "start freedrive" if self._on else "stop freedrive"
         return _off_thread(lambda: self._backend.set_freedrive(self._on), describe)
 
@@ -79,7 +78,7 @@ class RecordWaypoint:
     def __init__(self, backend: FreedriveBackend) -> None:
         self._backend = backend
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         name = str(call.args.get("name", "waypoint")).strip()
         if not name:
             raise OperationFailed("the waypoint needs a name")
@@ -92,7 +91,7 @@ class RecordWaypoint:
         else:
             raise OperationFailed(f"frame must be 'world' or 'joints', not {frame!r}")
         call.write("waypoint", waypoint)
-        return True
+        return Job.done()
 
 
 def build_freedrive_capability() -> Capability:

@@ -5,7 +5,7 @@ from __future__ import annotations
 from capabilities.base import Capability, CapabilityEnv
 from capabilities.gripper.backend import GRIPPER, GripperBackend
 from capabilities.jobs import job_from_handle
-from engine.operations import OperationCall, OperationKind, OperationManifest, StartResult
+from engine.operations import Job, OperationCall, OperationKind, OperationManifest
 
 __all__ = ["build_gripper_capability"]
 
@@ -34,7 +34,7 @@ class Open:
     def __init__(self, gripper: GripperBackend) -> None:
         self._gripper = gripper
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         return job_from_handle(self._gripper.open(), "open the gripper")
 
 
@@ -44,7 +44,7 @@ class Close:
     def __init__(self, gripper: GripperBackend) -> None:
         self._gripper = gripper
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         return job_from_handle(self._gripper.close(), "close the gripper")
 
 
@@ -54,8 +54,8 @@ class IsClosed:
     def __init__(self, gripper: GripperBackend) -> None:
         self._gripper = gripper
 
-    def start(self, call: OperationCall) -> StartResult:
-        return self._gripper.is_closed()
+    def start(self, call: OperationCall) -> Job:
+        return Job.answer(self._gripper.is_closed())
 
 
 class IsHolding:
@@ -64,8 +64,8 @@ class IsHolding:
     def __init__(self, gripper: GripperBackend) -> None:
         self._gripper = gripper
 
-    def start(self, call: OperationCall) -> StartResult:
-        return self._gripper.is_holding()
+    def start(self, call: OperationCall) -> Job:
+        return Job.answer(self._gripper.is_holding())
 
 
 def build_gripper_capability() -> Capability:

@@ -30,7 +30,6 @@ from engine.operations import (
     OperationKind,
     OperationManifest,
     PortSpec,
-    StartResult,
 )
 from engine.types import ObjectModel, ParamType, Pose
 
@@ -100,7 +99,7 @@ class DetectMarkers:
     def __init__(self, env: _Env) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         camera = self._env.camera(str(call.args["camera"]))
         env = self._env
 
@@ -129,13 +128,13 @@ class MarkerPose:
     def __init__(self, env: _Env) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         marker_id = int(call.args["marker_id"])
         found = self._env.world.marker(marker_id)
         if found is None:
             raise OperationFailed(f"marker {marker_id} has not been seen")
         call.write("pose", found[0])
-        return True
+        return Job.done()
 
 
 def _best(env: _Env, model: Any) -> Detection | None:
@@ -147,20 +146,20 @@ class ObjectPose:
     def __init__(self, env: _Env) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         detection = _best(self._env, call.args["object"])
         if detection is None:
             raise OperationFailed(f"{call.args['object'].name} has not been seen")
         call.write("pose", detection.pose)
-        return True
+        return Job.done()
 
 
 class ObjectFound:
     def __init__(self, env: _Env) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
-        return _best(self._env, call.args["object"]) is not None
+    def start(self, call: OperationCall) -> Job:
+        return Job.answer(_best(self._env, call.args["object"]) is not None)
 
 
 class CalibrateCamera:
@@ -169,7 +168,7 @@ class CalibrateCamera:
     def __init__(self, env: _Env) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         camera = self._env.camera(str(call.args["camera"]))
         if camera.on_wrist:
             raise OperationFailed(

@@ -19,7 +19,7 @@ from capabilities.motion.backend import ARM, WORLD, ArmBackend, WorldBackend
 from capabilities.motion.geometry import format_pose_mm
 from capabilities.motion.symmetry import SymmetryTable
 from capabilities.motion.targets import TargetResolver
-from engine.operations import OperationCall, OperationFailed, StartResult
+from engine.operations import Job, OperationCall, OperationFailed
 from engine.types import JointConfig, Pose
 
 __all__ = ["build_motion_capability", "scale"]
@@ -58,7 +58,7 @@ class MoveTo:
         self._arm = arm
         self._resolver = resolver
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         mode = str(call.args.get("mode", "joint"))
         if mode not in ("joint", "linear"):
             raise OperationFailed(f"mode must be 'joint' or 'linear', not {mode!r}")
@@ -92,7 +92,7 @@ class MoveJoints:
     def __init__(self, arm: ArmBackend) -> None:
         self._arm = arm
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         target = call.args["target"]
         if not isinstance(target, JointConfig):
             raise OperationFailed(f"target must be joint positions, not {type(target).__name__}")
@@ -105,7 +105,7 @@ class MoveRelative:
     def __init__(self, arm: ArmBackend) -> None:
         self._arm = arm
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         offset = (float(call.args["dx"]), float(call.args["dy"]), float(call.args["dz"]))
         frame = str(call.args.get("frame", "world"))
         now = self._arm.tcp_pose()
@@ -128,7 +128,7 @@ class GoHome:
     def __init__(self, arm: ArmBackend) -> None:
         self._arm = arm
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         return _joint_move(self._arm, self._arm.home_joints(), call, "go home")
 
 
@@ -138,7 +138,7 @@ class Stop:
     def __init__(self, arm: ArmBackend) -> None:
         self._arm = arm
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         return job_from_handle(self._arm.stop(), "stop")
 
 
@@ -148,9 +148,9 @@ class CurrentPose:
     def __init__(self, arm: ArmBackend) -> None:
         self._arm = arm
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         call.write("pose", self._arm.tcp_pose())
-        return True
+        return Job.done()
 
 
 class CurrentJoints:
@@ -159,9 +159,9 @@ class CurrentJoints:
     def __init__(self, arm: ArmBackend) -> None:
         self._arm = arm
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         call.write("joints", JointConfig(self._arm.joint_positions()))
-        return True
+        return Job.done()
 
 
 class IsMoving:
@@ -171,8 +171,8 @@ class IsMoving:
         self._arm = arm
         self._negate = negate
 
-    def start(self, call: OperationCall) -> StartResult:
-        return self._arm.is_moving() != self._negate
+    def start(self, call: OperationCall) -> Job:
+        return Job.answer(self._arm.is_moving() != self._negate)
 
 
 class IsHome:
@@ -181,10 +181,10 @@ class IsHome:
     def __init__(self, arm: ArmBackend) -> None:
         self._arm = arm
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         tolerance = float(call.args.get("tolerance", 0.01))
         now, home = self._arm.joint_positions(), self._arm.home_joints()
-        return max(abs(a - b) for a, b in zip(now, home, strict=True)) <= tolerance
+        return Job.answer(max(abs(a - b) for a, b in zip(now, home, strict=True)) <= tolerance)
 
 
 def _world(env: CapabilityEnv) -> WorldBackend | None:

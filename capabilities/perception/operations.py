@@ -31,7 +31,6 @@ from engine.operations import (
     OperationKind,
     OperationManifest,
     PortSpec,
-    StartResult,
 )
 from engine.types import ObjectModel, ParamType, Pose
 
@@ -101,7 +100,7 @@ class DetectObjects:
     def __init__(self, env: _Env) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         env = self._env
         camera = env.camera(str(call.args["camera"]))
         recognizer = env.shared.recognizer(env.library, env.config)
@@ -134,38 +133,38 @@ class ObjectFound:
     def __init__(self, env: _Env) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
-        return bool(self._env.seen(call.args["object"]))
+    def start(self, call: OperationCall) -> Job:
+        return Job.answer(bool(self._env.seen(call.args["object"])))
 
 
 class ObjectPose:
     def __init__(self, env: _Env) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         seen = self._env.seen(call.args["object"])
         if not seen:
             raise OperationFailed(f"{_name(call.args['object'])} has not been seen")
         call.write("pose", seen[0].pose)
-        return True
+        return Job.done()
 
 
 class ObjectsOfClass:
     def __init__(self, env: _Env) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         seen = self._env.seen(call.args["object"])
         call.write("count", float(len(seen)))
         call.write("poses", [d.pose for d in seen])
-        return True
+        return Job.done()
 
 
 class PlateType:
     def __init__(self, env: _Env) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         near: Pose = call.args["near"]
         within = float(call.args["within"])
         plates = [
@@ -179,7 +178,7 @@ class PlateType:
             raise OperationFailed(f"no plate seen within {within:g} m of {near.position}")
         call.write("model", ObjectModel(ranked[0].object_class))
         call.write("pose", ranked[0].pose)
-        return True
+        return Job.done()
 
 
 def _name(model: Any) -> str:

@@ -20,7 +20,6 @@ from engine.operations import (
     OperationCall,
     OperationKind,
     OperationManifest,
-    StartResult,
 )
 from engine.types import Pose
 
@@ -93,10 +92,10 @@ class _Scripted:
 class Unholster(_Scripted):
     """tool.unholster: open, approach above the handle, descend, close, lift out."""
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         if self.suction.in_hand():
             call.log("the suction tool is already in the gripper")
-            return True
+            return Job.done()
         if self.gripper.is_holding():
             return _check(lambda: False, "the gripper holds something: put it down first")
         grasp = self.suction.handle_grasp_pose
@@ -121,10 +120,10 @@ class Unholster(_Scripted):
 class Holster(_Scripted):
     """tool.holster: vacuum off, approach above the holster, lower, open, move clear."""
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         if not self.suction.in_hand():
             call.log("the suction tool is not in the gripper: nothing to put back")
-            return True
+            return Job.done()
         tip = self.suction.holstered_tip_pose
         return chain_jobs(
             [
@@ -152,7 +151,7 @@ class SuctionOn:
     def __init__(self, suction: SuctionBackend) -> None:
         self._suction = suction
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         return job_from_handle(self._suction.suction_on(), "suction on")
 
 
@@ -162,7 +161,7 @@ class SuctionOff:
     def __init__(self, suction: SuctionBackend) -> None:
         self._suction = suction
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         return job_from_handle(self._suction.suction_off(), "suction off")
 
 
@@ -172,8 +171,8 @@ class HasPart:
     def __init__(self, suction: SuctionBackend) -> None:
         self._suction = suction
 
-    def start(self, call: OperationCall) -> StartResult:
-        return self._suction.has_part()
+    def start(self, call: OperationCall) -> Job:
+        return Job.answer(self._suction.has_part())
 
 
 def build_tool_capability() -> Capability:
