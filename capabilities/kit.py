@@ -14,15 +14,28 @@ and the key, and an explicit 0 is 0.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from capabilities.errors import CapabilityError
 from engine.operations import OperationKind, OperationManifest, PortSpec
 from engine.types import ParamType, Pose, decode_value
 
-__all__ = ["CapabilitySettingsError", "Setting", "manifest", "parse_settings"]
+if TYPE_CHECKING:
+    from capabilities.base import CapabilityEnv
+
+__all__ = [
+    "CAMERAS",
+    "CapabilitySettingsError",
+    "Setting",
+    "manifest",
+    "parse_settings",
+    "stateful",
+]
+
+CAMERAS = ("shoulder", "wrist")
+"""The RGB-D cameras a cell may have; camera ``name`` is the interface ``rgbd:<name>``."""
 
 
 class CapabilitySettingsError(CapabilityError):
@@ -48,6 +61,13 @@ def manifest(
     return OperationManifest(f"{capability}.{name}", kind, doc, capability, ports, aliases)
 
 
+def stateful(cls: Callable[..., Any], *extra: Any) -> Callable[[CapabilityEnv], Any]:
+    """The factory of an operation class whose first argument is the per-cell state:
+    ``cap.add(IS_EMPTY, stateful(RegionCondition, False))`` makes
+    ``RegionCondition(env.state, False)`` for each leaf."""
+    return lambda env: cls(env.state, *extra)
+
+
 _PY_TYPES: dict[type, str] = {float: "a number", int: "an integer", bool: "true or false",
                               str: "a text", Pose: "a pose"}  # fmt: skip
 
@@ -58,26 +78,33 @@ class Setting:
 
     Attributes:
         name: the key in the block.
-        type: float (SI units; an integer is taken as a float), int, bool, str or Pose
-            (the JSON form of a Pose parameter).
+        type: float (SI units; an integer is taken as a float), int, bool, str, Pose
+            (the JSON form of a Pose parameter) or tuple (a list of ``size`` numbers,
+            read as a tuple of floats).
         default: the value when the cell file does not give one (None: not set).
         doc: one line saying what it does and its unit.
+        size: how many numbers a tuple setting has.
     """
 
     name: str
     type: type
     default: Any = None
     doc: str = ""
+    size: int = 0
 
     def parse(self, value: Any, where: str) -> Any:
         """The setting's value from its JSON form; raises CapabilitySettingsError."""
         if value is None:
             return None
+        if self.type is Pose and isinstance(value, Pose):  # given in code, not from a file
+            return value
         if self.type is Pose:
             try:
                 return decode_value(ParamType.POSE, value, where)
             except ValueError as exc:
                 raise CapabilitySettingsError(str(exc)) from exc
+        if self.type is tuple:
+            return self._numbers(value, where)
         ok = isinstance(value, self.type) and not (self.type is not bool and isinstance(value, bool))
         if self.type is float and isinstance(value, int) and not isinstance(value, bool):
             return float(value)
@@ -85,6 +112,17 @@ class Setting:
             expected = _PY_TYPES.get(self.type, self.type.__name__)
             raise CapabilitySettingsError(f"{where}: expected {expected}, got {value!r}")
         return value
+
+    def _numbers(self, value: Any, where: str) -> tuple[float, ...]:
+        if (
+            not isinstance(value, (list, tuple))
+            or len(value) != self.size
+            or any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in value)
+        ):
+            raise CapabilitySettingsError(
+                f"{where}: expected a list of {self.size} numbers, got {value!r}"
+            )
+        return tuple(float(v) for v in value)
 
 
 def parse_settings(

@@ -41,7 +41,7 @@ from engine.operations import (
 from engine.status import RUNNING, Status
 from engine.types import ObjectModel, ParamType, Region
 
-__all__ = ["CAP", "build_capability"]
+__all__ = ["CAP", "capability"]
 
 CAP = "collaboration"
 CAMERAS = ("shoulder", "wrist")
@@ -273,7 +273,7 @@ def _manifests() -> list[tuple[OperationManifest, Any]]:
     ]  # fmt: skip
 
 
-def build_capability() -> Capability:
+def capability() -> Capability:
     """The collaboration capability (requires the cell's ``operator`` console)."""
     cap = Capability(
         CAP,

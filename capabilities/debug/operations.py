@@ -21,7 +21,7 @@ from engine.operations import (
 from engine.status import FAILURE, RUNNING, SUCCESS, Status
 from engine.types import ParamType
 
-__all__ = ["build_debug_capability"]
+__all__ = ["capability"]
 
 CAP = "debug"
 ANY = (ParamType.ANY,)
@@ -127,7 +127,7 @@ def _maker(cls: type) -> Any:
     return make
 
 
-def build_debug_capability() -> Capability:
+def capability() -> Capability:
     """The debug capability with all its operations."""
     cap = Capability(CAP, "Operations for trying plans without a robot.")
     ticks = PortSpec("ticks", (ParamType.NUMBER,), default=3, doc="ticks spent RUNNING")

@@ -18,7 +18,7 @@ from engine.operations import (
 )
 from engine.types import JointConfig, ParamType, Waypoint, WaypointFrame
 
-__all__ = ["build_freedrive_capability"]
+__all__ = ["capability"]
 
 CAP = "freedrive"
 
@@ -94,7 +94,7 @@ class RecordWaypoint:
         return Job.done()
 
 
-def build_freedrive_capability() -> Capability:
+def capability() -> Capability:
     """The freedrive capability (requires ``freedrive``)."""
     cap = Capability(
         CAP, "Hand guiding of the arm and recording where it is.", requires=(FREEDRIVE,)

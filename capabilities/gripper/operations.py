@@ -7,7 +7,7 @@ from capabilities.gripper.backend import GRIPPER, GripperBackend
 from capabilities.jobs import job_from_handle
 from engine.operations import Job, OperationCall, OperationKind, OperationManifest
 
-__all__ = ["build_gripper_capability"]
+__all__ = ["capability"]
 
 CAP = "gripper"
 
@@ -68,7 +68,7 @@ class IsHolding:
         return Job.answer(self._gripper.is_holding())
 
 
-def build_gripper_capability() -> Capability:
+def capability() -> Capability:
     """The gripper capability (requires ``gripper``)."""
     cap = Capability(CAP, "Opens and closes the parallel gripper.", requires=(GRIPPER,))
 

@@ -33,7 +33,7 @@ from engine.operations import (
 )
 from engine.types import ObjectModel, ParamType, Pose
 
-__all__ = ["build_capability"]
+__all__ = ["capability"]
 
 CAP = "markers"
 CAMERAS = ("shoulder", "wrist")
@@ -195,7 +195,7 @@ class CalibrateCamera:
         return job
 
 
-def build_capability() -> Capability:
+def capability() -> Capability:
     cap = Capability(
         CAP,
         "Finds ArUco markers in camera images; object poses and camera calibration from them.",

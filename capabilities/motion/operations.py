@@ -22,7 +22,7 @@ from capabilities.motion.targets import TargetResolver
 from engine.operations import Job, OperationCall, OperationFailed
 from engine.types import JointConfig, Pose
 
-__all__ = ["build_motion_capability", "scale"]
+__all__ = ["capability", "scale"]
 
 _MAX_SCALE = 2.0
 
@@ -194,7 +194,7 @@ def _world(env: CapabilityEnv) -> WorldBackend | None:
         return None  # relative waypoints then need their reference bound
 
 
-def build_motion_capability(symmetries: SymmetryTable | None = None) -> Capability:
+def capability(symmetries: SymmetryTable | None = None) -> Capability:
     """The motion capability (requires ``arm``; reads ``world`` when the cell has one)."""
     table = symmetries if symmetries is not None else SymmetryTable()
     cap = Capability(

@@ -34,7 +34,7 @@ from engine.operations import (
 )
 from engine.types import ObjectModel, ParamType, Pose
 
-__all__ = ["SOURCE_PREFIX", "build_capability"]
+__all__ = ["SOURCE_PREFIX", "capability"]
 
 CAP = "perception"
 CAMERAS = ("shoulder", "wrist")
@@ -189,7 +189,7 @@ def _object_port() -> PortSpec:
     return PortSpec("object", (ParamType.OBJECT,), doc="the object class (a model name)")
 
 
-def build_capability() -> Capability:
+def capability() -> Capability:
     cap = Capability(
         CAP,
         "Recognises the library's objects on the table in RGB-D point clouds; plate types.",

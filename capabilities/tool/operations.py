@@ -23,7 +23,7 @@ from engine.operations import (
 )
 from engine.types import Pose
 
-__all__ = ["build_tool_capability", "APPROACH_HEIGHT", "LIFT_HEIGHT"]
+__all__ = ["capability", "APPROACH_HEIGHT", "LIFT_HEIGHT"]
 
 CAP = "tool"
 APPROACH_HEIGHT = 0.10  # m above the handle (or holster) where the straight descent starts
@@ -175,7 +175,7 @@ class HasPart:
         return Job.answer(self._suction.has_part())
 
 
-def build_tool_capability() -> Capability:
+def capability() -> Capability:
     """The tool capability (requires ``arm``, ``gripper`` and ``suction``)."""
     cap = Capability(
         CAP,
