@@ -21,6 +21,7 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
+from capabilities.errors import CapabilityError
 from engine.types import ParamType, ValueError_, Waypoint, decode_value, encode_value
 
 __all__ = [
@@ -36,7 +37,7 @@ FORMAT_VERSION = 1
 _PLAN_SUFFIXES = (".costar.json", ".json")
 
 
-class WaypointFileError(Exception):
+class WaypointFileError(CapabilityError):
     """A waypoint file cannot be read or written, or an edit is not possible.
 
     Attributes:
