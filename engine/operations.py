@@ -185,11 +185,14 @@ def read_reference(port: PortSpec, key: str, value: Any) -> Any:
     """A value read from the blackboard for ``port``, checked against the port's types.
 
     Raises:
-        InputTypeError: the value is of none of the port's types; the message names the
-            port, the blackboard name, the expected and the actual type.
+        InputTypeError: the value is of none of the port's types (or not one of its
+            choices); the message names the port, the blackboard name, the expected and
+            the actual type.
     """
     for ptype in port.types:
         if check_value(ptype, value):
+            if port.choices and value not in port.choices:
+                break
             return typed_input(port, value)
     raise InputTypeError(port, key, value)
 
@@ -354,6 +357,8 @@ class InputTypeError(OperationFailed):
         self.port = port.name
         self.key = key
         expected = " or ".join(t.value for t in port.types)
+        if port.choices:
+            expected += f" (one of {', '.join(port.choices)})"
         actual = type_of_value(value).value
         super().__init__(
             f"input {port.name!r} reads {key!r}, which holds {actual} {_short(value)}; "

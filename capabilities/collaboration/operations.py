@@ -48,10 +48,10 @@ CAMERAS = ("shoulder", "wrist")
 
 
 def _seconds(call: OperationCall, port: str) -> float:
-    value = call.args.get(port, 0.0)
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value >= 0:
+    value: float = call.input(port)  # a Duration (validation checked the type, not the sign)
+    if not value >= 0:
         raise OperationFailed(f"{port} must be a number of seconds, 0 or more, not {value!r}")
-    return float(value)
+    return value
 
 
 def _interface(env: CapabilityEnv, name: str, what: str) -> Any:
@@ -103,7 +103,7 @@ class Confirm:
         self._console = console
 
     def start(self, call: OperationCall) -> Job:
-        text = str(call.args.get("prompt", "")).strip()
+        text = call.input("prompt").strip()
         if not text:
             raise OperationFailed("confirm needs the text of the question")
         timeout = _seconds(call, "timeout")
@@ -120,7 +120,7 @@ class ButtonPressed:
         self._console = console
 
     def start(self, call: OperationCall) -> Job:
-        return Job.answer(self._console.consume(str(call.args.get("button", "continue"))))
+        return Job.answer(self._console.consume(call.input("button")))
 
 
 class _ButtonJob(Job):
@@ -159,8 +159,8 @@ class WaitForButton:
         self._console = console
 
     def start(self, call: OperationCall) -> Job:
-        button = str(call.args.get("button", "continue"))
-        if not call.args.get("earlier_press_counts", False):
+        button = call.input("button")
+        if not call.input("earlier_press_counts"):
             self._console.clear(button)
         return _ButtonJob(self._console, button, call, _seconds(call, "timeout"))
 
@@ -176,13 +176,13 @@ class WaitForHandoff:
 
     def start(self, call: OperationCall) -> Job:
         what = "wait_for_handoff"
-        camera_name = str(call.args.get("camera", "shoulder"))
+        camera_name = call.input("camera")
         if camera_name not in CAMERAS:
             raise OperationFailed(f"unknown camera {camera_name!r}; cameras: {', '.join(CAMERAS)}")
         camera = _interface(self._env, camera_interface(camera_name), what)
         world: WorldModel = _interface(self._env, "world", what)
         library = _interface(self._env, "objects", what)
-        name = _object_name(call.args["object"])
+        name = _object_name(call.input("object"))
         if name not in library.names():
             raise OperationFailed(f"the object library has no model {name!r}")
         target = object_markers(library.get(name))
@@ -192,7 +192,7 @@ class WaitForHandoff:
             interval=max(_seconds(call, "interval"), 0.01), settle=_seconds(call, "settle"),
             timeout=_seconds(call, "timeout"),
         )  # fmt: skip
-        region: Region = call.args["region"]
+        region: Region = call.input("region")
         return HandoffJob(camera, target, region, world, call.clock, settings, call.log)
 
 
@@ -210,13 +210,13 @@ class ObjectInRegion:
 
     def start(self, call: OperationCall) -> Job:
         world: WorldModel = _interface(self._env, "world", "object_in_region")
-        detection = latest(world, _object_name(call.args["object"]))
+        detection = latest(world, _object_name(call.input("object")))
         if detection is None:
             return Job.answer(False)
         max_age = _seconds(call, "max_age")
         if max_age > 0 and call.clock() - detection.stamp > max_age:
             return Job.answer(False)
-        return Job.answer(in_region(detection.pose, call.args["region"]))
+        return Job.answer(in_region(detection.pose, call.input("region")))
 
 
 # ---------------------------------------------------------------------- manifests

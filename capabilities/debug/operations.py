@@ -39,7 +39,7 @@ class _Succeed:
 
 class _Fail:
     def start(self, call: OperationCall) -> Job:
-        raise OperationFailed(str(call.args.get("message") or "failed on purpose"))
+        raise OperationFailed(str(call.input("message") or "failed on purpose"))
 
 
 class _TickJob(Job):
@@ -60,47 +60,44 @@ class _TickJob(Job):
         return self._then
 
 
-def _then_status(value: Any) -> Status:
-    text = str(value).upper()
-    if text not in ("SUCCESS", "FAILURE"):
-        raise OperationFailed(f"'then' must be SUCCESS or FAILURE, not {value!r}")
-    return SUCCESS if text == "SUCCESS" else FAILURE
+def _then_status(value: str) -> Status:
+    return SUCCESS if value == "SUCCESS" else FAILURE  # the port's choices
 
 
 class _Running:
     def start(self, call: OperationCall) -> Job:
-        ticks = int(call.args["ticks"])
+        ticks = int(call.input("ticks"))
         if ticks < 0:
             raise OperationFailed(f"ticks must be 0 or more, not {ticks}")
-        return _TickJob(ticks, _then_status(call.args["then"]), str(call.args.get("message", "")))
+        return _TickJob(ticks, _then_status(call.input("then")), call.input("message"))
 
 
 class _PretendMove:
     def start(self, call: OperationCall) -> Job:
-        call.log(f"moving to {call.args['target']}")
-        return _TickJob(int(call.args["ticks"]), SUCCESS, "")
+        call.log(f"moving to {call.input('target')}")
+        return _TickJob(int(call.input("ticks")), SUCCESS, "")
 
 
 class _SetParam:
     def start(self, call: OperationCall) -> Job:
-        call.write("name", call.args["value"])
+        call.write("name", call.input("value"))
         return Job.done()
 
 
 class _Query:
     def start(self, call: OperationCall) -> Job:
-        call.write("result", call.args["value"])
+        call.write("result", call.input("value"))
         return Job.done()
 
 
 class _CheckParam:
     def start(self, call: OperationCall) -> Job:
-        return Job.answer(bool(call.args["value"] == call.args["expected"]))
+        return Job.answer(bool(call.input("value") == call.input("expected")))
 
 
 class _Condition:
     def start(self, call: OperationCall) -> Job:
-        return Job.answer(bool(call.args["result"]))
+        return Job.answer(bool(call.input("result")))
 
 
 class _SucceedAfter:
@@ -111,12 +108,12 @@ class _SucceedAfter:
 
     def start(self, call: OperationCall) -> Job:
         self.evaluations += 1
-        return Job.answer(self.evaluations > int(call.args["failures"]))
+        return Job.answer(self.evaluations > int(call.input("failures")))
 
 
 class _Log:
     def start(self, call: OperationCall) -> Job:
-        call.log(str(call.args["message"]))
+        call.log(call.input("message"))
         return Job.done()
 
 

@@ -79,17 +79,15 @@ class RecordWaypoint:
         self._backend = backend
 
     def start(self, call: OperationCall) -> Job:
-        name = str(call.args.get("name", "waypoint")).strip()
+        name = call.input("name").strip()
         if not name:
             raise OperationFailed("the waypoint needs a name")
-        frame = str(call.args.get("frame", "world"))
+        frame = call.input("frame")
         if frame == "world":
             waypoint = Waypoint(name, WaypointFrame.WORLD, pose=self._backend.tcp_pose())
-        elif frame == "joints":
+        else:  # "joints" (the port's choices)
             joints = JointConfig(self._backend.joint_positions())
             waypoint = Waypoint(name, WaypointFrame.JOINTS, joints=joints)
-        else:
-            raise OperationFailed(f"frame must be 'world' or 'joints', not {frame!r}")
         call.write("waypoint", waypoint)
         return Job.done()
 

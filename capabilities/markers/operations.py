@@ -100,7 +100,7 @@ class DetectMarkers:
         self._env = env
 
     def start(self, call: OperationCall) -> Job:
-        camera = self._env.camera(str(call.args["camera"]))
+        camera = self._env.camera(call.input("camera"))
         env = self._env
 
         def look() -> dict[str, Any]:
@@ -129,7 +129,7 @@ class MarkerPose:
         self._env = env
 
     def start(self, call: OperationCall) -> Job:
-        marker_id = int(call.args["marker_id"])
+        marker_id = int(call.input("marker_id"))
         found = self._env.world.marker(marker_id)
         if found is None:
             raise OperationFailed(f"marker {marker_id} has not been seen")
@@ -147,9 +147,9 @@ class ObjectPose:
         self._env = env
 
     def start(self, call: OperationCall) -> Job:
-        detection = _best(self._env, call.args["object"])
+        detection = _best(self._env, call.input("object"))
         if detection is None:
-            raise OperationFailed(f"{call.args['object'].name} has not been seen")
+            raise OperationFailed(f"{call.input('object').name} has not been seen")
         call.write("pose", detection.pose)
         return Job.done()
 
@@ -159,7 +159,7 @@ class ObjectFound:
         self._env = env
 
     def start(self, call: OperationCall) -> Job:
-        return Job.answer(_best(self._env, call.args["object"]) is not None)
+        return Job.answer(_best(self._env, call.input("object")) is not None)
 
 
 class CalibrateCamera:
@@ -169,13 +169,13 @@ class CalibrateCamera:
         self._env = env
 
     def start(self, call: OperationCall) -> Job:
-        camera = self._env.camera(str(call.args["camera"]))
+        camera = self._env.camera(call.input("camera"))
         if camera.on_wrist:
             raise OperationFailed(
                 "the wrist camera is calibrated by hand-eye calibration, not here"
             )
         env = self._env
-        max_rms = float(call.args["max_error_px"])
+        max_rms = call.input("max_error_px")
 
         def calibrate() -> dict[str, Any]:
             frame = camera.capture()

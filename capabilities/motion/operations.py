@@ -8,7 +8,6 @@ the tick except :class:`OperationFailed`.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from typing import Any
 
@@ -29,12 +28,10 @@ _MAX_SCALE = 2.0
 
 def scale(call: OperationCall, port: str) -> float:
     """A speed or acceleration fraction from a port, checked to be in (0, 2]."""
-    value = call.args.get(port, 1.0)
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise OperationFailed(f"{port} must be a number, not {value!r}")
-    if not 0 < value <= _MAX_SCALE or not math.isfinite(value):
+    value: float = call.input(port)  # a Number (validation checked the type, not the range)
+    if not 0 < value <= _MAX_SCALE:
         raise OperationFailed(f"{port} must be above 0 and at most {_MAX_SCALE:g}, not {value}")
-    return float(value)
+    return value
 
 
 def _joint_move(arm: ArmBackend, q: Sequence[float], call: OperationCall, describe: str) -> Any:
@@ -59,11 +56,9 @@ class MoveTo:
         self._resolver = resolver
 
     def start(self, call: OperationCall) -> Job:
-        mode = str(call.args.get("mode", "joint"))
-        if mode not in ("joint", "linear"):
-            raise OperationFailed(f"mode must be 'joint' or 'linear', not {mode!r}")
+        mode = call.input("mode")
         current = self._arm.tcp_pose()
-        target = self._resolver.resolve(call.args["target"], call.args.get("reference"), current)
+        target = self._resolver.resolve(call.input("target"), call.input("reference"), current)
         if target.joints is not None:
             return _joint_move(
                 self._arm, target.joints.positions, call, f"move to {target.describe}"
@@ -93,9 +88,7 @@ class MoveJoints:
         self._arm = arm
 
     def start(self, call: OperationCall) -> Job:
-        target = call.args["target"]
-        if not isinstance(target, JointConfig):
-            raise OperationFailed(f"target must be joint positions, not {type(target).__name__}")
+        target: JointConfig = call.input("target")
         return _joint_move(self._arm, target.positions, call, "move_joints")
 
 
@@ -106,16 +99,14 @@ class MoveRelative:
         self._arm = arm
 
     def start(self, call: OperationCall) -> Job:
-        offset = (float(call.args["dx"]), float(call.args["dy"]), float(call.args["dz"]))
-        frame = str(call.args.get("frame", "world"))
+        offset = (call.input("dx"), call.input("dy"), call.input("dz"))
+        frame = call.input("frame")
         now = self._arm.tcp_pose()
         if frame == "world":
             x, y, z = now.position
             target = Pose((x + offset[0], y + offset[1], z + offset[2]), now.orientation)
-        elif frame == "tool":
+        else:  # "tool" (the port's choices)
             target = now.compose(Pose(offset))
-        else:
-            raise OperationFailed(f"frame must be 'world' or 'tool', not {frame!r}")
         if self._arm.inverse_kinematics(target) is None:
             raise OperationFailed(f"unreachable: pose {format_pose_mm(target)}")
         mm = ", ".join(f"{v * 1000:.1f}" for v in offset)
@@ -182,7 +173,7 @@ class IsHome:
         self._arm = arm
 
     def start(self, call: OperationCall) -> Job:
-        tolerance = float(call.args.get("tolerance", 0.01))
+        tolerance = call.input("tolerance")
         now, home = self._arm.joint_positions(), self._arm.home_joints()
         return Job.answer(max(abs(a - b) for a, b in zip(now, home, strict=True)) <= tolerance)
 

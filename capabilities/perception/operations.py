@@ -102,7 +102,7 @@ class DetectObjects:
 
     def start(self, call: OperationCall) -> Job:
         env = self._env
-        camera = env.camera(str(call.args["camera"]))
+        camera = env.camera(call.input("camera"))
         recognizer = env.shared.recognizer(env.library, env.config)
         tracker = env.shared.tracker(env.world, camera.name, env.library)
         source = f"{SOURCE_PREFIX}{camera.name}"
@@ -134,7 +134,7 @@ class ObjectFound:
         self._env = env
 
     def start(self, call: OperationCall) -> Job:
-        return Job.answer(bool(self._env.seen(call.args["object"])))
+        return Job.answer(bool(self._env.seen(call.input("object"))))
 
 
 class ObjectPose:
@@ -142,9 +142,9 @@ class ObjectPose:
         self._env = env
 
     def start(self, call: OperationCall) -> Job:
-        seen = self._env.seen(call.args["object"])
+        seen = self._env.seen(call.input("object"))
         if not seen:
-            raise OperationFailed(f"{_name(call.args['object'])} has not been seen")
+            raise OperationFailed(f"{_name(call.input('object'))} has not been seen")
         call.write("pose", seen[0].pose)
         return Job.done()
 
@@ -154,7 +154,7 @@ class ObjectsOfClass:
         self._env = env
 
     def start(self, call: OperationCall) -> Job:
-        seen = self._env.seen(call.args["object"])
+        seen = self._env.seen(call.input("object"))
         call.write("count", float(len(seen)))
         call.write("poses", [d.pose for d in seen])
         return Job.done()
@@ -165,8 +165,8 @@ class PlateType:
         self._env = env
 
     def start(self, call: OperationCall) -> Job:
-        near: Pose = call.args["near"]
-        within = float(call.args["within"])
+        near: Pose = call.input("near")
+        within = call.input("within")
         plates = [
             d
             for name in self._env.library.names()

@@ -17,7 +17,7 @@ from engine.spec import NodeKind, NodeSpec, PlanSpec
 from engine.status import Status
 from engine.tree import BehaviorTree
 from engine.validation import validate_plan
-from tests.capabilities.motion.plans import build, down_at, op, registry_for, run_plan, sim_steps
+from tests.capabilities.motion.plans import down_at, op, registry_for, run_plan
 
 
 class ProbeCell:
