@@ -27,6 +27,7 @@ from capabilities.collaboration.handoff import (
     in_region,
     object_markers,
 )
+from capabilities.kit import manifest
 from capabilities.markers.backend import camera_interface
 from capabilities.world_model import Detection, WorldModel
 from engine.operations import (
@@ -230,31 +231,28 @@ TIME = (ParamType.DURATION, ParamType.NUMBER)
 
 
 def _manifests() -> list[tuple[OperationManifest, Any]]:
-    def op(op_id: str, kind: OperationKind, doc: str, *ports: PortSpec) -> OperationManifest:
-        return OperationManifest(f"{CAP}.{op_id}", kind, doc, CAP, ports)
-
     button = _port("button", (ParamType.TEXT,), "the operator button", default="continue")
     obj = _port("object", (ParamType.OBJECT,), "the object (by its model name)")
     region = _port("region", (ParamType.REGION,), "where it must be (a sphere)")
     console = lambda env: env.interface("operator")  # noqa: E731
     return [
-        (op("confirm", OperationKind.ACTION,
+        (manifest(CAP, "confirm", OperationKind.ACTION,
             "Asks the operator a yes/no question; succeeds on yes, fails on no.",
             _port("prompt", (ParamType.TEXT,), "the question shown to the operator"),
             _port("timeout", TIME, "give up after this long (0: wait for ever)", default=0.0,
                   unit="s")),
          lambda env: Confirm(console(env))),
-        (op("button_pressed", OperationKind.CONDITION,
+        (manifest(CAP, "button_pressed", OperationKind.CONDITION,
             "True when the operator pressed the button since it was last checked.", button),
          lambda env: ButtonPressed(console(env))),
-        (op("wait_for_button", OperationKind.ACTION,
+        (manifest(CAP, "wait_for_button", OperationKind.ACTION,
             "Waits until the operator presses the button (or the foot pedal).", button,
             _port("timeout", TIME, "give up after this long (0: wait for ever)", default=0.0,
                   unit="s"),
             _port("earlier_press_counts", (ParamType.BOOL,),
                   "a press made before this node started counts", default=False)),
          lambda env: WaitForButton(console(env))),
-        (op("wait_for_handoff", OperationKind.ACTION,
+        (manifest(CAP, "wait_for_handoff", OperationKind.ACTION,
             "Waits until a person puts the object down in the region (seen by its markers).",
             obj, region,
             _port("camera", (ParamType.TEXT,), "which camera watches", default="shoulder",
@@ -265,7 +263,7 @@ def _manifests() -> list[tuple[OperationManifest, Any]]:
             _port("interval", TIME, "time between camera frames", default=0.1, unit="s"),
             PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where it was put")),
          WaitForHandoff),
-        (op("object_in_region", OperationKind.CONDITION,
+        (manifest(CAP, "object_in_region", OperationKind.CONDITION,
             "True when the object was last seen inside the region.", obj, region,
             _port("max_age", TIME, "ignore sightings older than this (0: any age)",
                   default=0.0, unit="s")),
@@ -280,6 +278,6 @@ def capability() -> Capability:
         "People and the robot: operator prompts and buttons, objects handed over.",
         requires=("operator",),
     )
-    for manifest, factory in _manifests():
-        cap.add(manifest, factory)
+    for made, factory in _manifests():
+        cap.add(made, factory)
     return cap

@@ -9,6 +9,7 @@ from __future__ import annotations
 from typing import Any
 
 from capabilities.base import Capability, CapabilityEnv
+from capabilities.kit import manifest
 from engine.operations import (
     Direction,
     Job,
@@ -26,10 +27,6 @@ __all__ = ["capability"]
 CAP = "debug"
 ANY = (ParamType.ANY,)
 ALL_TYPES = (*(t for t in ParamType if t is not ParamType.ANY), ParamType.ANY)
-
-
-def _manifest(op: str, kind: OperationKind, doc: str, *ports: PortSpec) -> OperationManifest:
-    return OperationManifest(f"{CAP}.{op}", kind, doc, CAP, tuple(ports))
 
 
 class _Succeed:
@@ -129,9 +126,10 @@ def capability() -> Capability:
     cap = Capability(CAP, "Operations for trying plans without a robot.")
     ticks = PortSpec("ticks", (ParamType.NUMBER,), default=3, doc="ticks spent RUNNING")
     entries: list[tuple[OperationManifest, type]] = [
-        (_manifest("succeed", OperationKind.ACTION, "Succeeds at once."), _Succeed),
+        (manifest(CAP, "succeed", OperationKind.ACTION, "Succeeds at once."), _Succeed),
         (
-            _manifest(
+            manifest(
+                CAP,
                 "fail",
                 OperationKind.ACTION,
                 "Fails at once with a message.",
@@ -140,7 +138,8 @@ def capability() -> Capability:
             _Fail,
         ),
         (
-            _manifest(
+            manifest(
+                CAP,
                 "running",
                 OperationKind.ACTION,
                 "Runs for a number of ticks, then succeeds or fails.",
@@ -157,7 +156,8 @@ def capability() -> Capability:
             _Running,
         ),
         (
-            _manifest(
+            manifest(
+                CAP,
                 "pretend_move",
                 OperationKind.ACTION,
                 "Pretends to move to a pose for some ticks.",
@@ -167,7 +167,8 @@ def capability() -> Capability:
             _PretendMove,
         ),
         (
-            _manifest(
+            manifest(
+                CAP,
                 "set_param",
                 OperationKind.ACTION,
                 "Writes a value to a named parameter.",
@@ -177,7 +178,8 @@ def capability() -> Capability:
             _SetParam,
         ),
         (
-            _manifest(
+            manifest(
+                CAP,
                 "query",
                 OperationKind.QUERY,
                 "Answers with a given value (a stand-in query).",
@@ -187,7 +189,8 @@ def capability() -> Capability:
             _Query,
         ),
         (
-            _manifest(
+            manifest(
+                CAP,
                 "check_param",
                 OperationKind.CONDITION,
                 "True when a parameter equals a value.",
@@ -197,7 +200,8 @@ def capability() -> Capability:
             _CheckParam,
         ),
         (
-            _manifest(
+            manifest(
+                CAP,
                 "condition",
                 OperationKind.CONDITION,
                 "True or false, as set.",
@@ -206,7 +210,8 @@ def capability() -> Capability:
             _Condition,
         ),
         (
-            _manifest(
+            manifest(
+                CAP,
                 "succeed_after",
                 OperationKind.CONDITION,
                 "False the first N times it is checked, then true (e.g. an object that appears).",
@@ -215,7 +220,8 @@ def capability() -> Capability:
             _SucceedAfter,
         ),
         (
-            _manifest(
+            manifest(
+                CAP,
                 "log",
                 OperationKind.ACTION,
                 "Writes a message to the run's log.",
@@ -224,6 +230,6 @@ def capability() -> Capability:
             _Log,
         ),
     ]
-    for manifest, cls in entries:
-        cap.add(manifest, _maker(cls))
+    for made, cls in entries:
+        cap.add(made, _maker(cls))
     return cap

@@ -7,13 +7,13 @@ from collections.abc import Callable
 
 from capabilities.base import Capability, CapabilityEnv
 from capabilities.freedrive.backend import FREEDRIVE, FreedriveBackend
+from capabilities.kit import manifest
 from engine.operations import (
     Direction,
     Job,
     OperationCall,
     OperationFailed,
     OperationKind,
-    OperationManifest,
     PortSpec,
 )
 from engine.types import JointConfig, ParamType, Waypoint, WaypointFrame
@@ -22,25 +22,15 @@ __all__ = ["capability"]
 
 CAP = "freedrive"
 
-START = OperationManifest(
-    f"{CAP}.start", OperationKind.ACTION, "Lets the worker guide the arm by hand.", CAP
-)
-STOP = OperationManifest(
-    f"{CAP}.stop", OperationKind.ACTION, "Ends hand guiding; the arm holds where it is.", CAP
-)
-RECORD_WAYPOINT = OperationManifest(
-    f"{CAP}.record_waypoint",
-    OperationKind.QUERY,
+START = manifest(CAP, "start", OperationKind.ACTION, "Lets the worker guide the arm by hand.")
+STOP = manifest(CAP, "stop", OperationKind.ACTION, "Ends hand guiding; the arm holds where it is.")
+RECORD_WAYPOINT = manifest(
+    CAP, "record_waypoint", OperationKind.QUERY,
     "Records where the arm is now as a waypoint (typically after guiding it by hand).",
-    CAP,
-    (
-        PortSpec("name", (ParamType.TEXT,), default="waypoint", doc="the waypoint's name"),
-        PortSpec(
-            "frame", (ParamType.TEXT,), default="world", choices=("world", "joints"),
-            doc="world: the tool pose; joints: the joint positions",
-        ),
-        PortSpec("waypoint", (ParamType.WAYPOINT,), Direction.OUT, doc="the recorded waypoint"),
-    ),
+    PortSpec("name", (ParamType.TEXT,), default="waypoint", doc="the waypoint's name"),
+    PortSpec("frame", (ParamType.TEXT,), default="world", choices=("world", "joints"),
+             doc="world: the tool pose; joints: the joint positions"),
+    PortSpec("waypoint", (ParamType.WAYPOINT,), Direction.OUT, doc="the recorded waypoint"),
 )  # fmt: skip
 
 

@@ -5,26 +5,26 @@ from __future__ import annotations
 from capabilities.base import Capability, CapabilityEnv
 from capabilities.gripper.backend import GRIPPER, GripperBackend
 from capabilities.jobs import job_from_handle
-from engine.operations import Job, OperationCall, OperationKind, OperationManifest
+from capabilities.kit import manifest
+from engine.operations import Job, OperationCall, OperationKind
 
 __all__ = ["capability"]
 
 CAP = "gripper"
 
 
-def _m(op: str, kind: OperationKind, doc: str) -> OperationManifest:
-    return OperationManifest(f"{CAP}.{op}", kind, doc, CAP)
-
-
-OPEN = _m("open", OperationKind.ACTION, "Opens the gripper fully, releasing what it holds.")
-CLOSE = _m(
+OPEN = manifest(
+    CAP, "open", OperationKind.ACTION, "Opens the gripper fully, releasing what it holds."
+)
+CLOSE = manifest(
+    CAP,
     "close",
     OperationKind.ACTION,
     "Closes the gripper until the fingers meet or stop on an object (see gripper.is_holding).",
 )
-IS_CLOSED = _m("is_closed", OperationKind.CONDITION, "True when the gripper is closed.")
-IS_HOLDING = _m(
-    "is_holding", OperationKind.CONDITION, "True when the closed gripper holds something."
+IS_CLOSED = manifest(CAP, "is_closed", OperationKind.CONDITION, "True when the gripper is closed.")
+IS_HOLDING = manifest(
+    CAP, "is_holding", OperationKind.CONDITION, "True when the closed gripper holds something."
 )
 
 

@@ -12,6 +12,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from capabilities.base import Capability, CapabilityEnv
+from capabilities.kit import manifest
 from capabilities.markers.backend import CameraDevice, camera_interface
 from capabilities.markers.calibration import calibrate_extrinsics
 from capabilities.markers.depth import refine_with_depth
@@ -28,7 +29,6 @@ from engine.operations import (
     OperationCall,
     OperationFailed,
     OperationKind,
-    OperationManifest,
     PortSpec,
 )
 from engine.types import ObjectModel, ParamType, Pose
@@ -202,29 +202,26 @@ def capability() -> Capability:
         requires=("world", "workers", "scene_layout", "objects", "rgbd:shoulder"),
     )
 
-    def op(op_id: str, kind: OperationKind, doc: str, *ports: PortSpec) -> OperationManifest:
-        return OperationManifest(f"{CAP}.{op_id}", kind, doc, CAP, ports)
-
     def maker(cls: type) -> Any:
         return lambda env: cls(_Env(env))
 
-    cap.add(op("detect_markers", OperationKind.ACTION,
+    cap.add(manifest(CAP, "detect_markers", OperationKind.ACTION,
                "Looks through a camera and remembers every marker and marked object it sees.",
                _camera_port(),
                PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="how many markers were seen")),
             maker(DetectMarkers))  # fmt: skip
-    cap.add(op("marker_pose", OperationKind.QUERY, "The pose of a marker last seen.",
+    cap.add(manifest(CAP, "marker_pose", OperationKind.QUERY, "The pose of a marker last seen.",
                PortSpec("marker_id", (ParamType.NUMBER,), doc="the marker's id"),
                PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where it is")),
             maker(MarkerPose))  # fmt: skip
-    cap.add(op("object_pose", OperationKind.QUERY, "The pose of an object, from its marker.",
+    cap.add(manifest(CAP, "object_pose", OperationKind.QUERY, "The pose of an object, from its marker.",
                _object_port(),
                PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the object is")),
             maker(ObjectPose))  # fmt: skip
-    cap.add(op("object_found", OperationKind.CONDITION, "True when the object's marker was seen.",
+    cap.add(manifest(CAP, "object_found", OperationKind.CONDITION, "True when the object's marker was seen.",
                _object_port()),
             maker(ObjectFound))  # fmt: skip
-    cap.add(op("calibrate_camera", OperationKind.ACTION,
+    cap.add(manifest(CAP, "calibrate_camera", OperationKind.ACTION,
                "Finds a fixed camera's pose from the table markers of known pose.",
                _camera_port(),
                PortSpec("max_error_px", (ParamType.NUMBER,), default=1.5, unit="px",

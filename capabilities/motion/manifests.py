@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from engine.operations import Direction, OperationKind, OperationManifest, PortSpec
+from capabilities.kit import manifest
+from engine.operations import Direction, OperationKind, PortSpec
 from engine.types import ParamType
 
 __all__ = [
@@ -32,12 +33,7 @@ ACCEL = PortSpec(
 )  # fmt: skip
 
 
-def _m(op: str, kind: OperationKind, doc: str, *ports: PortSpec) -> OperationManifest:
-    return OperationManifest(f"{CAP}.{op}", kind, doc, CAP, tuple(ports))
-
-
-MOVE_TO = _m(
-    "move_to",
+MOVE_TO = manifest(CAP, "move_to",
     OperationKind.ACTION,
     "Moves the tool to a pose or waypoint (relative waypoints follow the detected object).",
     PortSpec(
@@ -57,7 +53,8 @@ MOVE_TO = _m(
     ACCEL,
 )  # fmt: skip
 
-MOVE_JOINTS = _m(
+MOVE_JOINTS = manifest(
+    CAP,
     "move_joints",
     OperationKind.ACTION,
     "Moves the arm to joint positions.",
@@ -66,8 +63,7 @@ MOVE_JOINTS = _m(
     ACCEL,
 )
 
-MOVE_RELATIVE = _m(
-    "move_relative",
+MOVE_RELATIVE = manifest(CAP, "move_relative",
     OperationKind.ACTION,
     "Moves the tool by an offset on a straight line.",
     PortSpec("dx", _N, default=0.0, unit="m", doc="offset along x"),
@@ -81,27 +77,36 @@ MOVE_RELATIVE = _m(
     ACCEL,
 )  # fmt: skip
 
-GO_HOME = _m("go_home", OperationKind.ACTION, "Moves the arm to its home joints.", SPEED, ACCEL)
+GO_HOME = manifest(
+    CAP, "go_home", OperationKind.ACTION, "Moves the arm to its home joints.", SPEED, ACCEL
+)
 
-STOP = _m("stop", OperationKind.ACTION, "Stops any arm motion; succeeds once the arm stands.")
+STOP = manifest(
+    CAP, "stop", OperationKind.ACTION, "Stops any arm motion; succeeds once the arm stands."
+)
 
-CURRENT_POSE = _m(
+CURRENT_POSE = manifest(
+    CAP,
     "current_pose",
     OperationKind.QUERY,
     "The tool's pose now (world frame).",
     PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="the tool pose"),
 )
 
-CURRENT_JOINTS = _m(
+CURRENT_JOINTS = manifest(
+    CAP,
     "current_joints",
     OperationKind.QUERY,
     "The arm's joint positions now.",
     PortSpec("joints", (ParamType.JOINTS,), Direction.OUT, unit="rad", doc="joint positions"),
 )
 
-IS_MOVING = _m("is_moving", OperationKind.CONDITION, "True while the arm moves.")
-IS_STOPPED = _m("is_stopped", OperationKind.CONDITION, "True while the arm stands still.")
-IS_HOME = _m(
+IS_MOVING = manifest(CAP, "is_moving", OperationKind.CONDITION, "True while the arm moves.")
+IS_STOPPED = manifest(
+    CAP, "is_stopped", OperationKind.CONDITION, "True while the arm stands still."
+)
+IS_HOME = manifest(
+    CAP,
     "is_home",
     OperationKind.CONDITION,
     "True when every joint is within a tolerance of the home position.",

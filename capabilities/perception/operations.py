@@ -18,6 +18,7 @@ import weakref
 from typing import Any
 
 from capabilities.base import Capability, CapabilityEnv
+from capabilities.kit import manifest
 from capabilities.perception.config import RecognitionConfig
 from capabilities.perception.errors import PerceptionError
 from capabilities.perception.recognizer import Recognizer
@@ -29,7 +30,6 @@ from engine.operations import (
     OperationCall,
     OperationFailed,
     OperationKind,
-    OperationManifest,
     PortSpec,
 )
 from engine.types import ObjectModel, ParamType, Pose
@@ -197,13 +197,10 @@ def capability() -> Capability:
     )
     shared = _Shared()
 
-    def op(op_id: str, kind: OperationKind, doc: str, *ports: PortSpec) -> OperationManifest:
-        return OperationManifest(f"{CAP}.{op_id}", kind, doc, CAP, ports)
-
     def maker(cls: type) -> Any:
         return lambda env: cls(_Env(env, shared))
 
-    cap.add(op("detect_objects", OperationKind.ACTION,
+    cap.add(manifest(CAP, "detect_objects", OperationKind.ACTION,
                "Looks through a camera and recognises the known objects on the table "
                "(point cloud matched to the object models).",
                PortSpec("camera", (ParamType.TEXT,), default="shoulder", doc="which camera looks",
@@ -211,21 +208,21 @@ def capability() -> Capability:
                PortSpec("count", (ParamType.NUMBER,), Direction.OUT,
                         doc="how many objects were recognised")),
             maker(DetectObjects))  # fmt: skip
-    cap.add(op("object_found", OperationKind.CONDITION,
+    cap.add(manifest(CAP, "object_found", OperationKind.CONDITION,
                "True when the last look recognised an object of this class.", _object_port()),
             maker(ObjectFound))  # fmt: skip
-    cap.add(op("object_pose", OperationKind.QUERY,
+    cap.add(manifest(CAP, "object_pose", OperationKind.QUERY,
                "The pose of the most confidently recognised object of a class.", _object_port(),
                PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the object is")),
             maker(ObjectPose))  # fmt: skip
-    cap.add(op("objects_of_class", OperationKind.QUERY,
+    cap.add(manifest(CAP, "objects_of_class", OperationKind.QUERY,
                "How many objects of a class the last look recognised, and their poses.",
                _object_port(),
                PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="how many"),
                PortSpec("poses", (ParamType.ANY,), Direction.OUT,
                         doc="their poses, most confident first")),
             maker(ObjectsOfClass))  # fmt: skip
-    cap.add(op("plate_type", OperationKind.QUERY,
+    cap.add(manifest(CAP, "plate_type", OperationKind.QUERY,
                "Which plate (by its holes) lies nearest to a pose.",
                PortSpec("near", (ParamType.POSE,), default=Pose(),
                         doc="the plate nearest this pose (default: nearest the robot base)"),

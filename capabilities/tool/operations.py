@@ -13,13 +13,13 @@ from collections.abc import Callable
 from capabilities.base import Capability, CapabilityEnv
 from capabilities.gripper.backend import GRIPPER, GripperBackend
 from capabilities.jobs import chain_jobs, job_from_handle
+from capabilities.kit import manifest
 from capabilities.motion.backend import ARM, ArmBackend
 from capabilities.tool.backend import SUCTION, SuctionBackend
 from engine.operations import (
     Job,
     OperationCall,
     OperationKind,
-    OperationManifest,
 )
 from engine.types import Pose
 
@@ -32,25 +32,27 @@ _JOINT_SPEED, _JOINT_ACCEL = 1.05, 1.4  # rad/s, rad/s^2
 _LINEAR_SPEED, _LINEAR_ACCEL = 0.15, 1.0  # m/s, m/s^2: gentle near the holster
 
 
-def _m(op: str, kind: OperationKind, doc: str) -> OperationManifest:
-    return OperationManifest(f"{CAP}.{op}", kind, doc, CAP)
-
-
-UNHOLSTER = _m(
+UNHOLSTER = manifest(
+    CAP,
     "unholster",
     OperationKind.ACTION,
     "Takes the suction tool out of its holster with the gripper (nothing to do if held).",
 )
-HOLSTER = _m(
+HOLSTER = manifest(
+    CAP,
     "holster",
     OperationKind.ACTION,
     "Puts the suction tool back in its holster and lets go of it (nothing to do if not held).",
 )
-SUCTION_ON = _m(
-    "suction_on", OperationKind.ACTION, "Switches the vacuum on (the tool must be held)."
+SUCTION_ON = manifest(
+    CAP, "suction_on", OperationKind.ACTION, "Switches the vacuum on (the tool must be held)."
 )
-SUCTION_OFF = _m("suction_off", OperationKind.ACTION, "Switches the vacuum off, dropping the part.")
-HAS_PART = _m("has_part", OperationKind.CONDITION, "True when the vacuum sensor feels a part.")
+SUCTION_OFF = manifest(
+    CAP, "suction_off", OperationKind.ACTION, "Switches the vacuum off, dropping the part."
+)
+HAS_PART = manifest(
+    CAP, "has_part", OperationKind.CONDITION, "True when the vacuum sensor feels a part."
+)
 
 
 def _above(pose: Pose, dz: float) -> Pose:
