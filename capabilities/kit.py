@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from capabilities.errors import CapabilityError
-from engine.operations import OperationKind, OperationManifest, PortSpec
+from engine.operations import OperationFailed, OperationKind, OperationManifest, PortSpec
 from engine.types import ParamType, Pose, decode_value
 
 if TYPE_CHECKING:
@@ -29,13 +29,26 @@ __all__ = [
     "CAMERAS",
     "CapabilitySettingsError",
     "Setting",
+    "camera",
     "manifest",
     "parse_settings",
     "stateful",
 ]
 
 CAMERAS = ("shoulder", "wrist")
-"""The RGB-D cameras a cell may have; camera ``name`` is the interface ``rgbd:<name>``."""
+"""The RGB-D cameras a cell may have (the choices of a ``camera`` port)."""
+
+
+def camera(env: CapabilityEnv, name: str) -> Any:
+    """The RGB-D camera ``name`` of the cell (its interface ``rgbd:<name>``).
+
+    Raises:
+        OperationFailed: the cell has no such camera.
+    """
+    found = env.cell.interfaces().get(f"rgbd:{name}")
+    if found is None:
+        raise OperationFailed(f"the {env.cell.name} cell has no {name} camera")
+    return found
 
 
 class CapabilitySettingsError(CapabilityError):

@@ -27,8 +27,7 @@ from capabilities.collaboration.handoff import (
     in_region,
     object_markers,
 )
-from capabilities.kit import manifest
-from capabilities.markers.backend import camera_interface
+from capabilities.kit import CAMERAS, camera, manifest
 from capabilities.world_model import Detection, WorldModel
 from engine.operations import (
     Direction,
@@ -45,7 +44,6 @@ from engine.types import ObjectModel, ParamType, Region
 __all__ = ["CAP", "capability"]
 
 CAP = "collaboration"
-CAMERAS = ("shoulder", "wrist")
 
 
 def _seconds(call: OperationCall, port: str) -> float:
@@ -177,10 +175,7 @@ class WaitForHandoff:
 
     def start(self, call: OperationCall) -> Job:
         what = "wait_for_handoff"
-        camera_name = call.input("camera")
-        if camera_name not in CAMERAS:
-            raise OperationFailed(f"unknown camera {camera_name!r}; cameras: {', '.join(CAMERAS)}")
-        camera = _interface(self._env, camera_interface(camera_name), what)
+        device = camera(self._env, call.input("camera"))
         world: WorldModel = _interface(self._env, "world", what)
         library = _interface(self._env, "objects", what)
         name = _object_name(call.input("object"))
@@ -194,7 +189,7 @@ class WaitForHandoff:
             timeout=_seconds(call, "timeout"),
         )  # fmt: skip
         region: Region = call.input("region")
-        return HandoffJob(camera, target, region, world, call.clock, settings, call.log)
+        return HandoffJob(device, target, region, world, call.clock, settings, call.log)
 
 
 def latest(world: WorldModel, name: str) -> Detection | None:

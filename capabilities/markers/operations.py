@@ -12,8 +12,8 @@ from collections.abc import Mapping
 from typing import Any
 
 from capabilities.base import Capability, CapabilityEnv
-from capabilities.kit import manifest
-from capabilities.markers.backend import CameraDevice, camera_interface
+from capabilities.kit import CAMERAS, camera, manifest
+from capabilities.markers.backend import CameraDevice
 from capabilities.markers.calibration import calibrate_extrinsics
 from capabilities.markers.depth import refine_with_depth
 from capabilities.markers.detection import (
@@ -36,7 +36,6 @@ from engine.types import ObjectModel, ParamType, Pose
 __all__ = ["capability"]
 
 CAP = "markers"
-CAMERAS = ("shoulder", "wrist")
 # A detection whose pose is ambiguous (a marker seen almost face-on) is kept but trusted less.
 MIN_CONFIDENCE = 0.05
 
@@ -61,9 +60,7 @@ class _Env:
         self.library = env.interface("objects")
 
     def camera(self, name: str) -> CameraDevice:
-        if name not in CAMERAS:
-            raise OperationFailed(f"unknown camera {name!r}; cameras: {', '.join(CAMERAS)}")
-        return self.env.interface(camera_interface(name))
+        return camera(self.env, name)  # type: ignore[no-any-return]  # an interface is Any
 
     def markers_on_objects(self) -> dict[int, tuple[str, Pose]]:
         """marker id -> (object model name, marker pose in the object frame)."""

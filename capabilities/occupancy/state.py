@@ -13,8 +13,9 @@ from typing import Any
 
 import numpy as np
 
-from capabilities.base import CapabilityEnv, CapabilityError
-from capabilities.kit import CAMERAS, Setting
+from capabilities import kit
+from capabilities.base import CapabilityEnv
+from capabilities.kit import Setting
 from capabilities.occupancy.feed import CameraFeed, Capture
 from capabilities.occupancy.region import RegionReading, estimate_table_z, read_region
 from capabilities.robot_body import (
@@ -64,15 +65,10 @@ class OccupancyState:
         return self._env.cell.clock()
 
     def feed(self, camera: str) -> CameraFeed:
-        """The feed of a camera ("shoulder" or "wrist"); raises OperationFailed if unknown."""
-        if camera not in CAMERAS:
-            raise OperationFailed(f"unknown camera {camera!r}; cameras: {', '.join(CAMERAS)}")
+        """The feed of a camera ("shoulder" or "wrist"); raises OperationFailed if missing."""
         with self._lock:
             if camera not in self._feeds:
-                try:
-                    device = self._env.interface(f"rgbd:{camera}")
-                except CapabilityError as exc:
-                    raise OperationFailed(str(exc)) from exc
+                device = kit.camera(self._env, camera)
                 reader = self._read_robot if self.arm is not None else None
                 self._feeds[camera] = CameraFeed(device, self.workers, reader)
             return self._feeds[camera]

@@ -18,7 +18,7 @@ import weakref
 from typing import Any
 
 from capabilities.base import Capability, CapabilityEnv
-from capabilities.kit import manifest
+from capabilities.kit import CAMERAS, camera, manifest
 from capabilities.perception.config import RecognitionConfig
 from capabilities.perception.errors import PerceptionError
 from capabilities.perception.recognizer import Recognizer
@@ -37,7 +37,6 @@ from engine.types import ObjectModel, ParamType, Pose
 __all__ = ["SOURCE_PREFIX", "capability"]
 
 CAP = "perception"
-CAMERAS = ("shoulder", "wrist")
 SOURCE_PREFIX = "perception:"
 
 
@@ -83,12 +82,7 @@ class _Env:
             raise OperationFailed(str(exc)) from exc
 
     def camera(self, name: str) -> Any:
-        if name not in CAMERAS:
-            raise OperationFailed(f"unknown camera {name!r}; cameras: {', '.join(CAMERAS)}")
-        interfaces = self.env.cell.interfaces()
-        if f"rgbd:{name}" not in interfaces:
-            raise OperationFailed(f"the {self.env.cell.name} cell has no {name} camera")
-        return interfaces[f"rgbd:{name}"]
+        return camera(self.env, name)
 
     def seen(self, model: Any) -> list[Detection]:
         """Current perception detections of a class, best first."""

@@ -9,19 +9,10 @@ import pytest
 
 from capabilities.base import CapabilityRegistry, NullCell
 from capabilities.sim.session import SimCellSession
+from capabilities.sim.testing import angle_between, distance, down_at
 from engine.status import Status
 from engine.types import JointConfig, Waypoint, WaypointFrame
-from tests.capabilities.motion.plans import (
-    all_capabilities,
-    angle_between,
-    build,
-    distance,
-    down_at,
-    op,
-    run_plan,
-    seq,
-    sim_steps,
-)
+from tests.capabilities.motion.plans import all_capabilities, build, op, run_plan, seq, sim_steps
 
 pytestmark = pytest.mark.sim
 

@@ -10,6 +10,7 @@ import pytest
 from capabilities.base import Capability, CapabilityRegistry, NullCell
 from capabilities.debug import capability as debug
 from capabilities.sim.session import SimCellSession
+from capabilities.sim.testing import down_at
 from capabilities.timing import capability as timing
 from engine.build import build_tree
 from engine.operations import Job, OperationKind, OperationManifest
@@ -17,7 +18,7 @@ from engine.spec import NodeKind, NodeSpec, PlanSpec
 from engine.status import Status
 from engine.tree import BehaviorTree
 from engine.validation import validate_plan
-from tests.capabilities.motion.plans import down_at, op, registry_for, run_plan
+from tests.capabilities.motion.plans import op, registry_for, run_plan
 
 
 class ProbeCell:
