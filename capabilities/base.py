@@ -178,7 +178,8 @@ class CapabilityRegistry:
         cell: the cell whose interfaces decide what is available.
         settings: the ``capabilities`` block of a cell file (capability name -> its
             settings as JSON values); default: the cell's ``capability_settings()`` when it
-            has one. Checked against each capability's declared settings here.
+            has one. Checked against each capability's declared settings here; a block
+            naming no installed capability is an error when ``capabilities`` is None.
         settings_source: the file the settings came from, named in errors.
 
     Raises:
@@ -208,8 +209,10 @@ class CapabilityRegistry:
             capabilities if capabilities is not None else load_entry_point_capabilities()
         ):
             self.register(capability)
+        # A block for a capability this registry lacks is a typo when every installed
+        # capability is here; a registry of chosen capabilities skips the others' blocks.
         unknown = sorted(set(settings) - set(self._capabilities))
-        if unknown:
+        if unknown and capabilities is None:
             raise CapabilitySettingsError(
                 f"{settings_source}: $.capabilities.{unknown[0]}: no capability of that name "
                 f"(capabilities: {', '.join(sorted(self._capabilities))})"

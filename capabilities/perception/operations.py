@@ -18,8 +18,8 @@ import weakref
 from typing import Any
 
 from capabilities.base import Capability, CapabilityEnv
-from capabilities.kit import CAMERAS, camera, manifest
-from capabilities.perception.config import RecognitionConfig
+from capabilities.kit import CAMERAS, camera, manifest, stateful
+from capabilities.perception.config import SETTINGS, RecognitionConfig
 from capabilities.perception.errors import PerceptionError
 from capabilities.perception.recognizer import Recognizer
 from capabilities.perception.tracker import SurfaceTracker
@@ -76,10 +76,7 @@ class _Env:
         self.world: WorldModel = env.interface("world")
         self.workers = env.interface("workers")
         self.library = env.interface("objects")
-        try:
-            self.config = RecognitionConfig.from_settings(env.settings)
-        except PerceptionError as exc:
-            raise OperationFailed(str(exc)) from exc
+        self.config = RecognitionConfig.from_settings(env.settings)
 
     def camera(self, name: str) -> Any:
         return camera(self.env, name)
@@ -188,11 +185,9 @@ def capability() -> Capability:
         CAP,
         "Recognises the library's objects on the table in RGB-D point clouds; plate types.",
         requires=("world", "workers", "objects", "rgbd:shoulder"),
+        settings=SETTINGS,
+        setup=lambda env: _Env(env, _Shared()),
     )
-    shared = _Shared()
-
-    def maker(cls: type) -> Any:
-        return lambda env: cls(_Env(env, shared))
 
     cap.add(manifest(CAP, "detect_objects", OperationKind.ACTION,
                "Looks through a camera and recognises the known objects on the table "
@@ -201,21 +196,21 @@ def capability() -> Capability:
                         choices=CAMERAS),
                PortSpec("count", (ParamType.NUMBER,), Direction.OUT,
                         doc="how many objects were recognised")),
-            maker(DetectObjects))  # fmt: skip
+            stateful(DetectObjects))  # fmt: skip
     cap.add(manifest(CAP, "object_found", OperationKind.CONDITION,
                "True when the last look recognised an object of this class.", _object_port()),
-            maker(ObjectFound))  # fmt: skip
+            stateful(ObjectFound))  # fmt: skip
     cap.add(manifest(CAP, "object_pose", OperationKind.QUERY,
                "The pose of the most confidently recognised object of a class.", _object_port(),
                PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the object is")),
-            maker(ObjectPose))  # fmt: skip
+            stateful(ObjectPose))  # fmt: skip
     cap.add(manifest(CAP, "objects_of_class", OperationKind.QUERY,
                "How many objects of a class the last look recognised, and their poses.",
                _object_port(),
                PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="how many"),
                PortSpec("poses", (ParamType.ANY,), Direction.OUT,
                         doc="their poses, most confident first")),
-            maker(ObjectsOfClass))  # fmt: skip
+            stateful(ObjectsOfClass))  # fmt: skip
     cap.add(manifest(CAP, "plate_type", OperationKind.QUERY,
                "Which plate (by its holes) lies nearest to a pose.",
                PortSpec("near", (ParamType.POSE,), default=Pose(),
@@ -224,5 +219,5 @@ def capability() -> Capability:
                         doc="fail when the nearest plate is farther than this"),
                PortSpec("model", (ParamType.OBJECT,), Direction.OUT, doc="the plate's model"),
                PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the plate is")),
-            maker(PlateType))  # fmt: skip
+            stateful(PlateType))  # fmt: skip
     return cap

@@ -7,6 +7,7 @@ the table top is at ``table_top_z``.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from dataclasses import dataclass, field
@@ -86,6 +87,9 @@ class CellConfig:
         stand_size: width and depth (m) of the robot's stand, which reaches from the floor up
             to the robot base.
         cameras: the RGB-D cameras by name ("shoulder", "wrist").
+        capabilities: the raw ``capabilities`` block (capability name -> its settings),
+            checked by the capability registry against each capability's declared settings.
+        source: the file this configuration was read from ("" when made in code).
     """
 
     robot_base: Pose = _BASE
@@ -101,6 +105,8 @@ class CellConfig:
     table: TableConfig = TableConfig()
     stand_size: tuple[float, float] = (0.2, 0.2)
     cameras: dict[str, CameraSettings] = field(default_factory=_default_cameras)
+    capabilities: dict[str, Any] = field(default_factory=dict)
+    source: str = ""
 
     @classmethod
     def load(cls, path: str | Path = DEFAULT_CONFIG_PATH) -> CellConfig:
@@ -112,7 +118,7 @@ class CellConfig:
         path = Path(path)
         try:
             data = json.loads(path.read_text(encoding="utf-8"))
-            return cls.from_json(data)
+            return dataclasses.replace(cls.from_json(data), source=str(path))
         except OSError as exc:
             raise SimError(f"{path}: cannot read cell config: {exc}") from exc
         except json.JSONDecodeError as exc:
@@ -151,6 +157,7 @@ class CellConfig:
             ),
             stand_size=_numbers(data, "stand_size", default.stand_size, 2),  # type: ignore[arg-type]
             cameras=_cameras(data.get("cameras"), default.cameras),
+            capabilities=_capabilities(data.get("capabilities", {})),
         )
 
     def to_json(self) -> dict[str, Any]:
@@ -183,7 +190,14 @@ class CellConfig:
                 }
                 for name, c in self.cameras.items()
             },
+            "capabilities": self.capabilities,
         }
+
+
+def _capabilities(block: Any) -> dict[str, Any]:
+    if not isinstance(block, dict):
+        raise ValueError_("$.capabilities", "an object of capability settings", block)
+    return block
 
 
 def _pose(data: dict[str, Any], key: str, default: Pose) -> Pose:

@@ -213,7 +213,6 @@ def test_factories_get_the_cell_interfaces_and_their_settings() -> None:
         ({"motion": {"count": 2.5}}, r"\$\.capabilities\.motion\.count: expected an integer"),
         ({"motion": {"speed": True}}, r"\$\.capabilities\.motion\.speed: expected a number, got True"),
         ({"motion": []}, r"\$\.capabilities\.motion: expected an object"),
-        ({"motoin": {}}, r"\$\.capabilities\.motoin: no capability of that name"),
     ],
 )
 def test_bad_settings_name_the_file_and_the_key(settings: Any, expected: str) -> None:
@@ -245,3 +244,10 @@ def test_a_cell_supplies_its_settings_block() -> None:
 
     with pytest.raises(CapabilitySettingsError, match=r"/cells/a\.cell\.json: \$\.capabilities\.motion\.speed"):
         CapabilityRegistry([_with_settings()], cell=FileCell())
+
+
+def test_a_block_for_no_installed_capability_is_an_error() -> None:
+    with pytest.raises(CapabilitySettingsError, match=r"c\.json: \$\.capabilities\.motoin: no capability"):
+        CapabilityRegistry(settings={"motoin": {}}, settings_source="c.json")
+    # a registry of chosen capabilities leaves the other capabilities' blocks alone
+    CapabilityRegistry([_with_settings()], settings={"occupancy": {"x": 1}})
