@@ -69,6 +69,19 @@ def test_world_waypoint_joints_home_and_relative_moves(session: SimCellSession) 
     assert distance(run.value("P2"), want) < MM
 
 
+def test_move_relative_tool_moves_along_the_tool_axis(session: SimCellSession) -> None:
+    plan = seq(
+        op("motion.move_to", "above", target=down_at(0.4, 0.2, 0.25)),
+        op("motion.move_relative_tool", "approach", dz=0.05),
+        op("motion.current_pose", "pose", pose="$P"),
+    )
+    run = run_plan(session, plan)
+    assert run.status is Status.SUCCESS, run.failure()
+    # The tool points down: +50 mm along its z is 50 mm lower in the world.
+    want = down_at(0.4, 0.2, 0.20)
+    assert distance(run.value("P"), want) < MM and angle_between(run.value("P"), want) < HALF_DEG
+
+
 def test_is_home_is_false_away_from_home(session: SimCellSession) -> None:
     run = run_plan(
         session,
