@@ -118,7 +118,9 @@ class Setting:
                 raise CapabilitySettingsError(str(exc)) from exc
         if self.type is tuple:
             return self._numbers(value, where)
-        ok = isinstance(value, self.type) and not (self.type is not bool and isinstance(value, bool))
+        ok = isinstance(value, self.type) and not (
+            self.type is not bool and isinstance(value, bool)
+        )
         if self.type is float and isinstance(value, int) and not isinstance(value, bool):
             return float(value)
         if not ok:

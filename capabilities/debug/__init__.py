@@ -5,4 +5,3 @@ from __future__ import annotations
 from capabilities.debug.operations import capability
 
 __all__ = ["capability"]
-

@@ -10,4 +10,3 @@ from capabilities.markers.errors import MarkerError
 from capabilities.markers.operations import capability
 
 __all__ = ["MarkerError", "capability"]
-

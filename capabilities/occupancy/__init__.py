@@ -9,4 +9,3 @@ from __future__ import annotations
 from capabilities.occupancy.operations import capability
 
 __all__ = ["capability"]
-

@@ -130,10 +130,16 @@ def _common_ports() -> tuple[PortSpec, ...]:
     )  # fmt: skip
 
 
-_MAX_AGE = PortSpec("max_age", (ParamType.DURATION,), default=1.0, unit="s",
-                    doc="answer from a frame up to this old; older: wait for a new one")
-_TIMEOUT = PortSpec("timeout", (ParamType.DURATION,), default=10.0, unit="s",
-                    doc="fail after this long (cell time)")
+_MAX_AGE = PortSpec(
+    "max_age",
+    (ParamType.DURATION,),
+    default=1.0,
+    unit="s",
+    doc="answer from a frame up to this old; older: wait for a new one",
+)
+_TIMEOUT = PortSpec(
+    "timeout", (ParamType.DURATION,), default=10.0, unit="s", doc="fail after this long (cell time)"
+)
 _PERIOD = PortSpec("period", (ParamType.DURATION,), default=0.1, unit="s",
                    doc="look again this often")  # fmt: skip
 

@@ -12,4 +12,3 @@ from capabilities.perception.errors import PerceptionError
 from capabilities.perception.operations import capability
 
 __all__ = ["PerceptionError", "capability"]
-

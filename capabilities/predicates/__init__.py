@@ -11,4 +11,3 @@ from capabilities.predicates.collision import PredicateError
 from capabilities.predicates.operations import capability
 
 __all__ = ["PredicateError", "capability"]
-

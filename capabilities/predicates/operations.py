@@ -65,8 +65,13 @@ def _object_port(name: str, doc: str) -> PortSpec:
 _PAIR = (_object_port("object_a", "the object the predicate is about"),
          _object_port("object_b", "the object it is compared with"))  # fmt: skip
 _ONE = _object_port("object", "the object")
-_FRAME = PortSpec("frame", (ParamType.TEXT,), default="world", choices=FRAMES,
-                  doc="directions along the world's, the robot base's or object_b's axes")
+_FRAME = PortSpec(
+    "frame",
+    (ParamType.TEXT,),
+    default="world",
+    choices=FRAMES,
+    doc="directions along the world's, the robot base's or object_b's axes",
+)
 _MARGIN = PortSpec("margin", (ParamType.NUMBER,), default=0.01, unit="m",
                    doc="by more than this (a tie under sensor noise is neither)")  # fmt: skip
 
@@ -118,13 +123,25 @@ class Relation:
         raise PredicateError(f"unknown frame {name!r}; frames: {', '.join(FRAMES)}")
 
 
-_WINDOW = PortSpec("window", (ParamType.DURATION,), default=0.5, unit="s",
-                   doc="judge the detections of this last stretch of time")
-_SPEED = PortSpec("speed", (ParamType.NUMBER,), default=0.02, unit="m/s",
-                  doc="faster than this is moving")
-IS_MOVING = manifest(CAP, "is_moving", CONDITION,
-                     "True when the object's detections moved faster than the speed.",
-                     _ONE, _WINDOW, _SPEED)
+_WINDOW = PortSpec(
+    "window",
+    (ParamType.DURATION,),
+    default=0.5,
+    unit="s",
+    doc="judge the detections of this last stretch of time",
+)
+_SPEED = PortSpec(
+    "speed", (ParamType.NUMBER,), default=0.02, unit="m/s", doc="faster than this is moving"
+)
+IS_MOVING = manifest(
+    CAP,
+    "is_moving",
+    CONDITION,
+    "True when the object's detections moved faster than the speed.",
+    _ONE,
+    _WINDOW,
+    _SPEED,
+)
 IS_STATIONARY = manifest(CAP, "is_stationary", CONDITION,
                          "True when the object's detections stayed (slower than the speed); "
                          "false when too few were seen.", _ONE, _WINDOW, _SPEED)  # fmt: skip
@@ -154,17 +171,44 @@ class Moving:
         return _verdict(moving == self._want, text)
 
 
-_TOLERANCE = PortSpec("tolerance", (ParamType.NUMBER,), default=0.003, unit="m",
-                      doc="surfaces this close count as touching")
-_DISTANCE = PortSpec("distance", (ParamType.NUMBER,), default=0.03, unit="m",
-                     doc="surfaces this close are a near collision")
-TOUCHING = manifest(CAP, "touching", CONDITION,
-                    "True when the two objects' shapes touch or overlap.", *_PAIR, _TOLERANCE)
-NEAR_COLLISION = manifest(CAP, "near_collision", CONDITION,
-                          "True when the two objects' shapes are closer than the distance "
-                          "(touching included).", *_PAIR, _DISTANCE)
-TOOL_TOUCHING = manifest(CAP, "tool_touching", CONDITION,
-                         "True when the tool touches or overlaps the object.", _ONE, _TOLERANCE)
+_TOLERANCE = PortSpec(
+    "tolerance",
+    (ParamType.NUMBER,),
+    default=0.003,
+    unit="m",
+    doc="surfaces this close count as touching",
+)
+_DISTANCE = PortSpec(
+    "distance",
+    (ParamType.NUMBER,),
+    default=0.03,
+    unit="m",
+    doc="surfaces this close are a near collision",
+)
+TOUCHING = manifest(
+    CAP,
+    "touching",
+    CONDITION,
+    "True when the two objects' shapes touch or overlap.",
+    *_PAIR,
+    _TOLERANCE,
+)
+NEAR_COLLISION = manifest(
+    CAP,
+    "near_collision",
+    CONDITION,
+    "True when the two objects' shapes are closer than the distance (touching included).",
+    *_PAIR,
+    _DISTANCE,
+)
+TOOL_TOUCHING = manifest(
+    CAP,
+    "tool_touching",
+    CONDITION,
+    "True when the tool touches or overlaps the object.",
+    _ONE,
+    _TOLERANCE,
+)
 TOOL_NEAR_COLLISION = manifest(CAP, "tool_near_collision", CONDITION,
                                "True when the tool is closer to the object than the distance "
                                "(touching included).", _ONE, _DISTANCE)  # fmt: skip

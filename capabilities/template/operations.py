@@ -24,9 +24,7 @@ __all__ = ["LAMP_IS_LIT", "SETTINGS", "LampState", "capability", "setup"]
 
 CAP = "template"
 
-SETTINGS = (
-    Setting("inverted", bool, False, "true when the lamp's input reads lit as off"),
-)
+SETTINGS = (Setting("inverted", bool, False, "true when the lamp's input reads lit as off"),)
 
 
 class LampState:

@@ -197,7 +197,8 @@ def test_factories_get_the_cell_interfaces_and_their_settings() -> None:
     env = first.env
     # declared defaults fill in; an int is a float for a float setting; an explicit 0 is 0
     assert (env.capability, dict(env.settings)) == (
-        "motion", {"speed": 1.0, "margin": 0.0, "count": 3}
+        "motion",
+        {"speed": 1.0, "margin": 0.0, "count": 3},
     )
     assert env.state is None
     assert env.interface("arm") is arm
@@ -209,9 +210,15 @@ def test_factories_get_the_cell_interfaces_and_their_settings() -> None:
     ("settings", "expected"),
     [
         ({"motion": {"sped": 1.0}}, r"cell\.json: \$\.capabilities\.motion\.sped: unknown setting"),
-        ({"motion": {"speed": "fast"}}, r"\$\.capabilities\.motion\.speed: expected a number, got 'fast'"),
+        (
+            {"motion": {"speed": "fast"}},
+            r"\$\.capabilities\.motion\.speed: expected a number, got 'fast'",
+        ),
         ({"motion": {"count": 2.5}}, r"\$\.capabilities\.motion\.count: expected an integer"),
-        ({"motion": {"speed": True}}, r"\$\.capabilities\.motion\.speed: expected a number, got True"),
+        (
+            {"motion": {"speed": True}},
+            r"\$\.capabilities\.motion\.speed: expected a number, got True",
+        ),
         ({"motion": []}, r"\$\.capabilities\.motion: expected an object"),
     ],
 )
@@ -242,12 +249,16 @@ def test_a_cell_supplies_its_settings_block() -> None:
         def capability_settings(self) -> tuple[dict[str, Any], str]:
             return {"motion": {"speed": "x"}}, "/cells/a.cell.json"
 
-    with pytest.raises(CapabilitySettingsError, match=r"/cells/a\.cell\.json: \$\.capabilities\.motion\.speed"):
+    with pytest.raises(
+        CapabilitySettingsError, match=r"/cells/a\.cell\.json: \$\.capabilities\.motion\.speed"
+    ):
         CapabilityRegistry([_with_settings()], cell=FileCell())
 
 
 def test_a_block_for_no_installed_capability_is_an_error() -> None:
-    with pytest.raises(CapabilitySettingsError, match=r"c\.json: \$\.capabilities\.motoin: no capability"):
+    with pytest.raises(
+        CapabilitySettingsError, match=r"c\.json: \$\.capabilities\.motoin: no capability"
+    ):
         CapabilityRegistry(settings={"motoin": {}}, settings_source="c.json")
     # a registry of chosen capabilities leaves the other capabilities' blocks alone
     CapabilityRegistry([_with_settings()], settings={"occupancy": {"x": 1}})

@@ -64,7 +64,10 @@ def test_settings_come_from_the_cell_block_and_feed_the_state() -> None:
 
 
 def test_a_wrong_setting_names_the_file_and_key() -> None:
-    with pytest.raises(CapabilitySettingsError, match=r"lamp\.cell\.json: \$\.capabilities\.template\.inverted: expected true or false"):
+    with pytest.raises(
+        CapabilitySettingsError,
+        match=r"lamp\.cell\.json: \$\.capabilities\.template\.inverted: expected true or false",
+    ):
         CapabilityRegistry([capability()], cell=LampCell(set()),
                            settings={"template": {"inverted": 0}}, settings_source="lamp.cell.json")  # fmt: skip
     with pytest.raises(CapabilitySettingsError, match=r"template\.colour: unknown setting"):
