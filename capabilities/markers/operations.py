@@ -12,7 +12,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from capabilities.base import Capability, CapabilityEnv
-from capabilities.kit import CAMERAS, camera, manifest
+from capabilities.kit import CAMERAS, camera, manifest, stateful
 from capabilities.markers.backend import CameraDevice
 from capabilities.markers.calibration import calibrate_extrinsics
 from capabilities.markers.depth import refine_with_depth
@@ -197,31 +197,29 @@ def capability() -> Capability:
         CAP,
         "Finds ArUco markers in camera images; object poses and camera calibration from them.",
         requires=("world", "workers", "scene_layout", "objects", "rgbd:shoulder"),
+        setup=_Env,  # the per-cell state: the interfaces every markers operation uses
     )
-
-    def maker(cls: type) -> Any:
-        return lambda env: cls(_Env(env))
 
     cap.add(manifest(CAP, "detect_markers", OperationKind.ACTION,
                "Looks through a camera and remembers every marker and marked object it sees.",
                _camera_port(),
                PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="how many markers were seen")),
-            maker(DetectMarkers))  # fmt: skip
+            stateful(DetectMarkers))  # fmt: skip
     cap.add(manifest(CAP, "marker_pose", OperationKind.QUERY, "The pose of a marker last seen.",
                PortSpec("marker_id", (ParamType.NUMBER,), doc="the marker's id"),
                PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where it is")),
-            maker(MarkerPose))  # fmt: skip
+            stateful(MarkerPose))  # fmt: skip
     cap.add(manifest(CAP, "object_pose", OperationKind.QUERY, "The pose of an object, from its marker.",
                _object_port(),
                PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the object is")),
-            maker(ObjectPose))  # fmt: skip
+            stateful(ObjectPose))  # fmt: skip
     cap.add(manifest(CAP, "object_found", OperationKind.CONDITION, "True when the object's marker was seen.",
                _object_port()),
-            maker(ObjectFound))  # fmt: skip
+            stateful(ObjectFound))  # fmt: skip
     cap.add(manifest(CAP, "calibrate_camera", OperationKind.ACTION,
                "Finds a fixed camera's pose from the table markers of known pose.",
                _camera_port(),
                PortSpec("max_error_px", (ParamType.NUMBER,), default=1.5, unit="px",
                         doc="refuse a calibration worse than this")),
-            maker(CalibrateCamera))  # fmt: skip
+            stateful(CalibrateCamera))  # fmt: skip
     return cap

@@ -99,7 +99,7 @@ def _figure3_tree(m: _Maker, finder: str, detect: str, title: str) -> NodeSpec:
     )  # fmt: skip
     wait = m.node(
         NodeKind.FORCE_FAILURE, "then look again",
-        m.op("timing.wait", "WAIT", seconds=Binding.fixed(1.0, ParamType.DURATION)),
+        m.node(NodeKind.WAIT, "WAIT", seconds=1.0),
     )  # fmt: skip
     return m.node(
         NodeKind.SEQUENCE, title,
