@@ -106,7 +106,7 @@ class CellConfig:
     stand_size: tuple[float, float] = (0.2, 0.2)
     cameras: dict[str, CameraSettings] = field(default_factory=_default_cameras)
     capabilities: dict[str, Any] = field(default_factory=dict)
-    source: str = ""
+    source: str = field(default="", compare=False)
 
     @classmethod
     def load(cls, path: str | Path = DEFAULT_CONFIG_PATH) -> CellConfig:

@@ -87,7 +87,7 @@ def test_the_handoff_is_seen_within_half_a_second_of_cell_time(tmp_path: Path, s
         assert decided is not None and decided.source.startswith("collaboration:")
         latency = decided.stamp - placed[0].time
         print(f"seed {seed}: handoff seen {latency:.3f} s of cell time after it was placed")
-        assert 0.0 < latency < 0.5
+        assert 0.0 <= latency < 0.5  # 0: the frame of the very step it was put down
         seen = tree.blackboard.get("BIN_POSE")
         close_to_truth(seen, placed[0].pose)
 

@@ -144,4 +144,4 @@ def test_motion_is_unavailable_without_an_arm_and_says_why() -> None:
         assert "needed by the" in availability.reason
     assert "arm" in registry.availability("motion.move_to").reason
     assert "suction" in registry.availability("tool.unholster").reason
-    assert registry.availability("timing.wait").available
+    assert registry.availability("timing.wait_until").available
