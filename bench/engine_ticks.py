@@ -244,9 +244,9 @@ class _Stamp:
     def __init__(self, stamps: list[int]) -> None:
         self._stamps = stamps
 
-    def start(self, call: OperationCall) -> bool:
+    def start(self, call: OperationCall) -> Job:
         self._stamps.append(time.perf_counter_ns())
-        return True
+        return Job.done()
 
 
 def _finisher(jobs: queue.Queue[Job], finished: list[int], runs: int, pause: float) -> None:

@@ -10,12 +10,14 @@ engine's :class:`~engine.operations.OperationSource`.
 from __future__ import annotations
 
 import importlib.metadata
+import threading
 import time
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
 from capabilities.errors import CapabilityError
+from capabilities.kit import CapabilitySettingsError, Setting, parse_settings
 from engine.operations import (
     Availability,
     Operation,
@@ -28,6 +30,7 @@ __all__ = [
     "Capability",
     "CapabilityEnv",
     "CapabilityError",
+    "CapabilityLoadError",
     "CapabilityRegistry",
     "Cell",
     "NullCell",
@@ -37,6 +40,10 @@ __all__ = [
 ]
 
 ENTRY_POINT_GROUP = "costar.capabilities"
+
+
+class CapabilityLoadError(CapabilityError):
+    """A capability could not be loaded or registered (a broken entry point, a clash)."""
 
 
 class Cell(Protocol):
@@ -67,14 +74,22 @@ class NullCell:
 
 @dataclass(frozen=True)
 class CapabilityEnv:
-    """What an operation factory gets: the cell, its interfaces and capability settings."""
+    """What ``setup`` and an operation factory get.
+
+    Attributes:
+        cell: the cell (its interfaces and clock).
+        capability: the capability's name.
+        settings: every declared setting, checked, from the cell file or its default.
+        operations: the registry that made the operation, for operations that run other
+            operations (timing.wait_until checks a named condition).
+        state: the capability's per-cell state, made by its ``setup`` hook (None without one).
+    """
 
     cell: Cell
     capability: str
     settings: Mapping[str, Any] = field(default_factory=dict)
-    # The registry the operation was made by, for operations that run other operations
-    # (timing.wait_until checks a named condition).
     operations: OperationSource | None = None
+    state: Any = None
 
     def interface(self, name: str) -> Any:
         """The backend behind an interface; raises CapabilityError when the cell lacks it."""
@@ -105,6 +120,10 @@ class Capability:
         requires: interfaces the cell must have for the operations to run.
         provides: interfaces this capability offers to others (documentation for now).
         operations: the operations, each with a manifest whose ``capability`` is ``name``.
+        settings: the settings a cell file may give it (``capabilities.<name>`` block).
+        setup: the per-cell hook: called once per registry (one registry per cell) before
+            the first operation is made, with the env (cell, checked settings); what it
+            returns is ``env.state`` for every operation of this capability on that cell.
     """
 
     name: str
@@ -112,14 +131,17 @@ class Capability:
     operations: list[OperationDef] = field(default_factory=list)
     requires: tuple[str, ...] = ()
     provides: tuple[str, ...] = ()
+    settings: tuple[Setting, ...] = ()
+    setup: Callable[[CapabilityEnv], Any] | None = None
 
     def add(self, manifest: OperationManifest, factory: OperationFactoryFn) -> None:
+        """Add an operation: its manifest and the factory that makes its code per leaf."""
         if manifest.capability != self.name:
-            raise CapabilityError(
+            raise CapabilityLoadError(
                 f"operation {manifest.id!r} says it belongs to {manifest.capability!r}, not {self.name!r}"
             )
         if not manifest.id.startswith(self.name + "."):
-            raise CapabilityError(
+            raise CapabilityLoadError(
                 f"operation id {manifest.id!r} must start with {self.name + '.'!r}"
             )
         self.operations.append(OperationDef(manifest, factory))
@@ -135,13 +157,13 @@ def load_entry_point_capabilities(group: str = ENTRY_POINT_GROUP) -> list[Capabi
         try:
             made = entry.load()()
         except Exception as exc:  # a broken plug-in must not take the others down
-            raise CapabilityError(
+            raise CapabilityLoadError(
                 f"capability entry point {entry.name!r} ({entry.value}) failed: {exc}"
             ) from exc
         items = made if isinstance(made, list) else [made]
         for item in items:
             if not isinstance(item, Capability):
-                raise CapabilityError(
+                raise CapabilityLoadError(
                     f"entry point {entry.name!r} returned {type(item).__name__}, not a Capability"
                 )
             found.append(item)
@@ -154,7 +176,15 @@ class CapabilityRegistry:
     Args:
         capabilities: what to register (default: every entry point).
         cell: the cell whose interfaces decide what is available.
-        settings: per-capability settings, by capability name.
+        settings: the ``capabilities`` block of a cell file (capability name -> its
+            settings as JSON values); default: the cell's ``capability_settings()`` when it
+            has one. Checked against each capability's declared settings here; a block
+            naming no installed capability is an error when ``capabilities`` is None.
+        settings_source: the file the settings came from, named in errors.
+
+    Raises:
+        CapabilitySettingsError: a settings block names an unknown capability or setting,
+            or gives a value of the wrong type.
     """
 
     def __init__(
@@ -162,9 +192,16 @@ class CapabilityRegistry:
         capabilities: Iterable[Capability] | None = None,
         cell: Cell | None = None,
         settings: Mapping[str, Mapping[str, Any]] | None = None,
+        settings_source: str = "the capability settings",
     ) -> None:
         self.cell: Cell = cell if cell is not None else NullCell()
-        self._settings = settings or {}
+        if settings is None:
+            settings, settings_source = _cell_settings(self.cell, settings_source)
+        self._raw_settings = settings
+        self._settings_source = settings_source
+        self._settings: dict[str, dict[str, Any]] = {}
+        self._states: dict[str, Any] = {}
+        self._lock = threading.Lock()
         self._capabilities: dict[str, Capability] = {}
         self._ops: dict[str, tuple[Capability, OperationDef]] = {}
         self._aliases: dict[str, str] = {}
@@ -172,14 +209,29 @@ class CapabilityRegistry:
             capabilities if capabilities is not None else load_entry_point_capabilities()
         ):
             self.register(capability)
+        # A block for a capability this registry lacks is a typo when every installed
+        # capability is here; a registry of chosen capabilities skips the others' blocks.
+        unknown = sorted(set(settings) - set(self._capabilities))
+        if unknown and capabilities is None:
+            raise CapabilitySettingsError(
+                f"{settings_source}: $.capabilities.{unknown[0]}: no capability of that name "
+                f"(capabilities: {', '.join(sorted(self._capabilities))})"
+            )
 
     def register(self, capability: Capability) -> None:
+        """Add a capability; its settings are checked against the block given for it."""
         if capability.name in self._capabilities:
-            raise CapabilityError(f"two capabilities are called {capability.name!r}")
+            raise CapabilityLoadError(f"two capabilities are called {capability.name!r}")
+        self._settings[capability.name] = parse_settings(
+            capability.name,
+            capability.settings,
+            self._raw_settings.get(capability.name, {}),
+            self._settings_source,
+        )
         self._capabilities[capability.name] = capability
         for op in capability.operations:
             if op.manifest.id in self._ops:
-                raise CapabilityError(f"operation {op.manifest.id!r} is registered twice")
+                raise CapabilityLoadError(f"operation {op.manifest.id!r} is registered twice")
             self._ops[op.manifest.id] = (capability, op)
             for alias in op.manifest.aliases:
                 self._aliases[alias] = op.manifest.id
@@ -214,12 +266,29 @@ class CapabilityRegistry:
     def availability(self, op_id: str) -> Availability:
         return self.capability_availability(self._lookup(op_id)[0])
 
+    def settings(self, capability: str) -> Mapping[str, Any]:
+        """The checked settings of a registered capability."""
+        return self._settings[capability]
+
     def create(self, op_id: str) -> Operation:
         capability, op = self._lookup(op_id)
-        env = CapabilityEnv(
-            self.cell, capability.name, self._settings.get(capability.name, {}), operations=self
-        )
+        env = CapabilityEnv(self.cell, capability.name, self._settings[capability.name], self)
+        if capability.setup is not None:
+            with self._lock:  # setup runs once per cell, even when two threads build trees
+                if capability.name not in self._states:
+                    self._states[capability.name] = capability.setup(env)
+            env = CapabilityEnv(env.cell, env.capability, env.settings, self,
+                                self._states[capability.name])  # fmt: skip
         return op.factory(env)
 
     def aliases(self) -> Mapping[str, str]:
         return dict(self._aliases)
+
+
+def _cell_settings(cell: Cell, default_source: str) -> tuple[Mapping[str, Any], str]:
+    """The cell's capability settings block and the file it came from (none: empty)."""
+    supplier = getattr(cell, "capability_settings", None)
+    if not callable(supplier):
+        return {}, default_source
+    raw, source = supplier()
+    return raw, source

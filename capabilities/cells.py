@@ -8,13 +8,14 @@ from types import TracebackType
 from typing import Any
 
 from capabilities.collaboration.console import OperatorConsole
+from capabilities.errors import CapabilityError
 
 __all__ = ["CELL_NAMES", "CellError", "ManagedCell", "open_cell"]
 
 CELL_NAMES: tuple[str, ...] = ("none", "sim")
 
 
-class CellError(Exception):
+class CellError(CapabilityError):
     """A cell could not be opened."""
 
 

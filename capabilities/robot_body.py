@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from capabilities.errors import CapabilityError
 from capabilities.geometry import matrix_to_pose, pose_to_matrix
 from engine.types import Pose
 
@@ -81,7 +82,7 @@ def matrix_pose(m: np.ndarray) -> Pose:
     return matrix_to_pose(m, project=False)
 
 
-class RobotBodyError(Exception):
+class RobotBodyError(CapabilityError):
     """The robot's body cannot be placed (unknown base pose, bad joints)."""
 
 

@@ -126,7 +126,10 @@ def _operation_leaf(spec: NodeSpec, ctx: TreeContext, source: OperationSource, p
             refs[port.name] = binding.ref
         else:
             fixed[port.name] = binding.value
-    return OperationLeaf(ctx, spec.id, spec.label, manifest.kind, operation, fixed, refs, outputs)
+    return OperationLeaf(
+        ctx, spec.id, spec.label, manifest.kind, operation, fixed, refs, outputs,
+        ports=manifest.inputs,
+    )  # fmt: skip
 
 
 def _build_node(spec: NodeSpec, ctx: TreeContext, source: OperationSource, path: str) -> Node:

@@ -7,7 +7,7 @@ it. Anything the operation raises becomes FAILURE of this node with the message.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from engine.blackboard import MISSING
@@ -19,8 +19,11 @@ from engine.operations import (
     OperationCall,
     OperationFailed,
     OperationKind,
+    PortSpec,
+    read_reference,
+    typed_input,
 )
-from engine.status import FAILURE, RUNNING, SUCCESS, Status
+from engine.status import RUNNING, SUCCESS, Status
 
 __all__ = ["OperationLeaf", "Wait"]
 
@@ -43,6 +46,9 @@ class OperationLeaf(Node):
         fixed: input port -> literal value (defaults included).
         refs: input port -> blackboard key read at each start.
         outputs: output port -> blackboard key written.
+        ports: the manifest's input ports: fixed values are given to the operation as the
+            port's type, and a reference's value is checked against the port's types when
+            read (a value of another type fails the node, naming port, name and types).
     """
 
     kind = "operation"
@@ -57,6 +63,8 @@ class OperationLeaf(Node):
         fixed: Mapping[str, Any] | None = None,
         refs: Mapping[str, str] | None = None,
         outputs: Mapping[str, str] | None = None,
+        *,
+        ports: Sequence[PortSpec] = (),
     ) -> None:
         super().__init__(ctx, node_id, name)
         self.op_kind = op_kind
@@ -66,8 +74,11 @@ class OperationLeaf(Node):
         # Python 3.11, a noticeable share of a leaf's tick.
         self._is_query = op_kind is OperationKind.QUERY
         self.operation = operation
-        self._fixed = dict(fixed or {})
-        self._refs = tuple((refs or {}).items())
+        by_name = {p.name: p for p in ports}
+        self._fixed = {
+            k: typed_input(by_name[k], v) if k in by_name else v for k, v in (fixed or {}).items()
+        }
+        self._refs = tuple((port, key, by_name.get(port)) for port, key in (refs or {}).items())
         self._written: set[str] = set()
         self._call = OperationCall(
             node_id, self.name, outputs or {}, self._write, ctx.log, self._wake, ctx.clock
@@ -84,51 +95,52 @@ class OperationLeaf(Node):
 
     def update(self) -> Status:
         job = self._job
+        fresh = job is None
         if job is None:
             try:
-                result = self._start()
+                job = self._start()
             except Exception as exc:  # the operation's fault: FAILURE of this node, never a crash
                 return self.fail(_error_text(exc))
-            if not isinstance(result, Job):
-                return result
-            job = self._job = result
-            job.bind_wake(self.ctx.wake)
         try:
-            status = job.poll()
+            # A plain Job's poll() is its status: read it without the call (the tick path of
+            # every operation that answers at once).
+            if job.__class__ is Job:
+                status = job._status
+            elif isinstance(job, Job):
+                status = job.poll()
+            else:
+                raise TypeError(f"start() returned {job!r}; expected a Job (Job.done() when done)")
             if status is RUNNING:
+                if fresh:
+                    self._job = job
+                    job.bind_wake(self.ctx.wake)
                 return RUNNING
-            self._job = None
+            if not fresh:
+                self._job = None
             if status is SUCCESS:
-                for port, value in job.outputs.items():
-                    self._call.write(port, value)
+                if job.outputs:
+                    for port, value in job.outputs.items():
+                        self._call.write(port, value)
                 return self._succeeded(job.message)
         except Exception as exc:
             self._job = None
             return self.fail(_error_text(exc))
-        return self.fail(job.message or "failed")
+        return self.fail(job.message or ("false" if self.is_condition else "failed"))
 
-    def _start(self) -> Status | Job:
+    def _start(self) -> Job:
         call = self._call
         if self._refs:
             board = self.ctx.blackboard
             args = dict(self._fixed)
-            for port, key in self._refs:
+            for port, key, spec in self._refs:
                 value = board.get(key, MISSING)
                 if value is MISSING:
                     raise OperationFailed(f"parameter {key!r} (for {port!r}) has no value yet")
-                args[port] = value
+                args[port] = value if spec is None else read_reference(spec, key, value)
             call.args = args
         if self._is_query:
             self._written.clear()
-        result = self.operation.start(call)
-        if result is True or result is None or result is SUCCESS:
-            return self._succeeded("")
-        if result is False or result is FAILURE:
-            self.message = "false" if self.is_condition else "failed"
-            return FAILURE
-        if isinstance(result, Job):
-            return result
-        raise TypeError(f"start() returned {result!r}; expected a bool, a Status or a Job")
+        return self.operation.start(call)
 
     def _succeeded(self, message: str) -> Status:
         if self._is_query:

@@ -16,7 +16,7 @@ from typing import Any, Protocol
 
 from engine.errors import EngineError
 from engine.status import FAILURE, RUNNING, SUCCESS, Status
-from engine.types import ParamType
+from engine.types import ParamType, check_value, type_of_value
 
 __all__ = [
     "OperationKind",
@@ -25,13 +25,13 @@ __all__ = [
     "OperationManifest",
     "OperationCall",
     "Operation",
-    "OperationFactory",
     "Job",
     "OperationNotFound",
     "OperationSource",
     "Availability",
     "OperationFailed",
     "StartResult",
+    "InputTypeError",
 ]
 
 
@@ -63,6 +63,9 @@ class PortSpec:
         unit: the SI unit of a Number ("m", "rad", "m/s"), shown converted in the UI.
         doc: one line for the inspector and ``costar ops``.
         choices: allowed values of a Text port, if it is an enumeration.
+        names_kind: set on a Text port whose value is the id of another operation, of
+            this kind (``timing.wait_until``'s ``condition``): validation checks that such
+            an operation exists, is of that kind and needs no inputs.
     """
 
     name: str
@@ -72,6 +75,7 @@ class PortSpec:
     unit: str = ""
     doc: str = ""
     choices: tuple[str, ...] = ()
+    names_kind: OperationKind | None = None
 
     @property
     def type(self) -> ParamType:
@@ -109,10 +113,14 @@ class OperationManifest:
 
 
 class OperationCall:
-    """What an operation gets when it starts: resolved inputs, a way to write outputs.
+    """What an operation gets when it starts: its typed inputs, a way to write outputs.
 
-    One call object lives per leaf and is reused between starts (allocation in the tick
-    path costs time); ``args`` is refreshed before each start.
+    An operation reads each input with :meth:`input` (BehaviorTree.CPP's ``getInput<T>``):
+    the value is already of one of the port's types and in SI units (a Number or Duration
+    is a float), fixed values were checked by validation and a reference's value was
+    checked against the port's types when the leaf read it, so an operation does not
+    check them again. One call object lives per leaf and is reused between starts
+    (allocation in the tick path costs time); the inputs are refreshed before each start.
     """
 
     __slots__ = ("_logger", "_writer", "args", "clock", "node_id", "node_name", "outputs", "wake")
@@ -127,7 +135,7 @@ class OperationCall:
         wake: Callable[[], None],
         clock: Callable[[], float],
     ) -> None:
-        self.args: dict[str, Any] = {}
+        self.args: dict[str, Any] = {}  # port name -> typed value; read it with input()
         self.node_id = node_id
         self.node_name = node_name
         self.outputs = dict(outputs)  # port name -> blackboard key
@@ -135,6 +143,17 @@ class OperationCall:
         self._logger = logger
         self.wake = wake
         self.clock = clock
+
+    def input(self, port: str) -> Any:
+        """The typed value of an input port (its default when the plan leaves it unbound).
+
+        Raises:
+            OperationFailed: the operation asked for a port its manifest does not have.
+        """
+        try:
+            return self.args[port]
+        except KeyError:
+            raise OperationFailed(f"{self.node_name!r} has no input {port!r}") from None
 
     def write(self, port: str, value: Any) -> None:
         """Write the value of an output port to the blackboard entry it is bound to.
@@ -152,13 +171,66 @@ class OperationCall:
         self._logger(self.node_id, message)
 
 
-class Job:
-    """Work that outlives one tick: finished from any thread, polled by the engine thread.
+_NUMERIC = (ParamType.NUMBER, ParamType.DURATION)
 
-    Subclass and override :meth:`poll` for work that advances with ticks; or keep the base
-    and call :meth:`succeed` / :meth:`fail` from the thread that does the work. Outputs
-    given to ``succeed`` are written to the blackboard by the engine thread when it polls.
+
+def typed_input(port: PortSpec, value: Any) -> Any:
+    """``value`` as the port's type: an int given to a Number or Duration port is a float."""
+    if type(value) is int and any(t in _NUMERIC for t in port.types):
+        return float(value)
+    return value
+
+
+def read_reference(port: PortSpec, key: str, value: Any) -> Any:
+    """A value read from the blackboard for ``port``, checked against the port's types.
+
+    Raises:
+        InputTypeError: the value is of none of the port's types (or not one of its
+            choices); the message names the port, the blackboard name, the expected and
+            the actual type.
     """
+    for ptype in port.types:
+        if check_value(ptype, value):
+            if port.choices and value not in port.choices:
+                break
+            return typed_input(port, value)
+    raise InputTypeError(port, key, value)
+
+
+class Job:
+    """What ``start`` returns: work that finished at once, or that outlives one tick.
+
+    Work done at once returns a finished job: :meth:`done`, :meth:`failed` or
+    :meth:`answer` (a condition's true/false). Longer work subclasses and overrides
+    :meth:`poll` for work that advances with ticks, or keeps the base and calls
+    :meth:`succeed` / :meth:`fail` from the thread that does the work. Outputs given to
+    ``succeed`` or ``done`` are written to the blackboard by the engine thread when it polls.
+    """
+
+    @staticmethod
+    def done(message: str = "", outputs: Mapping[str, Any] | None = None) -> Job:
+        """A job that already succeeded (shared when it carries nothing)."""
+        if not message and not outputs:
+            return _DONE
+        job = Job()
+        job.succeed(message, outputs)
+        return job
+
+    @staticmethod
+    def failed(message: str = "") -> Job:
+        """A job that already failed with ``message`` (empty: the leaf says "failed")."""
+        if not message:
+            return _FAILED
+        job = Job()
+        job.fail(message)
+        return job
+
+    @staticmethod
+    def answer(value: bool, message: str = "") -> Job:
+        """A condition's answer: SUCCESS when true, FAILURE (message "false") when not."""
+        if message:
+            return Job.done(message) if value else Job.failed(message)
+        return _DONE if value else _FAILED
 
     def __init__(self, on_cancel: Callable[[], None] | None = None) -> None:
         self._lock = threading.Lock()
@@ -172,8 +244,9 @@ class Job:
     def bind_wake(self, wake: Callable[[], None]) -> None:
         """Called by the leaf: ``wake`` runs when the job finishes, to tick again at once."""
         with self._lock:
-            self._on_done = wake
             finished = self._status is not RUNNING
+            if not finished:
+                self._on_done = wake
         if finished:
             wake()
 
@@ -219,21 +292,24 @@ class Job:
             callback()
 
 
-StartResult = Status | bool | Job | None
+_DONE = Job()
+_DONE.succeed()
+_FAILED = Job()
+_FAILED.fail("")
+
+StartResult = Job  # the one thing ``start`` returns
 
 
 class Operation(Protocol):
     """The code of one operation; one instance per leaf of a built tree.
 
-    ``start`` must return quickly: True/SUCCESS or False/FAILURE when done at once, or a
-    :class:`Job` for longer work. ``None`` counts as SUCCESS. Raising makes the node FAILURE
-    with the exception's message.
+    ``start`` must return quickly, always with a :class:`Job`: a finished one
+    (``Job.done()``, ``Job.failed(message)``, ``Job.answer(flag)``) when the work is done at
+    once, a running one for longer work. Raising makes the node FAILURE with the exception's
+    message (:class:`OperationFailed`: exactly its message).
     """
 
     def start(self, call: OperationCall) -> StartResult: ...
-
-
-OperationFactory = Callable[[], Operation]
 
 
 class OperationNotFound(EngineError, LookupError):
@@ -272,3 +348,24 @@ class OperationSource(Protocol):
 
 class OperationFailed(EngineError):
     """Raised by an operation to fail its node with exactly this message."""
+
+
+class InputTypeError(OperationFailed):
+    """A reference's value is not of the type the reading port accepts."""
+
+    def __init__(self, port: PortSpec, key: str, value: Any) -> None:
+        self.port = port.name
+        self.key = key
+        expected = " or ".join(t.value for t in port.types)
+        if port.choices:
+            expected += f" (one of {', '.join(port.choices)})"
+        actual = type_of_value(value).value
+        super().__init__(
+            f"input {port.name!r} reads {key!r}, which holds {actual} {_short(value)}; "
+            f"expected {expected}"
+        )
+
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."

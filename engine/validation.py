@@ -27,6 +27,7 @@ from engine.operations import (
     OperationManifest,
     OperationNotFound,
     OperationSource,
+    PortSpec,
 )
 from engine.spec import KIND_CATEGORY, Binding, Category, NodeKind, NodeSpec, PlanSpec
 from engine.types import ParamType, check_value
@@ -285,6 +286,8 @@ def _check_bound_ports(
             _check_output(check, node, port_name, binding, port.types)
         elif not binding.is_ref:
             _check_fixed(check, node, port_name, binding, port.types, port.choices)
+            if port.names_kind is not None:
+                _check_named_operation(check, node, port, binding)
 
 
 def _check_unbound_ports(
@@ -362,6 +365,36 @@ def _check_fixed(
     else:
         return True
     return False
+
+
+def _check_named_operation(check: _Check, node: NodeSpec, port: PortSpec, binding: Binding) -> None:
+    """A port whose value is an operation id (``names_kind``): that operation must exist,
+    be of the kind the port names, be available and need no inputs."""
+    kind = port.names_kind
+    assert kind is not None
+    op_id = binding.value.strip() if isinstance(binding.value, str) else ""
+    wanted = f"the id of a {kind.value} operation"
+    if not op_id:
+        check.add(ERROR, node, f"{port.name!r} of {node.label!r} needs {wanted}.", port.name)
+        return
+    try:
+        named = check.source.manifest(op_id)
+    except OperationNotFound:
+        hint = _suggest(check, op_id)
+        text = f"{port.name!r} of {node.label!r} names no operation: {op_id!r}{hint}."
+        check.add(ERROR, node, text, port.name)
+        return
+    needs = [p.name for p in named.inputs if p.required]
+    if named.kind is not kind:
+        article = "an" if named.kind.value[0] in "aeiou" else "a"
+        problem = f"{op_id} is {article} {named.kind.value}, not a {kind.value}"
+    elif not check.source.availability(op_id).available:
+        problem = f"{op_id} cannot run on this cell: {check.source.availability(op_id).reason}"
+    elif needs:
+        problem = f"{op_id} needs {', '.join(needs)}, which {node.label!r} cannot give it"
+    else:
+        return
+    check.add(ERROR, node, f"{port.name!r} of {node.label!r}: {problem}.", port.name)
 
 
 def _check_writer_types(check: _Check) -> None:

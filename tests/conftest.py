@@ -1,9 +1,17 @@
-"""Marks tests by folder (gui, sim, hardware) so that runs can pick them (-m "not sim")."""
+"""Marks tests by what they use, so that runs can pick them (-m "not sim").
+
+``gui`` and ``hardware`` go by folder. ``sim`` goes by use: a test is ``sim`` when it, or
+any fixture it uses (directly or through other fixtures), starts the simulated cell, that is
+names ``SimCellSession``, ``SimCell`` or ``open_cell`` in its code, wherever its file lives.
+The ``sim`` folder marks ``sim`` too.
+"""
 
 from __future__ import annotations
 
 import os
 from pathlib import Path
+from types import CodeType
+from typing import Any
 
 import pytest
 
@@ -18,6 +26,37 @@ _MARK_BY_FOLDER = {
     "hardware": "hardware",
 }
 
+# Names whose use in a test or fixture means the simulated cell (pybullet) starts.
+_STARTS_THE_SIM = frozenset({"SimCellSession", "SimCell", "open_cell"})
+
+
+def _names(code: CodeType) -> set[str]:
+    """Global and attribute names a function's code uses, nested functions included."""
+    found = set(code.co_names)
+    for const in code.co_consts:
+        if isinstance(const, CodeType):
+            found |= _names(const)
+    return found
+
+
+def _starts_the_sim(func: Any) -> bool:
+    code = getattr(getattr(func, "__wrapped__", func), "__code__", None)
+    return code is not None and not _STARTS_THE_SIM.isdisjoint(_names(code))
+
+
+def uses_the_sim(item: pytest.Item) -> bool:
+    """True when the test or a fixture in its closure starts the simulated cell."""
+    if _starts_the_sim(getattr(item, "function", None)):
+        return True
+    info = getattr(item, "_fixtureinfo", None)
+    if info is None:
+        return False
+    return any(
+        _starts_the_sim(fixturedef.func)
+        for fixturedefs in info.name2fixturedefs.values()
+        for fixturedef in fixturedefs
+    )
+
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     for item in items:
@@ -25,3 +64,5 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
         for folder, mark in _MARK_BY_FOLDER.items():
             if folder in parts:
                 item.add_marker(getattr(pytest.mark, mark))
+        if "sim" not in item.keywords and uses_the_sim(item):
+            item.add_marker(pytest.mark.sim)

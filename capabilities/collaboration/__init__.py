@@ -9,7 +9,6 @@ The meeting point of plan and people is the cell's ``operator`` interface, an
 
 from __future__ import annotations
 
-from capabilities.base import Capability
 from capabilities.collaboration.console import (
     ConsoleEvent,
     ConsoleEventKind,
@@ -18,7 +17,7 @@ from capabilities.collaboration.console import (
     PromptState,
 )
 from capabilities.collaboration.errors import CollaborationError
-from capabilities.collaboration.operations import build_capability
+from capabilities.collaboration.operations import capability
 
 __all__ = [
     "CollaborationError",
@@ -29,8 +28,3 @@ __all__ = [
     "PromptState",
     "capability",
 ]
-
-
-def capability() -> Capability:
-    """Entry point of the ``costar.capabilities`` group."""
-    return build_capability()

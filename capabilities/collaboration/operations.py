@@ -27,7 +27,7 @@ from capabilities.collaboration.handoff import (
     in_region,
     object_markers,
 )
-from capabilities.markers.backend import camera_interface
+from capabilities.kit import CAMERAS, camera, manifest
 from capabilities.world_model import Detection, WorldModel
 from engine.operations import (
     Direction,
@@ -37,22 +37,20 @@ from engine.operations import (
     OperationKind,
     OperationManifest,
     PortSpec,
-    StartResult,
 )
 from engine.status import RUNNING, Status
 from engine.types import ObjectModel, ParamType, Region
 
-__all__ = ["CAP", "build_capability"]
+__all__ = ["CAP", "capability"]
 
 CAP = "collaboration"
-CAMERAS = ("shoulder", "wrist")
 
 
 def _seconds(call: OperationCall, port: str) -> float:
-    value = call.args.get(port, 0.0)
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value >= 0:
+    value: float = call.input(port)  # a Duration (validation checked the type, not the sign)
+    if not value >= 0:
         raise OperationFailed(f"{port} must be a number of seconds, 0 or more, not {value!r}")
-    return float(value)
+    return value
 
 
 def _interface(env: CapabilityEnv, name: str, what: str) -> Any:
@@ -103,8 +101,8 @@ class Confirm:
     def __init__(self, console: OperatorConsole) -> None:
         self._console = console
 
-    def start(self, call: OperationCall) -> StartResult:
-        text = str(call.args.get("prompt", "")).strip()
+    def start(self, call: OperationCall) -> Job:
+        text = call.input("prompt").strip()
         if not text:
             raise OperationFailed("confirm needs the text of the question")
         timeout = _seconds(call, "timeout")
@@ -120,8 +118,8 @@ class ButtonPressed:
     def __init__(self, console: OperatorConsole) -> None:
         self._console = console
 
-    def start(self, call: OperationCall) -> StartResult:
-        return self._console.consume(str(call.args.get("button", "continue")))
+    def start(self, call: OperationCall) -> Job:
+        return Job.answer(self._console.consume(call.input("button")))
 
 
 class _ButtonJob(Job):
@@ -159,9 +157,9 @@ class WaitForButton:
     def __init__(self, console: OperatorConsole) -> None:
         self._console = console
 
-    def start(self, call: OperationCall) -> StartResult:
-        button = str(call.args.get("button", "continue"))
-        if not call.args.get("earlier_press_counts", False):
+    def start(self, call: OperationCall) -> Job:
+        button = call.input("button")
+        if not call.input("earlier_press_counts"):
             self._console.clear(button)
         return _ButtonJob(self._console, button, call, _seconds(call, "timeout"))
 
@@ -175,15 +173,12 @@ class WaitForHandoff:
     def __init__(self, env: CapabilityEnv) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         what = "wait_for_handoff"
-        camera_name = str(call.args.get("camera", "shoulder"))
-        if camera_name not in CAMERAS:
-            raise OperationFailed(f"unknown camera {camera_name!r}; cameras: {', '.join(CAMERAS)}")
-        camera = _interface(self._env, camera_interface(camera_name), what)
+        device = camera(self._env, call.input("camera"))
         world: WorldModel = _interface(self._env, "world", what)
         library = _interface(self._env, "objects", what)
-        name = _object_name(call.args["object"])
+        name = _object_name(call.input("object"))
         if name not in library.names():
             raise OperationFailed(f"the object library has no model {name!r}")
         target = object_markers(library.get(name))
@@ -193,8 +188,8 @@ class WaitForHandoff:
             interval=max(_seconds(call, "interval"), 0.01), settle=_seconds(call, "settle"),
             timeout=_seconds(call, "timeout"),
         )  # fmt: skip
-        region: Region = call.args["region"]
-        return HandoffJob(camera, target, region, world, call.clock, settings, call.log)
+        region: Region = call.input("region")
+        return HandoffJob(device, target, region, world, call.clock, settings, call.log)
 
 
 def latest(world: WorldModel, name: str) -> Detection | None:
@@ -209,15 +204,15 @@ class ObjectInRegion:
     def __init__(self, env: CapabilityEnv) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         world: WorldModel = _interface(self._env, "world", "object_in_region")
-        detection = latest(world, _object_name(call.args["object"]))
+        detection = latest(world, _object_name(call.input("object")))
         if detection is None:
-            return False
+            return Job.answer(False)
         max_age = _seconds(call, "max_age")
         if max_age > 0 and call.clock() - detection.stamp > max_age:
-            return False
-        return in_region(detection.pose, call.args["region"])
+            return Job.answer(False)
+        return Job.answer(in_region(detection.pose, call.input("region")))
 
 
 # ---------------------------------------------------------------------- manifests
@@ -231,31 +226,28 @@ TIME = (ParamType.DURATION, ParamType.NUMBER)
 
 
 def _manifests() -> list[tuple[OperationManifest, Any]]:
-    def op(op_id: str, kind: OperationKind, doc: str, *ports: PortSpec) -> OperationManifest:
-        return OperationManifest(f"{CAP}.{op_id}", kind, doc, CAP, ports)
-
     button = _port("button", (ParamType.TEXT,), "the operator button", default="continue")
     obj = _port("object", (ParamType.OBJECT,), "the object (by its model name)")
     region = _port("region", (ParamType.REGION,), "where it must be (a sphere)")
     console = lambda env: env.interface("operator")  # noqa: E731
     return [
-        (op("confirm", OperationKind.ACTION,
+        (manifest(CAP, "confirm", OperationKind.ACTION,
             "Asks the operator a yes/no question; succeeds on yes, fails on no.",
             _port("prompt", (ParamType.TEXT,), "the question shown to the operator"),
             _port("timeout", TIME, "give up after this long (0: wait for ever)", default=0.0,
                   unit="s")),
          lambda env: Confirm(console(env))),
-        (op("button_pressed", OperationKind.CONDITION,
+        (manifest(CAP, "button_pressed", OperationKind.CONDITION,
             "True when the operator pressed the button since it was last checked.", button),
          lambda env: ButtonPressed(console(env))),
-        (op("wait_for_button", OperationKind.ACTION,
+        (manifest(CAP, "wait_for_button", OperationKind.ACTION,
             "Waits until the operator presses the button (or the foot pedal).", button,
             _port("timeout", TIME, "give up after this long (0: wait for ever)", default=0.0,
                   unit="s"),
             _port("earlier_press_counts", (ParamType.BOOL,),
                   "a press made before this node started counts", default=False)),
          lambda env: WaitForButton(console(env))),
-        (op("wait_for_handoff", OperationKind.ACTION,
+        (manifest(CAP, "wait_for_handoff", OperationKind.ACTION,
             "Waits until a person puts the object down in the region (seen by its markers).",
             obj, region,
             _port("camera", (ParamType.TEXT,), "which camera watches", default="shoulder",
@@ -266,7 +258,7 @@ def _manifests() -> list[tuple[OperationManifest, Any]]:
             _port("interval", TIME, "time between camera frames", default=0.1, unit="s"),
             PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where it was put")),
          WaitForHandoff),
-        (op("object_in_region", OperationKind.CONDITION,
+        (manifest(CAP, "object_in_region", OperationKind.CONDITION,
             "True when the object was last seen inside the region.", obj, region,
             _port("max_age", TIME, "ignore sightings older than this (0: any age)",
                   default=0.0, unit="s")),
@@ -274,13 +266,13 @@ def _manifests() -> list[tuple[OperationManifest, Any]]:
     ]  # fmt: skip
 
 
-def build_capability() -> Capability:
+def capability() -> Capability:
     """The collaboration capability (requires the cell's ``operator`` console)."""
     cap = Capability(
         CAP,
         "People and the robot: operator prompts and buttons, objects handed over.",
         requires=("operator",),
     )
-    for manifest, factory in _manifests():
-        cap.add(manifest, factory)
+    for made, factory in _manifests():
+        cap.add(made, factory)
     return cap

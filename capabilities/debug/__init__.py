@@ -2,12 +2,6 @@
 
 from __future__ import annotations
 
-from capabilities.base import Capability
-from capabilities.debug.operations import build_debug_capability
+from capabilities.debug.operations import capability
 
 __all__ = ["capability"]
-
-
-def capability() -> Capability:
-    """Entry point of the ``costar.capabilities`` group."""
-    return build_debug_capability()

@@ -9,6 +9,7 @@ from __future__ import annotations
 from typing import Any
 
 from capabilities.base import Capability, CapabilityEnv
+from capabilities.kit import manifest
 from engine.operations import (
     Direction,
     Job,
@@ -17,30 +18,25 @@ from engine.operations import (
     OperationKind,
     OperationManifest,
     PortSpec,
-    StartResult,
 )
 from engine.status import FAILURE, RUNNING, SUCCESS, Status
 from engine.types import ParamType
 
-__all__ = ["build_debug_capability"]
+__all__ = ["capability"]
 
 CAP = "debug"
 ANY = (ParamType.ANY,)
 ALL_TYPES = (*(t for t in ParamType if t is not ParamType.ANY), ParamType.ANY)
 
 
-def _manifest(op: str, kind: OperationKind, doc: str, *ports: PortSpec) -> OperationManifest:
-    return OperationManifest(f"{CAP}.{op}", kind, doc, CAP, tuple(ports))
-
-
 class _Succeed:
-    def start(self, call: OperationCall) -> StartResult:
-        return True
+    def start(self, call: OperationCall) -> Job:
+        return Job.done()
 
 
 class _Fail:
-    def start(self, call: OperationCall) -> StartResult:
-        raise OperationFailed(str(call.args.get("message") or "failed on purpose"))
+    def start(self, call: OperationCall) -> Job:
+        raise OperationFailed(str(call.input("message") or "failed on purpose"))
 
 
 class _TickJob(Job):
@@ -61,47 +57,44 @@ class _TickJob(Job):
         return self._then
 
 
-def _then_status(value: Any) -> Status:
-    text = str(value).upper()
-    if text not in ("SUCCESS", "FAILURE"):
-        raise OperationFailed(f"'then' must be SUCCESS or FAILURE, not {value!r}")
-    return SUCCESS if text == "SUCCESS" else FAILURE
+def _then_status(value: str) -> Status:
+    return SUCCESS if value == "SUCCESS" else FAILURE  # the port's choices
 
 
 class _Running:
-    def start(self, call: OperationCall) -> StartResult:
-        ticks = int(call.args["ticks"])
+    def start(self, call: OperationCall) -> Job:
+        ticks = int(call.input("ticks"))
         if ticks < 0:
             raise OperationFailed(f"ticks must be 0 or more, not {ticks}")
-        return _TickJob(ticks, _then_status(call.args["then"]), str(call.args.get("message", "")))
+        return _TickJob(ticks, _then_status(call.input("then")), call.input("message"))
 
 
 class _PretendMove:
-    def start(self, call: OperationCall) -> StartResult:
-        call.log(f"moving to {call.args['target']}")
-        return _TickJob(int(call.args["ticks"]), SUCCESS, "")
+    def start(self, call: OperationCall) -> Job:
+        call.log(f"moving to {call.input('target')}")
+        return _TickJob(int(call.input("ticks")), SUCCESS, "")
 
 
 class _SetParam:
-    def start(self, call: OperationCall) -> StartResult:
-        call.write("name", call.args["value"])
-        return True
+    def start(self, call: OperationCall) -> Job:
+        call.write("name", call.input("value"))
+        return Job.done()
 
 
 class _Query:
-    def start(self, call: OperationCall) -> StartResult:
-        call.write("result", call.args["value"])
-        return True
+    def start(self, call: OperationCall) -> Job:
+        call.write("result", call.input("value"))
+        return Job.done()
 
 
 class _CheckParam:
-    def start(self, call: OperationCall) -> StartResult:
-        return bool(call.args["value"] == call.args["expected"])
+    def start(self, call: OperationCall) -> Job:
+        return Job.answer(bool(call.input("value") == call.input("expected")))
 
 
 class _Condition:
-    def start(self, call: OperationCall) -> StartResult:
-        return bool(call.args["result"])
+    def start(self, call: OperationCall) -> Job:
+        return Job.answer(bool(call.input("result")))
 
 
 class _SucceedAfter:
@@ -110,15 +103,15 @@ class _SucceedAfter:
     def __init__(self) -> None:
         self.evaluations = 0
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         self.evaluations += 1
-        return self.evaluations > int(call.args["failures"])
+        return Job.answer(self.evaluations > int(call.input("failures")))
 
 
 class _Log:
-    def start(self, call: OperationCall) -> StartResult:
-        call.log(str(call.args["message"]))
-        return True
+    def start(self, call: OperationCall) -> Job:
+        call.log(call.input("message"))
+        return Job.done()
 
 
 def _maker(cls: type) -> Any:
@@ -128,14 +121,15 @@ def _maker(cls: type) -> Any:
     return make
 
 
-def build_debug_capability() -> Capability:
+def capability() -> Capability:
     """The debug capability with all its operations."""
     cap = Capability(CAP, "Operations for trying plans without a robot.")
     ticks = PortSpec("ticks", (ParamType.NUMBER,), default=3, doc="ticks spent RUNNING")
     entries: list[tuple[OperationManifest, type]] = [
-        (_manifest("succeed", OperationKind.ACTION, "Succeeds at once."), _Succeed),
+        (manifest(CAP, "succeed", OperationKind.ACTION, "Succeeds at once."), _Succeed),
         (
-            _manifest(
+            manifest(
+                CAP,
                 "fail",
                 OperationKind.ACTION,
                 "Fails at once with a message.",
@@ -144,7 +138,8 @@ def build_debug_capability() -> Capability:
             _Fail,
         ),
         (
-            _manifest(
+            manifest(
+                CAP,
                 "running",
                 OperationKind.ACTION,
                 "Runs for a number of ticks, then succeeds or fails.",
@@ -161,7 +156,8 @@ def build_debug_capability() -> Capability:
             _Running,
         ),
         (
-            _manifest(
+            manifest(
+                CAP,
                 "pretend_move",
                 OperationKind.ACTION,
                 "Pretends to move to a pose for some ticks.",
@@ -171,7 +167,8 @@ def build_debug_capability() -> Capability:
             _PretendMove,
         ),
         (
-            _manifest(
+            manifest(
+                CAP,
                 "set_param",
                 OperationKind.ACTION,
                 "Writes a value to a named parameter.",
@@ -181,7 +178,8 @@ def build_debug_capability() -> Capability:
             _SetParam,
         ),
         (
-            _manifest(
+            manifest(
+                CAP,
                 "query",
                 OperationKind.QUERY,
                 "Answers with a given value (a stand-in query).",
@@ -191,7 +189,8 @@ def build_debug_capability() -> Capability:
             _Query,
         ),
         (
-            _manifest(
+            manifest(
+                CAP,
                 "check_param",
                 OperationKind.CONDITION,
                 "True when a parameter equals a value.",
@@ -201,7 +200,8 @@ def build_debug_capability() -> Capability:
             _CheckParam,
         ),
         (
-            _manifest(
+            manifest(
+                CAP,
                 "condition",
                 OperationKind.CONDITION,
                 "True or false, as set.",
@@ -210,7 +210,8 @@ def build_debug_capability() -> Capability:
             _Condition,
         ),
         (
-            _manifest(
+            manifest(
+                CAP,
                 "succeed_after",
                 OperationKind.CONDITION,
                 "False the first N times it is checked, then true (e.g. an object that appears).",
@@ -219,7 +220,8 @@ def build_debug_capability() -> Capability:
             _SucceedAfter,
         ),
         (
-            _manifest(
+            manifest(
+                CAP,
                 "log",
                 OperationKind.ACTION,
                 "Writes a message to the run's log.",
@@ -228,6 +230,6 @@ def build_debug_capability() -> Capability:
             _Log,
         ),
     ]
-    for manifest, cls in entries:
-        cap.add(manifest, _maker(cls))
+    for made, cls in entries:
+        cap.add(made, _maker(cls))
     return cap

@@ -2,12 +2,6 @@
 
 from __future__ import annotations
 
-from capabilities.base import Capability
-from capabilities.freedrive.operations import build_freedrive_capability
+from capabilities.freedrive.operations import capability
 
 __all__ = ["capability"]
-
-
-def capability() -> Capability:
-    """Entry point of the ``costar.capabilities`` group."""
-    return build_freedrive_capability()

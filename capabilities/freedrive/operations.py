@@ -7,41 +7,30 @@ from collections.abc import Callable
 
 from capabilities.base import Capability, CapabilityEnv
 from capabilities.freedrive.backend import FREEDRIVE, FreedriveBackend
+from capabilities.kit import manifest
 from engine.operations import (
     Direction,
     Job,
     OperationCall,
     OperationFailed,
     OperationKind,
-    OperationManifest,
     PortSpec,
-    StartResult,
 )
 from engine.types import JointConfig, ParamType, Waypoint, WaypointFrame
 
-__all__ = ["build_freedrive_capability"]
+__all__ = ["capability"]
 
 CAP = "freedrive"
 
-START = OperationManifest(
-    f"{CAP}.start", OperationKind.ACTION, "Lets the worker guide the arm by hand.", CAP
-)
-STOP = OperationManifest(
-    f"{CAP}.stop", OperationKind.ACTION, "Ends hand guiding; the arm holds where it is.", CAP
-)
-RECORD_WAYPOINT = OperationManifest(
-    f"{CAP}.record_waypoint",
-    OperationKind.QUERY,
+START = manifest(CAP, "start", OperationKind.ACTION, "Lets the worker guide the arm by hand.")
+STOP = manifest(CAP, "stop", OperationKind.ACTION, "Ends hand guiding; the arm holds where it is.")
+RECORD_WAYPOINT = manifest(
+    CAP, "record_waypoint", OperationKind.QUERY,
     "Records where the arm is now as a waypoint (typically after guiding it by hand).",
-    CAP,
-    (
-        PortSpec("name", (ParamType.TEXT,), default="waypoint", doc="the waypoint's name"),
-        PortSpec(
-            "frame", (ParamType.TEXT,), default="world", choices=("world", "joints"),
-            doc="world: the tool pose; joints: the joint positions",
-        ),
-        PortSpec("waypoint", (ParamType.WAYPOINT,), Direction.OUT, doc="the recorded waypoint"),
-    ),
+    PortSpec("name", (ParamType.TEXT,), default="waypoint", doc="the waypoint's name"),
+    PortSpec("frame", (ParamType.TEXT,), default="world", choices=("world", "joints"),
+             doc="world: the tool pose; joints: the joint positions"),
+    PortSpec("waypoint", (ParamType.WAYPOINT,), Direction.OUT, doc="the recorded waypoint"),
 )  # fmt: skip
 
 
@@ -68,7 +57,7 @@ class SetFreedrive:
         self._backend = backend
         self._on = on
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         describe = "start freedrive" if self._on else "stop freedrive"
         return _off_thread(lambda: self._backend.set_freedrive(self._on), describe)
 
@@ -79,23 +68,21 @@ class RecordWaypoint:
     def __init__(self, backend: FreedriveBackend) -> None:
         self._backend = backend
 
-    def start(self, call: OperationCall) -> StartResult:
-        name = str(call.args.get("name", "waypoint")).strip()
+    def start(self, call: OperationCall) -> Job:
+        name = call.input("name").strip()
         if not name:
             raise OperationFailed("the waypoint needs a name")
-        frame = str(call.args.get("frame", "world"))
+        frame = call.input("frame")
         if frame == "world":
             waypoint = Waypoint(name, WaypointFrame.WORLD, pose=self._backend.tcp_pose())
-        elif frame == "joints":
+        else:  # "joints" (the port's choices)
             joints = JointConfig(self._backend.joint_positions())
             waypoint = Waypoint(name, WaypointFrame.JOINTS, joints=joints)
-        else:
-            raise OperationFailed(f"frame must be 'world' or 'joints', not {frame!r}")
         call.write("waypoint", waypoint)
-        return True
+        return Job.done()
 
 
-def build_freedrive_capability() -> Capability:
+def capability() -> Capability:
     """The freedrive capability (requires ``freedrive``)."""
     cap = Capability(
         CAP, "Hand guiding of the arm and recording where it is.", requires=(FREEDRIVE,)

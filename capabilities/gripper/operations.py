@@ -5,26 +5,26 @@ from __future__ import annotations
 from capabilities.base import Capability, CapabilityEnv
 from capabilities.gripper.backend import GRIPPER, GripperBackend
 from capabilities.jobs import job_from_handle
-from engine.operations import OperationCall, OperationKind, OperationManifest, StartResult
+from capabilities.kit import manifest
+from engine.operations import Job, OperationCall, OperationKind
 
-__all__ = ["build_gripper_capability"]
+__all__ = ["capability"]
 
 CAP = "gripper"
 
 
-def _m(op: str, kind: OperationKind, doc: str) -> OperationManifest:
-    return OperationManifest(f"{CAP}.{op}", kind, doc, CAP)
-
-
-OPEN = _m("open", OperationKind.ACTION, "Opens the gripper fully, releasing what it holds.")
-CLOSE = _m(
+OPEN = manifest(
+    CAP, "open", OperationKind.ACTION, "Opens the gripper fully, releasing what it holds."
+)
+CLOSE = manifest(
+    CAP,
     "close",
     OperationKind.ACTION,
     "Closes the gripper until the fingers meet or stop on an object (see gripper.is_holding).",
 )
-IS_CLOSED = _m("is_closed", OperationKind.CONDITION, "True when the gripper is closed.")
-IS_HOLDING = _m(
-    "is_holding", OperationKind.CONDITION, "True when the closed gripper holds something."
+IS_CLOSED = manifest(CAP, "is_closed", OperationKind.CONDITION, "True when the gripper is closed.")
+IS_HOLDING = manifest(
+    CAP, "is_holding", OperationKind.CONDITION, "True when the closed gripper holds something."
 )
 
 
@@ -34,7 +34,7 @@ class Open:
     def __init__(self, gripper: GripperBackend) -> None:
         self._gripper = gripper
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         return job_from_handle(self._gripper.open(), "open the gripper")
 
 
@@ -44,7 +44,7 @@ class Close:
     def __init__(self, gripper: GripperBackend) -> None:
         self._gripper = gripper
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         return job_from_handle(self._gripper.close(), "close the gripper")
 
 
@@ -54,8 +54,8 @@ class IsClosed:
     def __init__(self, gripper: GripperBackend) -> None:
         self._gripper = gripper
 
-    def start(self, call: OperationCall) -> StartResult:
-        return self._gripper.is_closed()
+    def start(self, call: OperationCall) -> Job:
+        return Job.answer(self._gripper.is_closed())
 
 
 class IsHolding:
@@ -64,11 +64,11 @@ class IsHolding:
     def __init__(self, gripper: GripperBackend) -> None:
         self._gripper = gripper
 
-    def start(self, call: OperationCall) -> StartResult:
-        return self._gripper.is_holding()
+    def start(self, call: OperationCall) -> Job:
+        return Job.answer(self._gripper.is_holding())
 
 
-def build_gripper_capability() -> Capability:
+def capability() -> Capability:
     """The gripper capability (requires ``gripper``)."""
     cap = Capability(CAP, "Opens and closes the parallel gripper.", requires=(GRIPPER,))
 

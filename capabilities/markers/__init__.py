@@ -6,13 +6,7 @@ frame, and calibrates a camera's extrinsics from markers of known pose.
 
 from __future__ import annotations
 
-from capabilities.base import Capability
 from capabilities.markers.errors import MarkerError
-from capabilities.markers.operations import build_capability
+from capabilities.markers.operations import capability
 
 __all__ = ["MarkerError", "capability"]
-
-
-def capability() -> Capability:
-    """Entry point of the ``costar.capabilities`` group."""
-    return build_capability()

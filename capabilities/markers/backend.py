@@ -9,7 +9,7 @@ import numpy as np
 
 from engine.types import Pose
 
-__all__ = ["CameraDevice", "FrameLike", "MarkerLayout", "camera_interface"]
+__all__ = ["CameraDevice", "FrameLike", "MarkerLayout"]
 
 
 class FrameLike(Protocol):
@@ -37,8 +37,3 @@ class MarkerLayout(Protocol):
     """The cell's marker configuration (``scene_layout``): sizes and table markers."""
 
     def __getitem__(self, key: str) -> Mapping[int, Any]: ...
-
-
-def camera_interface(name: str) -> str:
-    """The interface name of a camera ("shoulder" -> "rgbd:shoulder")."""
-    return f"rgbd:{name}"

@@ -12,7 +12,8 @@ from collections.abc import Mapping
 from typing import Any
 
 from capabilities.base import Capability, CapabilityEnv
-from capabilities.markers.backend import CameraDevice, camera_interface
+from capabilities.kit import CAMERAS, camera, manifest, stateful
+from capabilities.markers.backend import CameraDevice
 from capabilities.markers.calibration import calibrate_extrinsics
 from capabilities.markers.depth import refine_with_depth
 from capabilities.markers.detection import (
@@ -28,16 +29,13 @@ from engine.operations import (
     OperationCall,
     OperationFailed,
     OperationKind,
-    OperationManifest,
     PortSpec,
-    StartResult,
 )
 from engine.types import ObjectModel, ParamType, Pose
 
-__all__ = ["build_capability"]
+__all__ = ["capability"]
 
 CAP = "markers"
-CAMERAS = ("shoulder", "wrist")
 # A detection whose pose is ambiguous (a marker seen almost face-on) is kept but trusted less.
 MIN_CONFIDENCE = 0.05
 
@@ -62,9 +60,7 @@ class _Env:
         self.library = env.interface("objects")
 
     def camera(self, name: str) -> CameraDevice:
-        if name not in CAMERAS:
-            raise OperationFailed(f"unknown camera {name!r}; cameras: {', '.join(CAMERAS)}")
-        return self.env.interface(camera_interface(name))
+        return camera(self.env, name)  # type: ignore[no-any-return]  # an interface is Any
 
     def markers_on_objects(self) -> dict[int, tuple[str, Pose]]:
         """marker id -> (object model name, marker pose in the object frame)."""
@@ -100,8 +96,8 @@ class DetectMarkers:
     def __init__(self, env: _Env) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
-        camera = self._env.camera(str(call.args["camera"]))
+    def start(self, call: OperationCall) -> Job:
+        camera = self._env.camera(call.input("camera"))
         env = self._env
 
         def look() -> dict[str, Any]:
@@ -129,13 +125,13 @@ class MarkerPose:
     def __init__(self, env: _Env) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
-        marker_id = int(call.args["marker_id"])
+    def start(self, call: OperationCall) -> Job:
+        marker_id = int(call.input("marker_id"))
         found = self._env.world.marker(marker_id)
         if found is None:
             raise OperationFailed(f"marker {marker_id} has not been seen")
         call.write("pose", found[0])
-        return True
+        return Job.done()
 
 
 def _best(env: _Env, model: Any) -> Detection | None:
@@ -147,20 +143,20 @@ class ObjectPose:
     def __init__(self, env: _Env) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
-        detection = _best(self._env, call.args["object"])
+    def start(self, call: OperationCall) -> Job:
+        detection = _best(self._env, call.input("object"))
         if detection is None:
-            raise OperationFailed(f"{call.args['object'].name} has not been seen")
+            raise OperationFailed(f"{call.input('object').name} has not been seen")
         call.write("pose", detection.pose)
-        return True
+        return Job.done()
 
 
 class ObjectFound:
     def __init__(self, env: _Env) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
-        return _best(self._env, call.args["object"]) is not None
+    def start(self, call: OperationCall) -> Job:
+        return Job.answer(_best(self._env, call.input("object")) is not None)
 
 
 class CalibrateCamera:
@@ -169,14 +165,14 @@ class CalibrateCamera:
     def __init__(self, env: _Env) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
-        camera = self._env.camera(str(call.args["camera"]))
+    def start(self, call: OperationCall) -> Job:
+        camera = self._env.camera(call.input("camera"))
         if camera.on_wrist:
             raise OperationFailed(
                 "the wrist camera is calibrated by hand-eye calibration, not here"
             )
         env = self._env
-        max_rms = float(call.args["max_error_px"])
+        max_rms = call.input("max_error_px")
 
         def calibrate() -> dict[str, Any]:
             frame = camera.capture()
@@ -196,39 +192,34 @@ class CalibrateCamera:
         return job
 
 
-def build_capability() -> Capability:
+def capability() -> Capability:
     cap = Capability(
         CAP,
         "Finds ArUco markers in camera images; object poses and camera calibration from them.",
         requires=("world", "workers", "scene_layout", "objects", "rgbd:shoulder"),
+        setup=_Env,  # the per-cell state: the interfaces every markers operation uses
     )
 
-    def op(op_id: str, kind: OperationKind, doc: str, *ports: PortSpec) -> OperationManifest:
-        return OperationManifest(f"{CAP}.{op_id}", kind, doc, CAP, ports)
-
-    def maker(cls: type) -> Any:
-        return lambda env: cls(_Env(env))
-
-    cap.add(op("detect_markers", OperationKind.ACTION,
+    cap.add(manifest(CAP, "detect_markers", OperationKind.ACTION,
                "Looks through a camera and remembers every marker and marked object it sees.",
                _camera_port(),
                PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="how many markers were seen")),
-            maker(DetectMarkers))  # fmt: skip
-    cap.add(op("marker_pose", OperationKind.QUERY, "The pose of a marker last seen.",
+            stateful(DetectMarkers))  # fmt: skip
+    cap.add(manifest(CAP, "marker_pose", OperationKind.QUERY, "The pose of a marker last seen.",
                PortSpec("marker_id", (ParamType.NUMBER,), doc="the marker's id"),
                PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where it is")),
-            maker(MarkerPose))  # fmt: skip
-    cap.add(op("object_pose", OperationKind.QUERY, "The pose of an object, from its marker.",
+            stateful(MarkerPose))  # fmt: skip
+    cap.add(manifest(CAP, "object_pose", OperationKind.QUERY, "The pose of an object, from its marker.",
                _object_port(),
                PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the object is")),
-            maker(ObjectPose))  # fmt: skip
-    cap.add(op("object_found", OperationKind.CONDITION, "True when the object's marker was seen.",
+            stateful(ObjectPose))  # fmt: skip
+    cap.add(manifest(CAP, "object_found", OperationKind.CONDITION, "True when the object's marker was seen.",
                _object_port()),
-            maker(ObjectFound))  # fmt: skip
-    cap.add(op("calibrate_camera", OperationKind.ACTION,
+            stateful(ObjectFound))  # fmt: skip
+    cap.add(manifest(CAP, "calibrate_camera", OperationKind.ACTION,
                "Finds a fixed camera's pose from the table markers of known pose.",
                _camera_port(),
                PortSpec("max_error_px", (ParamType.NUMBER,), default=1.5, unit="px",
                         doc="refuse a calibration worse than this")),
-            maker(CalibrateCamera))  # fmt: skip
+            stateful(CalibrateCamera))  # fmt: skip
     return cap

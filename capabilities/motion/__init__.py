@@ -2,12 +2,6 @@
 
 from __future__ import annotations
 
-from capabilities.base import Capability
-from capabilities.motion.operations import build_motion_capability
+from capabilities.motion.operations import capability
 
 __all__ = ["capability"]
-
-
-def capability() -> Capability:
-    """Entry point of the ``costar.capabilities`` group."""
-    return build_motion_capability()

@@ -8,47 +8,89 @@ the tick except :class:`OperationFailed`.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from typing import Any
 
 from capabilities.base import Capability, CapabilityEnv, CapabilityError
 from capabilities.jobs import job_from_handle
-from capabilities.motion import manifests as mf
+from capabilities.kit import manifest
 from capabilities.motion.backend import ARM, WORLD, ArmBackend, WorldBackend
 from capabilities.motion.geometry import format_pose_mm
 from capabilities.motion.symmetry import SymmetryTable
 from capabilities.motion.targets import TargetResolver
-from engine.operations import OperationCall, OperationFailed, StartResult
-from engine.types import JointConfig, Pose
+from engine.operations import (
+    Direction,
+    Job,
+    OperationCall,
+    OperationFailed,
+    OperationKind,
+    PortSpec,
+)
+from engine.types import JointConfig, ParamType, Pose
 
-__all__ = ["build_motion_capability", "scale"]
+__all__ = ["capability", "scale"]
+
+CAP = "motion"
+# Nominal speeds: the UR defaults of moveJ and moveL; the speed ports scale them.
+JOINT_SPEED = 1.05  # rad/s
+JOINT_ACCEL = 1.4  # rad/s^2
+LINEAR_SPEED = 0.25  # m/s
+LINEAR_ACCEL = 1.2  # m/s^2
+
+_N = (ParamType.NUMBER,)
+SPEED = PortSpec(
+    "speed", _N, default=1.0,
+    doc="fraction of the nominal speed (1.05 rad/s joint, 0.25 m/s linear), 0 to 2",
+)  # fmt: skip
+ACCEL = PortSpec(
+    "accel", _N, default=1.0,
+    doc="fraction of the nominal acceleration (1.4 rad/s^2 joint, 1.2 m/s^2 linear), 0 to 2",
+)  # fmt: skip
 
 _MAX_SCALE = 2.0
 
 
 def scale(call: OperationCall, port: str) -> float:
     """A speed or acceleration fraction from a port, checked to be in (0, 2]."""
-    value = call.args.get(port, 1.0)
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise OperationFailed(f"{port} must be a number, not {value!r}")
-    if not 0 < value <= _MAX_SCALE or not math.isfinite(value):
+    value: float = call.input(port)  # a Number (validation checked the type, not the range)
+    if not 0 < value <= _MAX_SCALE:
         raise OperationFailed(f"{port} must be above 0 and at most {_MAX_SCALE:g}, not {value}")
-    return float(value)
+    return value
 
 
 def _joint_move(arm: ArmBackend, q: Sequence[float], call: OperationCall, describe: str) -> Any:
     handle = arm.move_joints(
-        q, mf.JOINT_SPEED * scale(call, "speed"), mf.JOINT_ACCEL * scale(call, "accel")
+        q, JOINT_SPEED * scale(call, "speed"), JOINT_ACCEL * scale(call, "accel")
     )
     return job_from_handle(handle, describe)
 
 
 def _linear_move(arm: ArmBackend, pose: Pose, call: OperationCall, describe: str) -> Any:
     handle = arm.move_linear(
-        pose, mf.LINEAR_SPEED * scale(call, "speed"), mf.LINEAR_ACCEL * scale(call, "accel")
+        pose, LINEAR_SPEED * scale(call, "speed"), LINEAR_ACCEL * scale(call, "accel")
     )
     return job_from_handle(handle, describe)
+
+
+MOVE_TO = manifest(CAP, "move_to",
+    OperationKind.ACTION,
+    "Moves the tool to a pose or waypoint (relative waypoints follow the detected object).",
+    PortSpec(
+        "target", (ParamType.WAYPOINT, ParamType.POSE),
+        doc="where the tool goes (world pose, or a waypoint in any frame)",
+    ),
+    PortSpec(
+        "reference", (ParamType.POSE, ParamType.TEXT), default="",
+        doc="for a relative waypoint: the object's (marker's) pose, or a class name / marker id "
+        "to look up; empty: the waypoint's own reference in the world model",
+    ),
+    PortSpec(
+        "mode", (ParamType.TEXT,), default="joint", choices=("joint", "linear"),
+        doc="joint: fastest path in joint space; linear: a straight line of the tool",
+    ),
+    SPEED,
+    ACCEL,
+)  # fmt: skip
 
 
 class MoveTo:
@@ -58,12 +100,10 @@ class MoveTo:
         self._arm = arm
         self._resolver = resolver
 
-    def start(self, call: OperationCall) -> StartResult:
-        mode = str(call.args.get("mode", "joint"))
-        if mode not in ("joint", "linear"):
-            raise OperationFailed(f"mode must be 'joint' or 'linear', not {mode!r}")
+    def start(self, call: OperationCall) -> Job:
+        mode = call.input("mode")
         current = self._arm.tcp_pose()
-        target = self._resolver.resolve(call.args["target"], call.args.get("reference"), current)
+        target = self._resolver.resolve(call.input("target"), call.input("reference"), current)
         if target.joints is not None:
             return _joint_move(
                 self._arm, target.joints.positions, call, f"move to {target.describe}"
@@ -86,17 +126,41 @@ class MoveTo:
         )
 
 
+MOVE_JOINTS = manifest(
+    CAP,
+    "move_joints",
+    OperationKind.ACTION,
+    "Moves the arm to joint positions.",
+    PortSpec("target", (ParamType.JOINTS,), unit="rad", doc="joint positions, base to wrist"),
+    SPEED,
+    ACCEL,
+)
+
+
 class MoveJoints:
     """motion.move_joints: a joint move to a JointConfig."""
 
     def __init__(self, arm: ArmBackend) -> None:
         self._arm = arm
 
-    def start(self, call: OperationCall) -> StartResult:
-        target = call.args["target"]
-        if not isinstance(target, JointConfig):
-            raise OperationFailed(f"target must be joint positions, not {type(target).__name__}")
+    def start(self, call: OperationCall) -> Job:
+        target: JointConfig = call.input("target")
         return _joint_move(self._arm, target.positions, call, "move_joints")
+
+
+MOVE_RELATIVE = manifest(CAP, "move_relative",
+    OperationKind.ACTION,
+    "Moves the tool by an offset on a straight line.",
+    PortSpec("dx", _N, default=0.0, unit="m", doc="offset along x"),
+    PortSpec("dy", _N, default=0.0, unit="m", doc="offset along y"),
+    PortSpec("dz", _N, default=0.0, unit="m", doc="offset along z"),
+    PortSpec(
+        "frame", (ParamType.TEXT,), default="world", choices=("world", "tool"),
+        doc="axes of the offset: the world's or the tool's",
+    ),
+    SPEED,
+    ACCEL,
+)  # fmt: skip
 
 
 class MoveRelative:
@@ -105,21 +169,45 @@ class MoveRelative:
     def __init__(self, arm: ArmBackend) -> None:
         self._arm = arm
 
-    def start(self, call: OperationCall) -> StartResult:
-        offset = (float(call.args["dx"]), float(call.args["dy"]), float(call.args["dz"]))
-        frame = str(call.args.get("frame", "world"))
+    def start(self, call: OperationCall) -> Job:
+        offset = (call.input("dx"), call.input("dy"), call.input("dz"))
+        frame = call.input("frame")
         now = self._arm.tcp_pose()
         if frame == "world":
             x, y, z = now.position
             target = Pose((x + offset[0], y + offset[1], z + offset[2]), now.orientation)
-        elif frame == "tool":
+        else:  # "tool" (the port's choices)
             target = now.compose(Pose(offset))
-        else:
-            raise OperationFailed(f"frame must be 'world' or 'tool', not {frame!r}")
         if self._arm.inverse_kinematics(target) is None:
             raise OperationFailed(f"unreachable: pose {format_pose_mm(target)}")
         mm = ", ".join(f"{v * 1000:.1f}" for v in offset)
         return _linear_move(self._arm, target, call, f"move by ({mm}) mm in the {frame} frame")
+
+
+MOVE_RELATIVE_TOOL = manifest(
+    CAP, "move_relative_tool", OperationKind.ACTION,
+    "Moves the tool by an offset along its own axes, on a straight line.",
+    PortSpec("dz", _N, default=0.0, unit="m", doc="offset along the tool's z (its approach)"),
+    SPEED, ACCEL,
+)  # fmt: skip
+
+
+class MoveRelativeTool:
+    """motion.move_relative_tool: a straight-line move along the tool's own z axis."""
+
+    def __init__(self, arm: ArmBackend) -> None:
+        self._arm = arm
+
+    def start(self, call: OperationCall) -> Job:
+        target = self._arm.tcp_pose().compose(Pose((0.0, 0.0, call.input("dz"))))
+        if self._arm.inverse_kinematics(target) is None:
+            raise OperationFailed(f"unreachable: pose {format_pose_mm(target)}")
+        return _linear_move(self._arm, target, call, "move along the tool's z")
+
+
+GO_HOME = manifest(
+    CAP, "go_home", OperationKind.ACTION, "Moves the arm to its home joints.", SPEED, ACCEL
+)
 
 
 class GoHome:
@@ -128,8 +216,13 @@ class GoHome:
     def __init__(self, arm: ArmBackend) -> None:
         self._arm = arm
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         return _joint_move(self._arm, self._arm.home_joints(), call, "go home")
+
+
+STOP = manifest(
+    CAP, "stop", OperationKind.ACTION, "Stops any arm motion; succeeds once the arm stands."
+)
 
 
 class Stop:
@@ -138,8 +231,17 @@ class Stop:
     def __init__(self, arm: ArmBackend) -> None:
         self._arm = arm
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         return job_from_handle(self._arm.stop(), "stop")
+
+
+CURRENT_POSE = manifest(
+    CAP,
+    "current_pose",
+    OperationKind.QUERY,
+    "The tool's pose now (world frame).",
+    PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="the tool pose"),
+)
 
 
 class CurrentPose:
@@ -148,9 +250,18 @@ class CurrentPose:
     def __init__(self, arm: ArmBackend) -> None:
         self._arm = arm
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         call.write("pose", self._arm.tcp_pose())
-        return True
+        return Job.done()
+
+
+CURRENT_JOINTS = manifest(
+    CAP,
+    "current_joints",
+    OperationKind.QUERY,
+    "The arm's joint positions now.",
+    PortSpec("joints", (ParamType.JOINTS,), Direction.OUT, unit="rad", doc="joint positions"),
+)
 
 
 class CurrentJoints:
@@ -159,9 +270,15 @@ class CurrentJoints:
     def __init__(self, arm: ArmBackend) -> None:
         self._arm = arm
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         call.write("joints", JointConfig(self._arm.joint_positions()))
-        return True
+        return Job.done()
+
+
+IS_MOVING = manifest(CAP, "is_moving", OperationKind.CONDITION, "True while the arm moves.")
+IS_STOPPED = manifest(
+    CAP, "is_stopped", OperationKind.CONDITION, "True while the arm stands still."
+)
 
 
 class IsMoving:
@@ -171,8 +288,17 @@ class IsMoving:
         self._arm = arm
         self._negate = negate
 
-    def start(self, call: OperationCall) -> StartResult:
-        return self._arm.is_moving() != self._negate
+    def start(self, call: OperationCall) -> Job:
+        return Job.answer(self._arm.is_moving() != self._negate)
+
+
+IS_HOME = manifest(
+    CAP,
+    "is_home",
+    OperationKind.CONDITION,
+    "True when every joint is within a tolerance of the home position.",
+    PortSpec("tolerance", _N, default=0.01, unit="rad", doc="largest joint difference allowed"),
+)
 
 
 class IsHome:
@@ -181,10 +307,10 @@ class IsHome:
     def __init__(self, arm: ArmBackend) -> None:
         self._arm = arm
 
-    def start(self, call: OperationCall) -> StartResult:
-        tolerance = float(call.args.get("tolerance", 0.01))
+    def start(self, call: OperationCall) -> Job:
+        tolerance = call.input("tolerance")
         now, home = self._arm.joint_positions(), self._arm.home_joints()
-        return max(abs(a - b) for a, b in zip(now, home, strict=True)) <= tolerance
+        return Job.answer(max(abs(a - b) for a, b in zip(now, home, strict=True)) <= tolerance)
 
 
 def _world(env: CapabilityEnv) -> WorldBackend | None:
@@ -194,25 +320,23 @@ def _world(env: CapabilityEnv) -> WorldBackend | None:
         return None  # relative waypoints then need their reference bound
 
 
-def build_motion_capability(symmetries: SymmetryTable | None = None) -> Capability:
+def capability(symmetries: SymmetryTable | None = None) -> Capability:
     """The motion capability (requires ``arm``; reads ``world`` when the cell has one)."""
     table = symmetries if symmetries is not None else SymmetryTable()
-    cap = Capability(
-        mf.CAP, "Moves the robot arm: poses, waypoints, joints, home.", requires=(ARM,)
-    )
-    m = mf.MANIFESTS
+    cap = Capability(CAP, "Moves the robot arm: poses, waypoints, joints, home.", requires=(ARM,))
 
     def arm(env: CapabilityEnv) -> ArmBackend:
         return env.interface(ARM)
 
-    cap.add(m["move_to"], lambda env: MoveTo(arm(env), TargetResolver(_world(env), table)))
-    cap.add(m["move_joints"], lambda env: MoveJoints(arm(env)))
-    cap.add(m["move_relative"], lambda env: MoveRelative(arm(env)))
-    cap.add(m["go_home"], lambda env: GoHome(arm(env)))
-    cap.add(m["stop"], lambda env: Stop(arm(env)))
-    cap.add(m["current_pose"], lambda env: CurrentPose(arm(env)))
-    cap.add(m["current_joints"], lambda env: CurrentJoints(arm(env)))
-    cap.add(m["is_moving"], lambda env: IsMoving(arm(env)))
-    cap.add(m["is_stopped"], lambda env: IsMoving(arm(env), negate=True))
-    cap.add(m["is_home"], lambda env: IsHome(arm(env)))
+    cap.add(MOVE_TO, lambda env: MoveTo(arm(env), TargetResolver(_world(env), table)))
+    cap.add(MOVE_JOINTS, lambda env: MoveJoints(arm(env)))
+    cap.add(MOVE_RELATIVE, lambda env: MoveRelative(arm(env)))
+    cap.add(MOVE_RELATIVE_TOOL, lambda env: MoveRelativeTool(arm(env)))
+    cap.add(GO_HOME, lambda env: GoHome(arm(env)))
+    cap.add(STOP, lambda env: Stop(arm(env)))
+    cap.add(CURRENT_POSE, lambda env: CurrentPose(arm(env)))
+    cap.add(CURRENT_JOINTS, lambda env: CurrentJoints(arm(env)))
+    cap.add(IS_MOVING, lambda env: IsMoving(arm(env)))
+    cap.add(IS_STOPPED, lambda env: IsMoving(arm(env), negate=True))
+    cap.add(IS_HOME, lambda env: IsHome(arm(env)))
     return cap

@@ -6,12 +6,6 @@ body (capsules from its joint positions) never count as occupants.
 
 from __future__ import annotations
 
-from capabilities.base import Capability
-from capabilities.occupancy.operations import build_capability
+from capabilities.occupancy.operations import capability
 
 __all__ = ["capability"]
-
-
-def capability() -> Capability:
-    """Entry point of the ``costar.capabilities`` group."""
-    return build_capability()

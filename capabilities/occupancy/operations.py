@@ -15,23 +15,22 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from capabilities.base import Capability, CapabilityEnv
+from capabilities.base import Capability
+from capabilities.kit import CAMERAS, manifest
 from capabilities.occupancy.feed import CameraFeed, Capture
-from capabilities.occupancy.state import CAMERAS, OccupancyState, StateBook
+from capabilities.occupancy.state import SETTINGS, OccupancyState, setup
 from engine.operations import (
     Direction,
     Job,
     OperationCall,
-    OperationFailed,
     OperationKind,
-    OperationManifest,
     PortSpec,
     StartResult,
 )
 from engine.status import RUNNING, Status
 from engine.types import ParamType, Region
 
-__all__ = ["FeedJob", "build_capability"]
+__all__ = ["FeedJob", "capability"]
 
 CAP = "occupancy"
 
@@ -131,23 +130,42 @@ def _common_ports() -> tuple[PortSpec, ...]:
     )  # fmt: skip
 
 
+_MAX_AGE = PortSpec(
+    "max_age",
+    (ParamType.DURATION,),
+    default=1.0,
+    unit="s",
+    doc="answer from a frame up to this old; older: wait for a new one",
+)
+_TIMEOUT = PortSpec(
+    "timeout", (ParamType.DURATION,), default=10.0, unit="s", doc="fail after this long (cell time)"
+)
+_PERIOD = PortSpec("period", (ParamType.DURATION,), default=0.1, unit="s",
+                   doc="look again this often")  # fmt: skip
+
+
 class _Args:
-    """The common ports of a call, checked."""
+    """The common ports of a call (typed by the engine)."""
 
     def __init__(self, call: OperationCall) -> None:
-        region = call.args["region"]
-        if not isinstance(region, Region):
-            raise OperationFailed(f"region must be a Region, got {type(region).__name__}")
-        self.region = region
-        self.camera = str(call.args.get("camera", "shoulder"))
-        self.min_points = max(1, round(float(call.args.get("min_points", 30.0))))
-        self.mask_robot = bool(call.args.get("mask_robot", True))
+        self.region: Region = call.input("region")
+        self.camera: str = call.input("camera")
+        self.min_points = max(1, round(call.input("min_points")))
+        self.mask_robot: bool = call.input("mask_robot")
 
 
 def _region_text(region: Region) -> str:
     c = region.center
     return (f"region ({c[0] * 1000:.0f}, {c[1] * 1000:.0f}, {c[2] * 1000:.0f}) mm "
             f"r {region.radius * 1000:.0f} mm")  # fmt: skip
+
+
+IS_OCCUPIED = manifest(CAP, "is_occupied", OperationKind.CONDITION,
+                       "True when something (not the table, not the robot) is in the region.",
+                       *_common_ports(), _MAX_AGE)  # fmt: skip
+IS_EMPTY = manifest(CAP, "is_empty", OperationKind.CONDITION,
+                    "True when nothing (but the table or the robot) is in the region.",
+                    *_common_ports(), _MAX_AGE)  # fmt: skip
 
 
 class RegionCondition:
@@ -159,7 +177,7 @@ class RegionCondition:
 
     def start(self, call: OperationCall) -> StartResult:
         args = _Args(call)
-        max_age = float(call.args.get("max_age", 1.0))
+        max_age: float = call.input("max_age")
         state = self._state
         feed = state.feed(args.camera)
         want = self._want
@@ -173,6 +191,14 @@ class RegionCondition:
         return FeedJob(feed, state.clock, decide, state.clock() - max_age, state.refresh_period)
 
 
+WAIT_UNTIL_OCCUPIED = manifest(CAP, "wait_until_occupied", OperationKind.ACTION,
+                               "Waits until something is in the region; fails after the timeout.",
+                               *_common_ports(), _TIMEOUT, _PERIOD)  # fmt: skip
+WAIT_UNTIL_EMPTY = manifest(CAP, "wait_until_empty", OperationKind.ACTION,
+                            "Waits until the region is clear; fails after the timeout.",
+                            *_common_ports(), _TIMEOUT, _PERIOD)  # fmt: skip
+
+
 class WaitForRegion:
     """``wait_until_occupied`` / ``wait_until_empty``: poll frames until it turns so."""
 
@@ -182,8 +208,8 @@ class WaitForRegion:
 
     def start(self, call: OperationCall) -> StartResult:
         args = _Args(call)
-        timeout = float(call.args.get("timeout", 10.0))
-        period = max(0.0, float(call.args.get("period", 0.1)))
+        timeout: float = call.input("timeout")
+        period: float = call.input("period")
         state = self._state
         feed = state.feed(args.camera)
         want, now = self._want, state.clock()
@@ -207,6 +233,13 @@ class WaitForRegion:
         return job
 
 
+COUNT_POINTS = manifest(CAP, "count_points", OperationKind.QUERY,
+                        "How many points of a fresh frame are in the region (table and robot left out).",
+                        *_common_ports(),
+                        PortSpec("count", (ParamType.NUMBER,), Direction.OUT,
+                                 doc="the occupant points counted"))  # fmt: skip
+
+
 class CountPoints:
     """``count_points``: a fresh frame's occupant points in the region."""
 
@@ -226,52 +259,18 @@ class CountPoints:
         return FeedJob(feed, state.clock, decide, state.clock(), 0.0)
 
 
-def build_capability() -> Capability:
+def capability() -> Capability:
+    """The occupancy capability; its per-cell state comes from ``state.setup``."""
     cap = Capability(
         CAP,
         "Whether a sphere of space is occupied, from the depth cameras' point clouds.",
         requires=("workers", "arm", "rgbd:shoulder"),
+        settings=SETTINGS,
+        setup=setup,
     )
-    book = StateBook()
-
-    def op(op_id: str, kind: OperationKind, doc: str, *ports: PortSpec) -> OperationManifest:
-        return OperationManifest(f"{CAP}.{op_id}", kind, doc, CAP, ports)
-
-    def make(cls: type, *extra: Any) -> Callable[[CapabilityEnv], Any]:
-        return lambda env: cls(book.get(env), *extra)
-
-    max_age = PortSpec(
-        "max_age",
-        (ParamType.DURATION,),
-        default=1.0,
-        unit="s",
-        doc="answer from a frame up to this old; older: wait for a new one",
-    )
-    timeout = PortSpec(
-        "timeout",
-        (ParamType.DURATION,),
-        default=10.0,
-        unit="s",
-        doc="fail after this long (cell time)",
-    )
-    period = PortSpec("period", (ParamType.DURATION,), default=0.1, unit="s",
-                      doc="look again this often")  # fmt: skip
-    cap.add(op("is_occupied", OperationKind.CONDITION,
-               "True when something (not the table, not the robot) is in the region.",
-               *_common_ports(), max_age), make(RegionCondition, True))  # fmt: skip
-    cap.add(op("is_empty", OperationKind.CONDITION,
-               "True when nothing (but the table or the robot) is in the region.",
-               *_common_ports(), max_age), make(RegionCondition, False))  # fmt: skip
-    cap.add(op("wait_until_occupied", OperationKind.ACTION,
-               "Waits until something is in the region; fails after the timeout.",
-               *_common_ports(), timeout, period), make(WaitForRegion, True))  # fmt: skip
-    cap.add(op("wait_until_empty", OperationKind.ACTION,
-               "Waits until the region is clear; fails after the timeout.",
-               *_common_ports(), timeout, period), make(WaitForRegion, False))  # fmt: skip
-    cap.add(op("count_points", OperationKind.QUERY,
-               "How many points of a fresh frame are in the region (table and robot left out).",
-               *_common_ports(),
-               PortSpec("count", (ParamType.NUMBER,), Direction.OUT,
-                        doc="the occupant points counted")),
-            make(CountPoints))  # fmt: skip
+    cap.add(IS_OCCUPIED, lambda env: RegionCondition(env.state, True))
+    cap.add(IS_EMPTY, lambda env: RegionCondition(env.state, False))
+    cap.add(WAIT_UNTIL_OCCUPIED, lambda env: WaitForRegion(env.state, True))
+    cap.add(WAIT_UNTIL_EMPTY, lambda env: WaitForRegion(env.state, False))
+    cap.add(COUNT_POINTS, lambda env: CountPoints(env.state))
     return cap

@@ -1,29 +1,21 @@
 """What the occupancy operations of one cell share: camera feeds, the table, the robot body.
 
-One :class:`OccupancyState` per cell (kept by the capability instance, never a module
-global): every occupancy node of a plan reads the same latest frame of a camera, so two
-conditions on one camera do not render twice.
-
-Settings (``CapabilityRegistry(settings={"occupancy": {...}})``):
-    table_z: height (m) of the table top; without it the table plane is found in the frames
-        of a fixed camera (the fullest horizontal slice of points).
-    table_margin: points this close (m) to the table plane are the table (default 0.008).
-    robot_base: world Pose of the robot's base frame (default: worked out from the arm).
-    mask_inflate: how much (m) the robot's capsules grow when masking (default 0.02).
-    tool_radius: radius (m) of the tool's capsule (default 0.07, the parallel gripper).
-    refresh_period: a frame older than this (s of cell time) is renewed (default 0.1).
+One :class:`OccupancyState` per cell, made by the capability's ``setup`` hook: every
+occupancy node of a plan reads the same latest frame of a camera, so two conditions on one
+camera do not render twice. Its settings (:data:`SETTINGS`) come from the cell file's
+``capabilities.occupancy`` block.
 """
 
 from __future__ import annotations
 
 import threading
-import weakref
-from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
-from capabilities.base import CapabilityEnv, CapabilityError
+from capabilities import kit
+from capabilities.base import CapabilityEnv
+from capabilities.kit import Setting
 from capabilities.occupancy.feed import CameraFeed, Capture
 from capabilities.occupancy.region import RegionReading, estimate_table_z, read_region
 from capabilities.robot_body import (
@@ -36,9 +28,17 @@ from capabilities.robot_body import (
 from engine.operations import OperationFailed
 from engine.types import Pose, Region
 
-__all__ = ["CAMERAS", "OccupancyState", "StateBook"]
+__all__ = ["SETTINGS", "OccupancyState", "setup"]
 
-CAMERAS = ("shoulder", "wrist")
+SETTINGS = (
+    Setting("table_z", float, None, "height (m) of the table top; without it the table plane "
+            "is found in the frames of a fixed camera (the fullest horizontal slice)"),
+    Setting("table_margin", float, 0.008, "points this close (m) to the table plane are the table"),
+    Setting("robot_base", Pose, None, "world pose of the robot's base frame (default: from the arm)"),
+    Setting("mask_inflate", float, 0.02, "how much (m) the robot's capsules grow when masking"),
+    Setting("tool_radius", float, 0.07, "radius (m) of the tool's capsule (the parallel gripper)"),
+    Setting("refresh_period", float, 0.1, "a frame older than this (s of cell time) is renewed"),
+)  # fmt: skip
 
 
 class OccupancyState:
@@ -46,15 +46,15 @@ class OccupancyState:
 
     def __init__(self, env: CapabilityEnv) -> None:
         self._env = env
-        settings: Mapping[str, Any] = env.settings
+        settings = env.settings  # checked against SETTINGS: typed, defaults filled in
         self.workers = env.interface("workers")
         self.arm = env.cell.interfaces().get("arm")
-        self.table_z_setting: float | None = _number(settings.get("table_z"))
-        self.table_margin = _number(settings.get("table_margin")) or 0.008
-        self.mask_inflate = _number(settings.get("mask_inflate")) or 0.02
-        self.tool_radius = _number(settings.get("tool_radius")) or 0.07
-        self.refresh_period = _number(settings.get("refresh_period")) or 0.1
-        self._base_setting = settings.get("robot_base")
+        self.table_z_setting: float | None = settings["table_z"]
+        self.table_margin: float = settings["table_margin"]
+        self.mask_inflate: float = settings["mask_inflate"]
+        self.tool_radius: float = settings["tool_radius"]
+        self.refresh_period: float = settings["refresh_period"]
+        self._base_setting: Pose | None = settings["robot_base"]
         self._lock = threading.Lock()
         self._feeds: dict[str, CameraFeed] = {}
         self._body: RobotBody | None = None
@@ -65,15 +65,10 @@ class OccupancyState:
         return self._env.cell.clock()
 
     def feed(self, camera: str) -> CameraFeed:
-        """The feed of a camera ("shoulder" or "wrist"); raises OperationFailed if unknown."""
-        if camera not in CAMERAS:
-            raise OperationFailed(f"unknown camera {camera!r}; cameras: {', '.join(CAMERAS)}")
+        """The feed of a camera ("shoulder" or "wrist"); raises OperationFailed if missing."""
         with self._lock:
             if camera not in self._feeds:
-                try:
-                    device = self._env.interface(f"rgbd:{camera}")
-                except CapabilityError as exc:
-                    raise OperationFailed(str(exc)) from exc
+                device = kit.camera(self._env, camera)
                 reader = self._read_robot if self.arm is not None else None
                 self._feeds[camera] = CameraFeed(device, self.workers, reader)
             return self._feeds[camera]
@@ -134,25 +129,6 @@ class OccupancyState:
         return read_region(capture.points, region, self.table_z(capture), self.table_margin, mask)
 
 
-class StateBook:
-    """One OccupancyState per cell, for the life of the cell (held by the capability)."""
-
-    def __init__(self) -> None:
-        self._lock = threading.Lock()
-        self._states: weakref.WeakKeyDictionary[Any, OccupancyState] = weakref.WeakKeyDictionary()
-
-    def get(self, env: CapabilityEnv) -> OccupancyState:
-        with self._lock:
-            try:
-                state = self._states.get(env.cell)
-                if state is None:
-                    state = self._states[env.cell] = OccupancyState(env)
-            except TypeError:  # a cell that cannot be weakly referenced shares nothing
-                state = OccupancyState(env)
-            return state
-
-
-def _number(value: Any) -> float | None:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return None
-    return float(value)
+def setup(env: CapabilityEnv) -> OccupancyState:
+    """The capability's per-cell hook: the state all occupancy operations of a cell share."""
+    return OccupancyState(env)

@@ -8,13 +8,7 @@ world model.
 
 from __future__ import annotations
 
-from capabilities.base import Capability
 from capabilities.perception.errors import PerceptionError
-from capabilities.perception.operations import build_capability
+from capabilities.perception.operations import capability
 
 __all__ = ["PerceptionError", "capability"]
-
-
-def capability() -> Capability:
-    """Entry point of the ``costar.capabilities`` group."""
-    return build_capability()

@@ -1,7 +1,7 @@
 """Settings of model-based recognition (SI units), with defaults for the default cell.
 
-A cell configures them through the capability's settings (``CapabilityRegistry(settings=
-{"perception": {...}})``); every key of :class:`RecognitionConfig` may be given there.
+A cell configures them in its file's ``capabilities.perception`` block; every field of
+:class:`RecognitionConfig` is a setting (:data:`SETTINGS`).
 """
 
 from __future__ import annotations
@@ -11,9 +11,9 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from capabilities.perception.errors import PerceptionError
+from capabilities.kit import Setting
 
-__all__ = ["RecognitionConfig"]
+__all__ = ["SETTINGS", "RecognitionConfig"]
 
 
 @dataclass(frozen=True)
@@ -59,20 +59,17 @@ class RecognitionConfig:
 
     @classmethod
     def from_settings(cls, settings: Mapping[str, Any]) -> RecognitionConfig:
-        """The defaults overridden by the keys of ``settings`` that name a field."""
-        names = {f.name: f for f in dataclasses.fields(cls)}
-        values: dict[str, Any] = {}
-        for key, value in settings.items():
-            if key not in names:
-                continue
-            default = getattr(cls(), key)
-            if isinstance(default, tuple):
-                if not isinstance(value, (list, tuple)) or len(value) != len(default):
-                    raise PerceptionError(f"perception setting {key!r}: expected 3 numbers")
-                value = tuple(float(v) for v in value)
-            elif isinstance(default, bool):
-                value = bool(value)
-            elif isinstance(default, (int, float)):
-                value = type(default)(value)
-            values[key] = value
-        return dataclasses.replace(cls(), **values)
+        """The configuration from the capability's checked settings (see :data:`SETTINGS`)."""
+        names = {f.name for f in dataclasses.fields(cls)}
+        return dataclasses.replace(cls(), **{k: v for k, v in settings.items() if k in names})
+
+
+def _setting(field: dataclasses.Field[Any]) -> Setting:
+    default = field.default
+    if isinstance(default, tuple):
+        return Setting(field.name, tuple, default, "see RecognitionConfig", len(default))
+    return Setting(field.name, type(default), default, "see RecognitionConfig")
+
+
+SETTINGS = tuple(_setting(f) for f in dataclasses.fields(RecognitionConfig))
+"""The perception capability's settings: every field of :class:`RecognitionConfig`."""

@@ -18,7 +18,8 @@ import weakref
 from typing import Any
 
 from capabilities.base import Capability, CapabilityEnv
-from capabilities.perception.config import RecognitionConfig
+from capabilities.kit import CAMERAS, camera, manifest, stateful
+from capabilities.perception.config import SETTINGS, RecognitionConfig
 from capabilities.perception.errors import PerceptionError
 from capabilities.perception.recognizer import Recognizer
 from capabilities.perception.tracker import SurfaceTracker
@@ -29,16 +30,13 @@ from engine.operations import (
     OperationCall,
     OperationFailed,
     OperationKind,
-    OperationManifest,
     PortSpec,
-    StartResult,
 )
 from engine.types import ObjectModel, ParamType, Pose
 
-__all__ = ["SOURCE_PREFIX", "build_capability"]
+__all__ = ["SOURCE_PREFIX", "capability"]
 
 CAP = "perception"
-CAMERAS = ("shoulder", "wrist")
 SOURCE_PREFIX = "perception:"
 
 
@@ -78,18 +76,10 @@ class _Env:
         self.world: WorldModel = env.interface("world")
         self.workers = env.interface("workers")
         self.library = env.interface("objects")
-        try:
-            self.config = RecognitionConfig.from_settings(env.settings)
-        except PerceptionError as exc:
-            raise OperationFailed(str(exc)) from exc
+        self.config = RecognitionConfig.from_settings(env.settings)
 
     def camera(self, name: str) -> Any:
-        if name not in CAMERAS:
-            raise OperationFailed(f"unknown camera {name!r}; cameras: {', '.join(CAMERAS)}")
-        interfaces = self.env.cell.interfaces()
-        if f"rgbd:{name}" not in interfaces:
-            raise OperationFailed(f"the {self.env.cell.name} cell has no {name} camera")
-        return interfaces[f"rgbd:{name}"]
+        return camera(self.env, name)
 
     def seen(self, model: Any) -> list[Detection]:
         """Current perception detections of a class, best first."""
@@ -101,9 +91,9 @@ class DetectObjects:
     def __init__(self, env: _Env) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         env = self._env
-        camera = env.camera(str(call.args["camera"]))
+        camera = env.camera(call.input("camera"))
         recognizer = env.shared.recognizer(env.library, env.config)
         tracker = env.shared.tracker(env.world, camera.name, env.library)
         source = f"{SOURCE_PREFIX}{camera.name}"
@@ -134,40 +124,40 @@ class ObjectFound:
     def __init__(self, env: _Env) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
-        return bool(self._env.seen(call.args["object"]))
+    def start(self, call: OperationCall) -> Job:
+        return Job.answer(bool(self._env.seen(call.input("object"))))
 
 
 class ObjectPose:
     def __init__(self, env: _Env) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
-        seen = self._env.seen(call.args["object"])
+    def start(self, call: OperationCall) -> Job:
+        seen = self._env.seen(call.input("object"))
         if not seen:
-            raise OperationFailed(f"{_name(call.args['object'])} has not been seen")
+            raise OperationFailed(f"{_name(call.input('object'))} has not been seen")
         call.write("pose", seen[0].pose)
-        return True
+        return Job.done()
 
 
 class ObjectsOfClass:
     def __init__(self, env: _Env) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
-        seen = self._env.seen(call.args["object"])
+    def start(self, call: OperationCall) -> Job:
+        seen = self._env.seen(call.input("object"))
         call.write("count", float(len(seen)))
         call.write("poses", [d.pose for d in seen])
-        return True
+        return Job.done()
 
 
 class PlateType:
     def __init__(self, env: _Env) -> None:
         self._env = env
 
-    def start(self, call: OperationCall) -> StartResult:
-        near: Pose = call.args["near"]
-        within = float(call.args["within"])
+    def start(self, call: OperationCall) -> Job:
+        near: Pose = call.input("near")
+        within = call.input("within")
         plates = [
             d
             for name in self._env.library.names()
@@ -179,7 +169,7 @@ class PlateType:
             raise OperationFailed(f"no plate seen within {within:g} m of {near.position}")
         call.write("model", ObjectModel(ranked[0].object_class))
         call.write("pose", ranked[0].pose)
-        return True
+        return Job.done()
 
 
 def _name(model: Any) -> str:
@@ -190,43 +180,38 @@ def _object_port() -> PortSpec:
     return PortSpec("object", (ParamType.OBJECT,), doc="the object class (a model name)")
 
 
-def build_capability() -> Capability:
+def capability() -> Capability:
     cap = Capability(
         CAP,
         "Recognises the library's objects on the table in RGB-D point clouds; plate types.",
         requires=("world", "workers", "objects", "rgbd:shoulder"),
+        settings=SETTINGS,
+        setup=lambda env: _Env(env, _Shared()),
     )
-    shared = _Shared()
 
-    def op(op_id: str, kind: OperationKind, doc: str, *ports: PortSpec) -> OperationManifest:
-        return OperationManifest(f"{CAP}.{op_id}", kind, doc, CAP, ports)
-
-    def maker(cls: type) -> Any:
-        return lambda env: cls(_Env(env, shared))
-
-    cap.add(op("detect_objects", OperationKind.ACTION,
+    cap.add(manifest(CAP, "detect_objects", OperationKind.ACTION,
                "Looks through a camera and recognises the known objects on the table "
                "(point cloud matched to the object models).",
                PortSpec("camera", (ParamType.TEXT,), default="shoulder", doc="which camera looks",
                         choices=CAMERAS),
                PortSpec("count", (ParamType.NUMBER,), Direction.OUT,
                         doc="how many objects were recognised")),
-            maker(DetectObjects))  # fmt: skip
-    cap.add(op("object_found", OperationKind.CONDITION,
+            stateful(DetectObjects))  # fmt: skip
+    cap.add(manifest(CAP, "object_found", OperationKind.CONDITION,
                "True when the last look recognised an object of this class.", _object_port()),
-            maker(ObjectFound))  # fmt: skip
-    cap.add(op("object_pose", OperationKind.QUERY,
+            stateful(ObjectFound))  # fmt: skip
+    cap.add(manifest(CAP, "object_pose", OperationKind.QUERY,
                "The pose of the most confidently recognised object of a class.", _object_port(),
                PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the object is")),
-            maker(ObjectPose))  # fmt: skip
-    cap.add(op("objects_of_class", OperationKind.QUERY,
+            stateful(ObjectPose))  # fmt: skip
+    cap.add(manifest(CAP, "objects_of_class", OperationKind.QUERY,
                "How many objects of a class the last look recognised, and their poses.",
                _object_port(),
                PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="how many"),
                PortSpec("poses", (ParamType.ANY,), Direction.OUT,
                         doc="their poses, most confident first")),
-            maker(ObjectsOfClass))  # fmt: skip
-    cap.add(op("plate_type", OperationKind.QUERY,
+            stateful(ObjectsOfClass))  # fmt: skip
+    cap.add(manifest(CAP, "plate_type", OperationKind.QUERY,
                "Which plate (by its holes) lies nearest to a pose.",
                PortSpec("near", (ParamType.POSE,), default=Pose(),
                         doc="the plate nearest this pose (default: nearest the robot base)"),
@@ -234,5 +219,5 @@ def build_capability() -> Capability:
                         doc="fail when the nearest plate is farther than this"),
                PortSpec("model", (ParamType.OBJECT,), Direction.OUT, doc="the plate's model"),
                PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the plate is")),
-            maker(PlateType))  # fmt: skip
+            stateful(PlateType))  # fmt: skip
     return cap

@@ -7,13 +7,7 @@ between the tool and an object, computed in a private pybullet client.
 
 from __future__ import annotations
 
-from capabilities.base import Capability
 from capabilities.predicates.collision import PredicateError
-from capabilities.predicates.operations import build_capability
+from capabilities.predicates.operations import capability
 
 __all__ = ["PredicateError", "capability"]
-
-
-def capability() -> Capability:
-    """Entry point of the ``costar.capabilities`` group."""
-    return build_capability()

@@ -15,6 +15,7 @@ import math
 import threading
 from typing import Any
 
+from capabilities.errors import CapabilityError
 from engine.types import Pose
 
 __all__ = ["CollisionWorld", "PredicateError", "TOOL"]
@@ -23,7 +24,7 @@ TOOL = "__tool__"
 _FAR = 1.0  # m: distances beyond this are reported as infinity
 
 
-class PredicateError(Exception):
+class PredicateError(CapabilityError):
     """A predicate cannot be evaluated (an unknown model, a missing interface)."""
 
 

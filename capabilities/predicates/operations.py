@@ -11,22 +11,24 @@ import math
 from collections.abc import Callable
 from typing import Any
 
-from capabilities.base import Capability, CapabilityEnv
+from capabilities.base import Capability
+from capabilities.kit import manifest, stateful
 from capabilities.predicates.collision import TOOL, PredicateError
 from capabilities.predicates.geometry import DIRECTIONS, box_center, offset_in_frame
-from capabilities.predicates.state import PredicatesState, StateBook
+from capabilities.predicates.state import SETTINGS, PredicatesState, setup
 from engine.operations import (
     Job,
     OperationCall,
     OperationFailed,
     OperationKind,
-    OperationManifest,
     PortSpec,
     StartResult,
 )
 from engine.types import ObjectModel, ParamType, Pose
 
-__all__ = ["build_capability"]
+__all__ = ["capability"]
+
+CONDITION = OperationKind.CONDITION
 
 CAP = "predicates"
 FRAMES = ("world", "robot", "object_b")
@@ -56,6 +58,32 @@ def _guarded(fn: Callable[[OperationCall], Job]) -> Callable[[OperationCall], St
     return start
 
 
+def _object_port(name: str, doc: str) -> PortSpec:
+    return PortSpec(name, (ParamType.OBJECT,), doc=doc)
+
+
+_PAIR = (_object_port("object_a", "the object the predicate is about"),
+         _object_port("object_b", "the object it is compared with"))  # fmt: skip
+_ONE = _object_port("object", "the object")
+_FRAME = PortSpec(
+    "frame",
+    (ParamType.TEXT,),
+    default="world",
+    choices=FRAMES,
+    doc="directions along the world's, the robot base's or object_b's axes",
+)
+_MARGIN = PortSpec("margin", (ParamType.NUMBER,), default=0.01, unit="m",
+                   doc="by more than this (a tie under sensor noise is neither)")  # fmt: skip
+
+RELATIONS = {
+    relation: manifest(CAP, relation, CONDITION,
+                       f"True when object_a is {relation.replace('_', ' ')} object_b (centres, "
+                       "along the frame's axes: front +x, left +y, up +z).",
+                       *_PAIR, _FRAME, _MARGIN)
+    for relation in DIRECTIONS
+}  # fmt: skip
+
+
 class Relation:
     """``left_of``, ``right_of``, ``in_front_of``, ``behind``, ``up_from``, ``down_from``."""
 
@@ -67,10 +95,10 @@ class Relation:
     def _start(self, call: OperationCall) -> Job:
         state = self._state
         state.sample()
-        a, b = state.best(call.args["object_a"]), state.best(call.args["object_b"])
-        frame_name = str(call.args.get("frame", "world"))
+        a, b = state.best(call.input("object_a")), state.best(call.input("object_b"))
+        frame_name: str = call.input("frame")
         frame = self._frame(frame_name, b.pose)
-        margin = float(call.args.get("margin", 0.0))
+        margin: float = call.input("margin")
         offset = offset_in_frame(
             box_center(a.pose, state.height(a.object_class)),
             box_center(b.pose, state.height(b.object_class)),
@@ -95,6 +123,30 @@ class Relation:
         raise PredicateError(f"unknown frame {name!r}; frames: {', '.join(FRAMES)}")
 
 
+_WINDOW = PortSpec(
+    "window",
+    (ParamType.DURATION,),
+    default=0.5,
+    unit="s",
+    doc="judge the detections of this last stretch of time",
+)
+_SPEED = PortSpec(
+    "speed", (ParamType.NUMBER,), default=0.02, unit="m/s", doc="faster than this is moving"
+)
+IS_MOVING = manifest(
+    CAP,
+    "is_moving",
+    CONDITION,
+    "True when the object's detections moved faster than the speed.",
+    _ONE,
+    _WINDOW,
+    _SPEED,
+)
+IS_STATIONARY = manifest(CAP, "is_stationary", CONDITION,
+                         "True when the object's detections stayed (slower than the speed); "
+                         "false when too few were seen.", _ONE, _WINDOW, _SPEED)  # fmt: skip
+
+
 class Moving:
     """``is_moving`` (want True) or ``is_stationary`` (want False) over a time window."""
 
@@ -106,9 +158,9 @@ class Moving:
     def _start(self, call: OperationCall) -> Job:
         state = self._state
         state.sample()
-        name = _name(call.args["object"])
-        window = float(call.args.get("window", 0.5))
-        threshold = float(call.args.get("speed", 0.02))
+        name = _name(call.input("object"))
+        window: float = call.input("window")
+        threshold: float = call.input("speed")
         motion = state.track(name).motion(call.clock() - window)
         if motion.samples < 2 or motion.span < window / 4:
             return _verdict(False, f"{name}: {motion.samples} detection(s) in the last "
@@ -117,6 +169,49 @@ class Moving:
         text = (f"{name} moves at {motion.speed * 1000:.0f} mm/s over {motion.samples} "
                 f"detections in {motion.span:.2f} s (threshold {threshold * 1000:.0f} mm/s)")  # fmt: skip
         return _verdict(moving == self._want, text)
+
+
+_TOLERANCE = PortSpec(
+    "tolerance",
+    (ParamType.NUMBER,),
+    default=0.003,
+    unit="m",
+    doc="surfaces this close count as touching",
+)
+_DISTANCE = PortSpec(
+    "distance",
+    (ParamType.NUMBER,),
+    default=0.03,
+    unit="m",
+    doc="surfaces this close are a near collision",
+)
+TOUCHING = manifest(
+    CAP,
+    "touching",
+    CONDITION,
+    "True when the two objects' shapes touch or overlap.",
+    *_PAIR,
+    _TOLERANCE,
+)
+NEAR_COLLISION = manifest(
+    CAP,
+    "near_collision",
+    CONDITION,
+    "True when the two objects' shapes are closer than the distance (touching included).",
+    *_PAIR,
+    _DISTANCE,
+)
+TOOL_TOUCHING = manifest(
+    CAP,
+    "tool_touching",
+    CONDITION,
+    "True when the tool touches or overlaps the object.",
+    _ONE,
+    _TOLERANCE,
+)
+TOOL_NEAR_COLLISION = manifest(CAP, "tool_near_collision", CONDITION,
+                               "True when the tool is closer to the object than the distance "
+                               "(touching included).", _ONE, _DISTANCE)  # fmt: skip
 
 
 class Contact:
@@ -131,13 +226,13 @@ class Contact:
     def _start(self, call: OperationCall) -> Job:
         state = self._state
         state.sample()
-        limit = float(call.args.get(self._port, 0.0))
+        limit: float = call.input(self._port)
         if self._tool:
-            b = state.best(call.args["object"])
+            b = state.best(call.input("object"))
             first, second = (TOOL, state.tool_pose()), (b.object_class, b.pose)
             label = f"the tool and {b.object_class}"
         else:
-            a, b = state.best(call.args["object_a"]), state.best(call.args["object_b"])
+            a, b = state.best(call.input("object_a")), state.best(call.input("object_b"))
             if a is b:
                 raise PredicateError(f"object_a and object_b are both {a.object_class}")
             first, second = (a.object_class, a.pose), (b.object_class, b.pose)
@@ -149,72 +244,21 @@ class Contact:
                                       f"({word} at {limit * 1000:.1f} mm or less)")  # fmt: skip
 
 
-def _object_port(name: str, doc: str) -> PortSpec:
-    return PortSpec(name, (ParamType.OBJECT,), doc=doc)
-
-
-def build_capability() -> Capability:
+def capability() -> Capability:
+    """The predicates capability; its per-cell state comes from ``state.setup``."""
     cap = Capability(
         CAP,
         "Predicates about objects: where they are relative to each other, motion, contact.",
         requires=("world", "objects"),
+        settings=SETTINGS,
+        setup=setup,
     )
-    book = StateBook()
-
-    def op(op_id: str, doc: str, *ports: PortSpec) -> OperationManifest:
-        return OperationManifest(f"{CAP}.{op_id}", OperationKind.CONDITION, doc, CAP, ports)
-
-    def make(cls: type, *extra: Any) -> Callable[[CapabilityEnv], Any]:
-        return lambda env: cls(book.get(env), *extra)
-
-    pair = (_object_port("object_a", "the object the predicate is about"),
-            _object_port("object_b", "the object it is compared with"))  # fmt: skip
-    frame = PortSpec(
-        "frame",
-        (ParamType.TEXT,),
-        default="world",
-        choices=FRAMES,
-        doc="directions along the world's, the robot base's or object_b's axes",
-    )
-    margin = PortSpec("margin", (ParamType.NUMBER,), default=0.01, unit="m",
-                      doc="by more than this (a tie under sensor noise is neither)")  # fmt: skip
-    for relation in DIRECTIONS:
-        words = relation.replace("_", " ")
-        cap.add(op(relation, f"True when object_a is {words} object_b (centres, along the "
-                             "frame's axes: front +x, left +y, up +z).",
-                   *pair, frame, margin), make(Relation, relation))  # fmt: skip
-    one = _object_port("object", "the object")
-    window = PortSpec(
-        "window",
-        (ParamType.DURATION,),
-        default=0.5,
-        unit="s",
-        doc="judge the detections of this last stretch of time",
-    )
-    speed = PortSpec("speed", (ParamType.NUMBER,), default=0.02, unit="m/s",
-                     doc="faster than this is moving")  # fmt: skip
-    cap.add(op("is_moving", "True when the object's detections moved faster than the speed.",
-               one, window, speed), make(Moving, True))  # fmt: skip
-    cap.add(op("is_stationary", "True when the object's detections stayed (slower than the "
-               "speed); false when too few were seen.", one, window, speed),
-            make(Moving, False))  # fmt: skip
-    tolerance = PortSpec(
-        "tolerance",
-        (ParamType.NUMBER,),
-        default=0.003,
-        unit="m",
-        doc="surfaces this close count as touching",
-    )
-    distance = PortSpec("distance", (ParamType.NUMBER,), default=0.03, unit="m",
-                        doc="surfaces this close are a near collision")  # fmt: skip
-    cap.add(op("touching", "True when the two objects' shapes touch or overlap.",
-               *pair, tolerance), make(Contact, "tolerance", False))  # fmt: skip
-    cap.add(op("near_collision", "True when the two objects' shapes are closer than the "
-               "distance (touching included).", *pair, distance),
-            make(Contact, "distance", False))  # fmt: skip
-    cap.add(op("tool_touching", "True when the tool touches or overlaps the object.",
-               one, tolerance), make(Contact, "tolerance", True))  # fmt: skip
-    cap.add(op("tool_near_collision", "True when the tool is closer to the object than the "
-               "distance (touching included).", one, distance),
-            make(Contact, "distance", True))  # fmt: skip
+    for relation, made in RELATIONS.items():
+        cap.add(made, stateful(Relation, relation))
+    cap.add(IS_MOVING, stateful(Moving, True))
+    cap.add(IS_STATIONARY, stateful(Moving, False))
+    cap.add(TOUCHING, stateful(Contact, "tolerance", False))
+    cap.add(NEAR_COLLISION, stateful(Contact, "distance", False))
+    cap.add(TOOL_TOUCHING, stateful(Contact, "tolerance", True))
+    cap.add(TOOL_NEAR_COLLISION, stateful(Contact, "distance", True))
     return cap

@@ -1,40 +1,43 @@
 """What the predicates of one cell share: pose histories and the private collision world.
 
-Settings (``CapabilityRegistry(settings={"predicates": {...}})``):
-    robot_base: world Pose of the robot's base frame (default: worked out from the arm).
-    tool_size: full size (m) of the tool's box (default 0.06 x 0.12 x 0.16, the gripper).
-    tool_center: the tool box's centre in the TCP frame (default (0, 0, -0.065)).
-    history: seconds of detections kept per object (default 10).
+One :class:`PredicatesState` per cell, made by the capability's ``setup`` hook; its
+settings (:data:`SETTINGS`) come from the cell file's ``capabilities.predicates`` block.
 """
 
 from __future__ import annotations
 
 import threading
-import weakref
-from collections.abc import Mapping
 from typing import Any
 
 from capabilities.base import CapabilityEnv
+from capabilities.kit import Setting
 from capabilities.predicates.collision import CollisionWorld, PredicateError
 from capabilities.predicates.geometry import PoseTrack
 from capabilities.robot_body import RobotBodyError, robot_base_from_arm
 from capabilities.world_model import Detection
 from engine.types import ObjectModel, Pose
 
-__all__ = ["PredicatesState", "StateBook"]
+__all__ = ["SETTINGS", "PredicatesState", "setup"]
+
+SETTINGS = (
+    Setting("robot_base", Pose, None, "world pose of the robot's base frame (default: from the arm)"),
+    Setting("tool_size", tuple, (0.06, 0.12, 0.16), "full size (m) of the tool's box (the gripper)", 3),
+    Setting("tool_center", tuple, (0.0, 0.0, -0.065), "the tool box's centre (m) in the TCP frame", 3),
+    Setting("history", float, 10.0, "seconds of detections kept per object"),
+)  # fmt: skip
 
 
 class PredicatesState:
     """The shared predicate machinery of one cell."""
 
     def __init__(self, env: CapabilityEnv) -> None:
-        settings: Mapping[str, Any] = env.settings
+        settings = env.settings  # checked against SETTINGS: typed, defaults filled in
         self.world = env.interface("world")
         self.library = env.interface("objects")
         self.arm = env.cell.interfaces().get("arm")
         self._settings = settings
         self._lock = threading.Lock()
-        self._history = float(settings.get("history", 10.0))
+        self._history: float = settings["history"]
         self._tracks: dict[str, PoseTrack] = {}
         self._collision: CollisionWorld | None = None
         self._base: Pose | None = None
@@ -77,7 +80,7 @@ class PredicatesState:
         with self._lock:
             if self._base is None:
                 try:
-                    self._base = robot_base_from_arm(self.arm, self._settings.get("robot_base"))
+                    self._base = robot_base_from_arm(self.arm, self._settings["robot_base"])
                 except (RobotBodyError, AttributeError) as exc:
                     raise PredicateError(f"the robot's base frame is unknown: {exc}") from exc
             return self._base
@@ -90,25 +93,11 @@ class PredicatesState:
     def collision(self) -> CollisionWorld:
         with self._lock:
             if self._collision is None:
-                size = self._settings.get("tool_size", (0.06, 0.12, 0.16))
-                center = self._settings.get("tool_center", (0.0, 0.0, -0.065))
-                self._collision = CollisionWorld(self.library, tuple(size), tuple(center))
+                size, center = self._settings["tool_size"], self._settings["tool_center"]
+                self._collision = CollisionWorld(self.library, size, center)
             return self._collision
 
 
-class StateBook:
-    """One PredicatesState per cell, for the life of the cell (held by the capability)."""
-
-    def __init__(self) -> None:
-        self._lock = threading.Lock()
-        self._states: weakref.WeakKeyDictionary[Any, PredicatesState] = weakref.WeakKeyDictionary()
-
-    def get(self, env: CapabilityEnv) -> PredicatesState:
-        with self._lock:
-            try:
-                state = self._states.get(env.cell)
-                if state is None:
-                    state = self._states[env.cell] = PredicatesState(env)
-            except TypeError:  # a cell that cannot be weakly referenced shares nothing
-                state = PredicatesState(env)
-            return state
+def setup(env: CapabilityEnv) -> PredicatesState:
+    """The capability's per-cell hook: the state all predicates of a cell share."""
+    return PredicatesState(env)

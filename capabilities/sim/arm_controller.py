@@ -18,7 +18,12 @@ import pybullet
 from capabilities.sim.commands import CommandHandle
 from capabilities.sim.freedrive import Freedrive
 from capabilities.sim.kinematics import UR5Kinematics
-from capabilities.sim.trajectory import CartesianTrajectory, JointTrajectory, PathError, plan_linear
+from capabilities.sim.trajectory import (
+    CartesianTrajectory,
+    JointTrajectory,
+    LinearPathError,
+    plan_linear,
+)
 from capabilities.sim.transforms import rotation_angle
 
 __all__ = ["ArmController"]
@@ -96,7 +101,7 @@ class ArmController:
             return
         try:
             traj = plan_linear(self._kin, self.q_cmd, self._tcp(), target, speed, accel, self._dt)
-        except PathError as exc:
+        except LinearPathError as exc:
             handle.resolve(False, str(exc))
             return
         self._begin(_Motion(traj, handle))

@@ -101,6 +101,9 @@ class CellConfig:
         stand_size: width and depth (m) of the robot's stand, which reaches from the floor up
             to the robot base.
         cameras: the RGB-D cameras by name ("shoulder", "wrist").
+        capabilities: the raw ``capabilities`` block (capability name -> its settings),
+            checked by the capability registry against each capability's declared settings.
+        source: the file this configuration was read from ("" when made in code).
     """
 
     robot_base: Pose = _BASE
@@ -116,6 +119,8 @@ class CellConfig:
     table: TableConfig = TableConfig()
     stand_size: tuple[float, float] = (0.2, 0.2)
     cameras: dict[str, CameraSettings] = field(default_factory=_default_cameras)
+    capabilities: dict[str, Any] = field(default_factory=dict)
+    source: str = field(default="", compare=False)
 
     @classmethod
     def load(cls, path: str | Path = DEFAULT_CONFIG_PATH) -> CellConfig:
@@ -172,6 +177,7 @@ class CellConfig:
                 }
                 for name, c in self.cameras.items()
             },
+            "capabilities": self.capabilities,
         }
 
 
@@ -200,6 +206,9 @@ def _config(r: JsonReader) -> CellConfig:
         ),
         stand_size=r.vector2("stand_size", default.stand_size),
         cameras=_cameras(r, default.cameras),
+        # Each capability checks its own block against its settings schema (capabilities.kit).
+        capabilities={name: entry.value for name, entry in r.entries("capabilities", "settings")},
+        source=r.file,
     )
 
 

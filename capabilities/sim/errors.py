@@ -7,5 +7,5 @@ from capabilities.errors import CapabilityError
 __all__ = ["SimError"]
 
 
-class SimError(CapabilityError):
+class SimError(CapabilityError, RuntimeError):
     """The simulated cell cannot do what was asked (not started, closed, bad config)."""

@@ -193,6 +193,11 @@ class SimCellSession:
     def clock(self) -> float:
         return self.sim.time()
 
+    def capability_settings(self) -> tuple[Mapping[str, Any], str]:
+        """The ``capabilities`` block of the cell file and the file's path (for errors)."""
+        config = self.sim.config
+        return config.capabilities, config.source or "the simulated cell's configuration"
+
     def close(self) -> None:
         self.workers.close()
         self.sim.close()

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from capabilities.errors import CapabilityError
 from capabilities.sim.kinematics import Joints, UR5Kinematics
 from capabilities.sim.transforms import (
     matrix_to_pose,
@@ -27,7 +28,7 @@ __all__ = [
     "Trapezoid",
     "JointTrajectory",
     "CartesianTrajectory",
-    "PathError",
+    "LinearPathError",
     "plan_linear",
 ]
 
@@ -38,7 +39,7 @@ _ROT_SPEED = 1.0  # rad/s of tool rotation for a moveL (UR's default tool rotati
 _ROT_ACCEL = 4.0
 
 
-class PathError(Exception):
+class LinearPathError(CapabilityError):
     """A straight-line move cannot be carried out (message says where and why)."""
 
 
@@ -141,7 +142,7 @@ def plan_linear(
     solved at every control step, nearest to the previous step's joints.
 
     Raises:
-        PathError: a point on the line is unreachable, or consecutive points need a joint
+        LinearPathError: a point on the line is unreachable, or consecutive points need a joint
             jump (branch flip, singularity).
     """
     start = kin.tcp_matrix(q_start, tcp)
@@ -161,9 +162,11 @@ def plan_linear(
         point[:3, :3] = quat_to_matrix(slerp(q0, q1, u))
         sol = kin.nearest(point, tcp, joints[k - 1])
         if sol is None:
-            raise PathError(f"moveL path unreachable at {pose_text_mm(matrix_to_pose(point))}")
+            raise LinearPathError(
+                f"moveL path unreachable at {pose_text_mm(matrix_to_pose(point))}"
+            )
         if float(np.max(np.abs(sol - joints[k - 1]))) > _MAX_JOINT_SPEED * dt:
-            raise PathError(
+            raise LinearPathError(
                 "moveL needs a branch flip or passes a singularity near "
                 f"{pose_text_mm(matrix_to_pose(point))}; use a joint move"
             )

@@ -18,6 +18,7 @@ from engine.operations import (
     OperationKind,
     OperationNotFound,
     OperationSource,
+    typed_input,
 )
 from engine.status import FAILURE, RUNNING, SUCCESS, Status
 
@@ -45,6 +46,8 @@ class ConditionRunner:
     """One evaluation at a time of a condition operation, with its ports at their defaults."""
 
     def __init__(self, source: OperationSource, op_id: str, parent: OperationCall) -> None:
+        if not op_id:  # a fixed id was checked by validation; one read from a name was not
+            raise OperationFailed("wait_until needs the id of a condition operation")
         try:
             manifest = source.manifest(op_id)
         except OperationNotFound as exc:
@@ -67,16 +70,13 @@ class ConditionRunner:
             parent.node_id, f"{parent.node_name} ({op_id})", {}, _no_write,
             lambda _node, message: parent.log(message), parent.wake, parent.clock,
         )  # fmt: skip
-        self._call.args = {p.name: p.default for p in manifest.inputs}
+        self._call.args = {p.name: typed_input(p, p.default) for p in manifest.inputs}
         self._job: Job | None = None
 
     def check(self) -> bool | None:
         """True or False once an evaluation is done; None while one is still running."""
         if self._job is None:
-            result = self._operation.start(self._call)
-            if not isinstance(result, Job):
-                return result is None or result is True or result is SUCCESS
-            self._job = result
+            self._job = self._operation.start(self._call)
         status = self._job.poll()
         if status is RUNNING:
             return None

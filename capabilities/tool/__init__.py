@@ -2,12 +2,6 @@
 
 from __future__ import annotations
 
-from capabilities.base import Capability
-from capabilities.tool.operations import build_tool_capability
+from capabilities.tool.operations import capability
 
 __all__ = ["capability"]
-
-
-def capability() -> Capability:
-    """Entry point of the ``costar.capabilities`` group."""
-    return build_tool_capability()

@@ -13,18 +13,17 @@ from collections.abc import Callable
 from capabilities.base import Capability, CapabilityEnv
 from capabilities.gripper.backend import GRIPPER, GripperBackend
 from capabilities.jobs import chain_jobs, job_from_handle
+from capabilities.kit import manifest
 from capabilities.motion.backend import ARM, ArmBackend
 from capabilities.tool.backend import SUCTION, SuctionBackend
 from engine.operations import (
     Job,
     OperationCall,
     OperationKind,
-    OperationManifest,
-    StartResult,
 )
 from engine.types import Pose
 
-__all__ = ["build_tool_capability", "APPROACH_HEIGHT", "LIFT_HEIGHT"]
+__all__ = ["capability", "APPROACH_HEIGHT", "LIFT_HEIGHT"]
 
 CAP = "tool"
 APPROACH_HEIGHT = 0.10  # m above the handle (or holster) where the straight descent starts
@@ -33,25 +32,27 @@ _JOINT_SPEED, _JOINT_ACCEL = 1.05, 1.4  # rad/s, rad/s^2
 _LINEAR_SPEED, _LINEAR_ACCEL = 0.15, 1.0  # m/s, m/s^2: gentle near the holster
 
 
-def _m(op: str, kind: OperationKind, doc: str) -> OperationManifest:
-    return OperationManifest(f"{CAP}.{op}", kind, doc, CAP)
-
-
-UNHOLSTER = _m(
+UNHOLSTER = manifest(
+    CAP,
     "unholster",
     OperationKind.ACTION,
     "Takes the suction tool out of its holster with the gripper (nothing to do if held).",
 )
-HOLSTER = _m(
+HOLSTER = manifest(
+    CAP,
     "holster",
     OperationKind.ACTION,
     "Puts the suction tool back in its holster and lets go of it (nothing to do if not held).",
 )
-SUCTION_ON = _m(
-    "suction_on", OperationKind.ACTION, "Switches the vacuum on (the tool must be held)."
+SUCTION_ON = manifest(
+    CAP, "suction_on", OperationKind.ACTION, "Switches the vacuum on (the tool must be held)."
 )
-SUCTION_OFF = _m("suction_off", OperationKind.ACTION, "Switches the vacuum off, dropping the part.")
-HAS_PART = _m("has_part", OperationKind.CONDITION, "True when the vacuum sensor feels a part.")
+SUCTION_OFF = manifest(
+    CAP, "suction_off", OperationKind.ACTION, "Switches the vacuum off, dropping the part."
+)
+HAS_PART = manifest(
+    CAP, "has_part", OperationKind.CONDITION, "True when the vacuum sensor feels a part."
+)
 
 
 def _above(pose: Pose, dz: float) -> Pose:
@@ -93,10 +94,10 @@ class _Scripted:
 class Unholster(_Scripted):
     """tool.unholster: open, approach above the handle, descend, close, lift out."""
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         if self.suction.in_hand():
             call.log("the suction tool is already in the gripper")
-            return True
+            return Job.done()
         if self.gripper.is_holding():
             return _check(lambda: False, "the gripper holds something: put it down first")
         grasp = self.suction.handle_grasp_pose
@@ -121,10 +122,10 @@ class Unholster(_Scripted):
 class Holster(_Scripted):
     """tool.holster: vacuum off, approach above the holster, lower, open, move clear."""
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         if not self.suction.in_hand():
             call.log("the suction tool is not in the gripper: nothing to put back")
-            return True
+            return Job.done()
         tip = self.suction.holstered_tip_pose
         return chain_jobs(
             [
@@ -152,7 +153,7 @@ class SuctionOn:
     def __init__(self, suction: SuctionBackend) -> None:
         self._suction = suction
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         return job_from_handle(self._suction.suction_on(), "suction on")
 
 
@@ -162,7 +163,7 @@ class SuctionOff:
     def __init__(self, suction: SuctionBackend) -> None:
         self._suction = suction
 
-    def start(self, call: OperationCall) -> StartResult:
+    def start(self, call: OperationCall) -> Job:
         return job_from_handle(self._suction.suction_off(), "suction off")
 
 
@@ -172,11 +173,11 @@ class HasPart:
     def __init__(self, suction: SuctionBackend) -> None:
         self._suction = suction
 
-    def start(self, call: OperationCall) -> StartResult:
-        return self._suction.has_part()
+    def start(self, call: OperationCall) -> Job:
+        return Job.answer(self._suction.has_part())
 
 
-def build_tool_capability() -> Capability:
+def capability() -> Capability:
     """The tool capability (requires ``arm``, ``gripper`` and ``suction``)."""
     cap = Capability(
         CAP,

@@ -17,7 +17,8 @@ from capabilities.base import (
     NullCell,
     load_entry_point_capabilities,
 )
-from engine.operations import OperationKind, OperationManifest, OperationNotFound
+from capabilities.kit import CapabilitySettingsError, Setting
+from engine.operations import Job, OperationKind, OperationManifest, OperationNotFound
 
 
 class FakeCell:
@@ -41,8 +42,8 @@ class Recorded:
     def __init__(self, env: CapabilityEnv) -> None:
         self.env = env
 
-    def start(self, call: Any) -> bool:
-        return True
+    def start(self, call: Any) -> Job:
+        return Job.done()
 
 
 def manifest(op_id: str, cap: str, aliases: tuple[str, ...] = ()) -> OperationManifest:
@@ -174,18 +175,90 @@ def test_the_default_cell_has_no_interfaces() -> None:
     assert "the none cell has no arm" in registry.availability("arm.move").reason
 
 
+def _with_settings(setup: Any = None) -> Capability:
+    cap = capability("motion", "motion.a")
+    cap.settings = (
+        Setting("speed", float, 0.5, "m/s"),
+        Setting("margin", float, 0.01, "m"),
+        Setting("count", int, 3),
+    )
+    cap.setup = setup
+    return cap
+
+
 def test_factories_get_the_cell_interfaces_and_their_settings() -> None:
     arm = object()
     registry = CapabilityRegistry(
-        [capability("motion", "motion.a")],
-        cell=FakeCell(arm=arm),
-        settings={"motion": {"speed": 0.25}, "other": {"x": 1}},
+        [_with_settings()], cell=FakeCell(arm=arm), settings={"motion": {"speed": 1, "margin": 0}}
     )
     first: Any = registry.create("motion.a")
     second = registry.create("motion.a")
     assert first is not second  # one instance per leaf
     env = first.env
-    assert (env.capability, dict(env.settings)) == ("motion", {"speed": 0.25})
+    # declared defaults fill in; an int is a float for a float setting; an explicit 0 is 0
+    assert (env.capability, dict(env.settings)) == (
+        "motion",
+        {"speed": 1.0, "margin": 0.0, "count": 3},
+    )
+    assert env.state is None
     assert env.interface("arm") is arm
     with pytest.raises(CapabilityError, match="the fake cell has no 'gripper' interface"):
         env.interface("gripper")
+
+
+@pytest.mark.parametrize(
+    ("settings", "expected"),
+    [
+        ({"motion": {"sped": 1.0}}, r"cell\.json: \$\.capabilities\.motion\.sped: unknown setting"),
+        (
+            {"motion": {"speed": "fast"}},
+            r"\$\.capabilities\.motion\.speed: expected a number, got 'fast'",
+        ),
+        ({"motion": {"count": 2.5}}, r"\$\.capabilities\.motion\.count: expected an integer"),
+        (
+            {"motion": {"speed": True}},
+            r"\$\.capabilities\.motion\.speed: expected a number, got True",
+        ),
+        ({"motion": []}, r"\$\.capabilities\.motion: expected an object"),
+    ],
+)
+def test_bad_settings_name_the_file_and_the_key(settings: Any, expected: str) -> None:
+    with pytest.raises(CapabilitySettingsError, match=expected):
+        CapabilityRegistry([_with_settings()], settings=settings, settings_source="my.cell.json")
+
+
+def test_setup_runs_once_per_cell_and_its_state_reaches_every_operation() -> None:
+    made: list[CapabilityEnv] = []
+
+    def setup(env: CapabilityEnv) -> dict[str, Any]:
+        made.append(env)
+        return {"speed": env.settings["speed"]}
+
+    registry = CapabilityRegistry([_with_settings(setup)], settings={"motion": {"speed": 0.0}})
+    first: Any = registry.create("motion.a")
+    second: Any = registry.create("motion.a")
+    assert len(made) == 1
+    assert first.env.state is second.env.state
+    assert first.env.state == {"speed": 0.0}
+    other: Any = CapabilityRegistry([_with_settings(setup)]).create("motion.a")
+    assert other.env.state is not first.env.state and len(made) == 2
+
+
+def test_a_cell_supplies_its_settings_block() -> None:
+    class FileCell(FakeCell):
+        def capability_settings(self) -> tuple[dict[str, Any], str]:
+            return {"motion": {"speed": "x"}}, "/cells/a.cell.json"
+
+    with pytest.raises(
+        CapabilitySettingsError, match=r"/cells/a\.cell\.json: \$\.capabilities\.motion\.speed"
+    ):
+        CapabilityRegistry([_with_settings()], cell=FileCell())
+
+
+def test_a_block_for_no_installed_capability_is_an_error() -> None:
+    with pytest.raises(
+        CapabilitySettingsError, match=r"c\.json: \$\.capabilities\.motoin: no capability"
+    ):
+        CapabilityRegistry(settings={"motoin": {}}, settings_source="c.json")
+    # a registry of chosen capabilities leaves the other capabilities' blocks alone
+    CapabilityRegistry([_with_settings()], settings={"occupancy": {"x": 1}})

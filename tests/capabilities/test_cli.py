@@ -182,7 +182,7 @@ EXPECTED_OPS = {
     "tool.unholster", "tool.holster", "tool.suction_on", "tool.suction_off", "tool.has_part",
     "markers.detect_markers", "markers.marker_pose", "markers.object_pose", "markers.object_found",
     "markers.calibrate_camera", "freedrive.start", "freedrive.stop", "freedrive.record_waypoint",
-    "timing.wait", "timing.wait_until",
+    "timing.wait_until",
 }  # fmt: skip
 
 
@@ -194,7 +194,8 @@ def test_ops_lists_every_robot_operation_with_reasons_when_no_cell() -> None:
     move = ops["motion.move_to"]
     assert not move["available"] and "arm" in move["reason"]
     assert {p["name"] for p in move["params"]} >= {"target", "mode", "speed"}
-    assert ops["timing.wait"]["available"]
+    assert ops["timing.wait_until"]["available"]
+    assert "timing.wait" not in ops  # the engine's Wait node waits a time
 
 
 def test_validate_on_no_cell_hints_at_the_simulated_cell() -> None:

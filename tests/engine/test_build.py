@@ -29,7 +29,7 @@ from engine.decorators import (
 )
 from engine.errors import EngineError
 from engine.leaves import OperationLeaf, Wait
-from engine.operations import Direction, OperationKind, OperationManifest, PortSpec
+from engine.operations import Direction, Job, OperationKind, OperationManifest, PortSpec
 from engine.spec import NodeKind, ParameterDecl, PlanSpec
 from engine.status import RUNNING, SUCCESS
 from engine.tree import Root, RunPolicy
@@ -131,7 +131,7 @@ def test_aliases_of_renamed_operations_build(clock: FakeClock) -> None:
     cap = Capability("demo", "a demo")
     cap.add(
         OperationManifest("demo.go", OperationKind.ACTION, "go", "demo", aliases=("demo.old_go",)),
-        lambda env: _Const(True),
+        lambda env: _Const(Job.done()),
     )
     spec = op("demo.old_go")
     tree = build_tree(plan(spec), CapabilityRegistry([cap]))

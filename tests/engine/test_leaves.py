@@ -19,8 +19,16 @@ from bt_fakes import (
 
 from engine.blackboard import Blackboard, BlackboardError
 from engine.composites import Parallel, Selector, Sequence
-from engine.leaves import Wait
-from engine.operations import Job, OperationCall, OperationFailed, OperationKind
+from engine.errors import EngineError
+from engine.leaves import OperationLeaf, Wait
+from engine.operations import (
+    Job,
+    OperationCall,
+    OperationFailed,
+    OperationKind,
+    OperationNotFound,
+    PortSpec,
+)
 from engine.status import FAILURE, IDLE, RUNNING, SUCCESS, Status
 from engine.types import ParamType, Pose
 
@@ -42,14 +50,31 @@ def raises(exc: Exception) -> FuncOperation:
 # ---------------------------------------------------------------------- immediate results
 
 
-@pytest.mark.parametrize("value", [True, None, SUCCESS])
+@pytest.mark.parametrize("value", [Job.done(), Job.answer(True), Job.done("moved")])
 def test_an_immediate_success(ctx: Any, value: Any) -> None:
     assert leaf(ctx, returns(value)).tick() is SUCCESS
 
 
+@pytest.mark.parametrize("value", [True, None, SUCCESS, False])
+def test_start_returns_a_job_and_nothing_else(ctx: Any, value: Any) -> None:
+    node = leaf(ctx, returns(value))
+    assert node.tick() is FAILURE
+    assert "expected a Job" in node.message
+
+
+def test_a_finished_job_with_outputs_writes_them(ctx: Any) -> None:
+    node = leaf(ctx, returns(Job.done("", {"pose": Pose()})), "q", QUERY, outputs={"pose": "P"})
+    assert node.tick() is SUCCESS
+    assert ctx.blackboard.get("P") == Pose()
+
+
 @pytest.mark.parametrize(
     ("value", "kind", "message"),
-    [(False, OperationKind.ACTION, "failed"), (FAILURE, CONDITION, "false")],
+    [
+        (Job.failed(), OperationKind.ACTION, "failed"),
+        (Job.answer(False), CONDITION, "false"),
+        (Job.failed("no cup"), CONDITION, "no cup"),
+    ],
 )
 def test_an_immediate_failure(ctx: Any, value: Any, kind: OperationKind, message: str) -> None:
     node = leaf(ctx, returns(value), kind=kind)
@@ -106,16 +131,24 @@ def test_a_job_finished_from_another_thread_wakes_the_tree(ctx: Any) -> None:
     assert node.tick() is SUCCESS
 
 
-def test_a_job_finished_before_the_leaf_binds_it_wakes_at_once(ctx: Any) -> None:
+def test_a_job_finished_inside_start_is_taken_in_the_same_tick(ctx: Any) -> None:
     wakes: list[int] = []
     ctx.wake = lambda: wakes.append(1)
 
     def start(call: OperationCall) -> Job:
         job = Job()
-        job.succeed()  # finished inside start, before bind_wake
+        job.succeed()  # finished inside start: no wake needed, the leaf polls it at once
         return job
 
     assert leaf(ctx, FuncOperation(start)).tick() is SUCCESS
+    assert wakes == []
+
+
+def test_a_job_finished_before_bind_wake_wakes_at_once() -> None:
+    wakes: list[int] = []
+    job = Job()
+    job.succeed()
+    job.bind_wake(lambda: wakes.append(1))
     assert wakes == [1]
 
 
@@ -211,9 +244,9 @@ def test_a_cancel_that_raises_does_not_break_the_reset(ctx: Any) -> None:
 
 
 def test_a_query_succeeds_only_when_it_wrote_its_output(ctx: Any) -> None:
-    def start(call: OperationCall) -> bool:
+    def start(call: OperationCall) -> Job:
         call.write("pose", Pose())
-        return True
+        return Job.done()
 
     node = leaf(ctx, FuncOperation(start), "where", QUERY, outputs={"pose": "CUP_POSE"})
     assert node.tick() is SUCCESS
@@ -221,7 +254,7 @@ def test_a_query_succeeds_only_when_it_wrote_its_output(ctx: Any) -> None:
 
 
 def test_a_query_that_writes_nothing_fails(ctx: Any) -> None:
-    node = leaf(ctx, returns(True), "where", QUERY, outputs={"pose": "CUP_POSE"})
+    node = leaf(ctx, returns(Job.done()), "where", QUERY, outputs={"pose": "CUP_POSE"})
     assert node.tick() is FAILURE
     assert node.message == "the query wrote no value for CUP_POSE"
     assert "CUP_POSE" not in ctx.blackboard
@@ -230,10 +263,10 @@ def test_a_query_that_writes_nothing_fails(ctx: Any) -> None:
 def test_a_query_must_write_again_on_each_run(ctx: Any) -> None:
     runs = iter([True, False])
 
-    def start(call: OperationCall) -> bool:
+    def start(call: OperationCall) -> Job:
         if next(runs):
             call.write("pose", Pose())
-        return True
+        return Job.done()
 
     node = leaf(ctx, FuncOperation(start), "where", QUERY, outputs={"pose": "CUP_POSE"})
     assert node.tick() is SUCCESS
@@ -242,9 +275,9 @@ def test_a_query_must_write_again_on_each_run(ctx: Any) -> None:
 
 
 def test_an_output_the_plan_does_not_store_is_dropped(ctx: Any) -> None:
-    def start(call: OperationCall) -> bool:
+    def start(call: OperationCall) -> Job:
         call.write("extra", 1.0)
-        return True
+        return Job.done()
 
     assert leaf(ctx, FuncOperation(start), "act").tick() is SUCCESS
     assert len(ctx.blackboard) == 0
@@ -270,9 +303,9 @@ def test_a_missing_reference_fails_the_node_naming_the_parameter(ctx: Any) -> No
 
 
 def test_operations_log_through_the_tree(ctx: Any) -> None:
-    def start(call: OperationCall) -> bool:
+    def start(call: OperationCall) -> Job:
         call.log("closing gripper")
-        return True
+        return Job.done()
 
     leaf(ctx, FuncOperation(start), "grip").tick()
     assert ctx.logs == [("grip", "closing gripper")]
@@ -353,3 +386,49 @@ def test_a_leaf_in_a_sequence_with_a_job(ctx: Any) -> None:
     assert seq.tick() is RUNNING
     work.job.succeed()
     assert seq.tick() is SUCCESS
+
+
+# ---------------------------------------------------------------------- typed inputs
+
+_TARGET = PortSpec("target", (ParamType.POSE, ParamType.WAYPOINT))
+_SPEED = PortSpec("speed", (ParamType.NUMBER,), default=0.25, unit="m/s")
+
+
+def _typed_leaf(ctx: Any, work: Any) -> Any:
+    return OperationLeaf(ctx, "move", "move", OperationKind.ACTION, work,
+                         {"speed": 1}, {"target": "CUP_POSE"}, ports=(_TARGET, _SPEED))  # fmt: skip
+
+
+def test_inputs_are_read_typed_and_in_si(ctx: Any) -> None:
+    seen: list[Any] = []
+
+    def start(call: OperationCall) -> Job:
+        seen.extend([call.input("speed"), call.input("target")])
+        return Job.done()
+
+    ctx.blackboard.set("CUP_POSE", Pose((0.1, 0.2, 0.3)))
+    assert _typed_leaf(ctx, FuncOperation(start)).tick() is SUCCESS
+    assert seen == [1.0, Pose((0.1, 0.2, 0.3))]
+    assert type(seen[0]) is float
+
+
+def test_a_reference_of_the_wrong_type_fails_naming_port_name_and_types(ctx: Any) -> None:
+    work = JobOperation()
+    ctx.blackboard.set("CUP_POSE", "hello")
+    node = _typed_leaf(ctx, work)
+    assert node.tick() is FAILURE
+    assert node.message == (
+        "input 'target' reads 'CUP_POSE', which holds Text 'hello'; expected Pose or Waypoint"
+    )
+    assert work.jobs == []
+
+
+def test_asking_for_an_input_the_manifest_lacks_fails_the_node(ctx: Any) -> None:
+    node = leaf(ctx, FuncOperation(lambda call: call.input("nope")), "act")
+    assert node.tick() is FAILURE
+    assert node.message == "'act' has no input 'nope'"
+
+
+def test_operation_errors_derive_from_the_engine_root() -> None:
+    assert issubclass(OperationFailed, EngineError)
+    assert issubclass(OperationNotFound, EngineError)

@@ -203,4 +203,4 @@ def test_handoff_operations_fail_with_the_reason_on_a_cell_without_cameras() -> 
     )  # fmt: skip
     tree = build(cell, root)
     assert run_to_end(tree, 50.0, DEADLINE).status is Status.FAILURE
-    assert "rgbd:shoulder" in tree.root.message
+    assert "has no shoulder camera" in tree.root.message

@@ -8,9 +8,10 @@ from collections.abc import Iterator
 import pytest
 
 from capabilities.sim.session import SimCellSession
+from capabilities.sim.testing import angle_between, distance, down_at
 from engine.status import Status
 from engine.types import JointConfig, Waypoint, WaypointFrame
-from tests.capabilities.motion.plans import angle_between, distance, down_at, op, run_plan, seq
+from tests.capabilities.motion.plans import op, run_plan, seq
 
 pytestmark = pytest.mark.sim
 

@@ -8,8 +8,9 @@ from collections.abc import Iterator
 import pytest
 
 from capabilities.sim.session import SimCellSession
+from capabilities.sim.testing import down_at
 from engine.status import Status
-from tests.capabilities.motion.plans import down_at, op, run_plan, seq
+from tests.capabilities.motion.plans import op, run_plan, seq
 
 pytestmark = pytest.mark.sim
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterator
 from typing import Any
 
@@ -18,15 +17,12 @@ from engine.executor import run_to_end
 from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
 from engine.status import Status
 from engine.tree import BehaviorTree
-from engine.types import Pose, type_of_value
+from engine.types import type_of_value
 from engine.validation import validate_plan
 
 __all__ = [
     "DOWN",
     "Run",
-    "angle_between",
-    "distance",
-    "down_at",
     "op",
     "registry_for",
     "run_plan",
@@ -105,20 +101,6 @@ def run_plan(
     result = run_to_end(tree, rate_hz=200.0, timeout=timeout)
     assert result.reason == "finished", result
     return Run(tree, result.status)
-
-
-def down_at(x: float, y: float, z: float, yaw: float = 0.0) -> Pose:
-    """A TCP pose pointing down at (x, y, z), turned ``yaw`` (rad) about the vertical."""
-    return Pose((x, y, z), (math.cos(yaw / 2), -math.sin(yaw / 2), 0.0, 0.0))
-
-
-def distance(a: Pose, b: Pose) -> float:
-    return math.dist(a.position, b.position)
-
-
-def angle_between(a: Pose, b: Pose) -> float:
-    dot = abs(sum(x * y for x, y in zip(a.orientation, b.orientation, strict=True)))
-    return 2 * math.acos(min(1.0, dot))
 
 
 def sim_steps(session: SimCellSession, step: float, limit: float) -> Iterator[float]:

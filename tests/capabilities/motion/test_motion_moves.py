@@ -9,19 +9,10 @@ import pytest
 
 from capabilities.base import CapabilityRegistry, NullCell
 from capabilities.sim.session import SimCellSession
+from capabilities.sim.testing import angle_between, distance, down_at
 from engine.status import Status
 from engine.types import JointConfig, Waypoint, WaypointFrame
-from tests.capabilities.motion.plans import (
-    all_capabilities,
-    angle_between,
-    build,
-    distance,
-    down_at,
-    op,
-    run_plan,
-    seq,
-    sim_steps,
-)
+from tests.capabilities.motion.plans import all_capabilities, build, op, run_plan, seq, sim_steps
 
 pytestmark = pytest.mark.sim
 
@@ -76,6 +67,19 @@ def test_world_waypoint_joints_home_and_relative_moves(session: SimCellSession) 
     assert distance(run.value("P"), want) < MM and angle_between(run.value("P"), want) < HALF_DEG
     assert isinstance(run.value("Q"), JointConfig)
     assert distance(run.value("P2"), want) < MM
+
+
+def test_move_relative_tool_moves_along_the_tool_axis(session: SimCellSession) -> None:
+    plan = seq(
+        op("motion.move_to", "above", target=down_at(0.4, 0.2, 0.25)),
+        op("motion.move_relative_tool", "approach", dz=0.05),
+        op("motion.current_pose", "pose", pose="$P"),
+    )
+    run = run_plan(session, plan)
+    assert run.status is Status.SUCCESS, run.failure()
+    # The tool points down: +50 mm along its z is 50 mm lower in the world.
+    want = down_at(0.4, 0.2, 0.20)
+    assert distance(run.value("P"), want) < MM and angle_between(run.value("P"), want) < HALF_DEG
 
 
 def test_is_home_is_false_away_from_home(session: SimCellSession) -> None:
@@ -140,4 +144,4 @@ def test_motion_is_unavailable_without_an_arm_and_says_why() -> None:
         assert "needed by the" in availability.reason
     assert "arm" in registry.availability("motion.move_to").reason
     assert "suction" in registry.availability("tool.unholster").reason
-    assert registry.availability("timing.wait").available
+    assert registry.availability("timing.wait_until").available

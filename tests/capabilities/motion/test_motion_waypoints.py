@@ -11,18 +11,11 @@ from capabilities.motion.geometry import axis_rotation, rotation_between
 from capabilities.motion.symmetry import NO_SYMMETRY, ObjectSymmetry, SymmetryTable
 from capabilities.motion.targets import symmetric_tool_poses
 from capabilities.sim.session import SimCellSession
+from capabilities.sim.testing import angle_between, distance, down_at
 from capabilities.world_model import Detection
 from engine.status import Status
 from engine.types import Pose, Waypoint, WaypointFrame
-from tests.capabilities.motion.plans import (
-    DOWN,
-    angle_between,
-    distance,
-    down_at,
-    op,
-    run_plan,
-    seq,
-)
+from tests.capabilities.motion.plans import DOWN, op, run_plan, seq
 
 MM = 1e-3
 HALF_DEG = math.radians(0.5)

@@ -10,7 +10,7 @@ import pybullet
 
 from capabilities.base import CapabilityRegistry
 from capabilities.sim.session import SimCellSession
-from engine.operations import Job, OperationCall, OperationFailed
+from engine.operations import OperationCall, OperationFailed, typed_input
 from engine.status import RUNNING, SUCCESS, Status
 from engine.types import Pose
 
@@ -45,13 +45,12 @@ def run_op(
         lambda key, value, _w: outputs.__setitem__(key, value),
         lambda _n, _m: None, woken.set, registry.cell.clock,
     )  # fmt: skip
-    call.args = {p.name: p.default for p in manifest.inputs} | args
+    given = {p.name: p.default for p in manifest.inputs} | args
+    call.args = {p.name: typed_input(p, given[p.name]) for p in manifest.inputs if p.name in given}
     try:
         result = operation.start(call)
     except OperationFailed as exc:  # the leaf turns a raise into FAILURE with the message
         return Outcome(Status.FAILURE, str(exc), outputs)
-    if not isinstance(result, Job):
-        return Outcome(SUCCESS if result in (True, None, SUCCESS) else Status.FAILURE, "", outputs)
     result.bind_wake(woken.set)
     end = time.monotonic() + deadline
     while (status := result.poll()) is RUNNING:

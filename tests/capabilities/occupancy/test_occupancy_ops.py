@@ -82,11 +82,6 @@ def test_a_condition_answers_at_once_from_a_recent_frame(registry: CapabilityReg
     assert job.poll() is FAILURE and "occupied" in job.message
 
 
-def test_bad_ports_fail_with_a_reason(registry: CapabilityRegistry) -> None:
-    outcome = run_op(registry, "occupancy.is_occupied", region=REGION, camera="ceiling")
-    assert outcome.status is FAILURE and "unknown camera 'ceiling'" in outcome.message
-
-
 def test_a_configured_table_height_is_used(session: SimCellSession) -> None:
     reg = CapabilityRegistry([capability()], cell=_Renamed(session),
                              settings={"occupancy": {"table_z": 0.3}})  # fmt: skip

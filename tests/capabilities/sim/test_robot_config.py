@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -12,7 +13,12 @@ from capabilities.sim.errors import SimError
 
 
 def test_default_file_matches_the_built_in_defaults() -> None:
-    assert CellConfig.load(DEFAULT_CONFIG_PATH) == CellConfig()
+    loaded = CellConfig.load(DEFAULT_CONFIG_PATH)
+    assert loaded.source == str(DEFAULT_CONFIG_PATH)
+    # The file also gives capability settings (checked by the registry, tests/capabilities/
+    # test_cell_settings.py); the built-in configuration leaves them to the capabilities.
+    assert loaded.capabilities
+    assert dataclasses.replace(loaded, capabilities={}) == CellConfig()
     assert CellConfig.from_json(CellConfig().to_json()) == CellConfig()
 
 
@@ -38,8 +44,7 @@ def test_the_cell_file_describes_the_cameras() -> None:
 def test_a_bad_camera_entry_names_its_json_path() -> None:
     import pytest
 
-    from capabilities.sim.config import CellConfig
-    from capabilities.sim.config import CellConfigError
+    from capabilities.sim.config import CellConfig, CellConfigError
 
     data = CellConfig().to_json()
     data["cameras"]["shoulder"]["size"] = [640, "tall"]

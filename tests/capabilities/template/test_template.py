@@ -5,7 +5,10 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+import pytest
+
 from capabilities.base import CapabilityRegistry, NullCell
+from capabilities.kit import CapabilitySettingsError
 from capabilities.template import capability
 from engine.build import build_tree
 from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
@@ -49,3 +52,24 @@ def test_unavailable_without_the_interface_and_says_why() -> None:
     availability = registry.availability("template.lamp_is_lit")
     assert not availability.available
     assert "lamp" in availability.reason
+
+
+def test_settings_come_from_the_cell_block_and_feed_the_state() -> None:
+    registry = CapabilityRegistry(
+        [capability()], cell=LampCell({"red"}), settings={"template": {"inverted": True}}
+    )
+    assert registry.settings("template") == {"inverted": True}
+    assert build_tree(_plan("red"), registry).tick() is Status.FAILURE
+    assert build_tree(_plan("green"), registry).tick() is Status.SUCCESS
+
+
+def test_a_wrong_setting_names_the_file_and_key() -> None:
+    with pytest.raises(
+        CapabilitySettingsError,
+        match=r"lamp\.cell\.json: \$\.capabilities\.template\.inverted: expected true or false",
+    ):
+        CapabilityRegistry([capability()], cell=LampCell(set()),
+                           settings={"template": {"inverted": 0}}, settings_source="lamp.cell.json")  # fmt: skip
+    with pytest.raises(CapabilitySettingsError, match=r"template\.colour: unknown setting"):
+        CapabilityRegistry([capability()], cell=LampCell(set()),
+                           settings={"template": {"colour": "red"}}, settings_source="x")  # fmt: skip

@@ -1,4 +1,4 @@
-"""timing: wait on the cell's clock; wait_until polls a condition of the same registry."""
+"""timing: wait_until polls a condition of the same registry, on the cell's clock."""
 
 from __future__ import annotations
 
@@ -10,13 +10,15 @@ import pytest
 from capabilities.base import Capability, CapabilityRegistry, NullCell
 from capabilities.debug import capability as debug
 from capabilities.sim.session import SimCellSession
+from capabilities.sim.testing import down_at
 from capabilities.timing import capability as timing
 from engine.build import build_tree
-from engine.operations import OperationKind, OperationManifest
+from engine.operations import Job, OperationKind, OperationManifest
 from engine.spec import NodeKind, NodeSpec, PlanSpec
 from engine.status import Status
 from engine.tree import BehaviorTree
-from tests.capabilities.motion.plans import build, down_at, op, registry_for, run_plan, sim_steps
+from engine.validation import validate_plan
+from tests.capabilities.motion.plans import op, registry_for, run_plan
 
 
 class ProbeCell:
@@ -43,8 +45,8 @@ def _probe() -> Capability:
         def __init__(self, cell: ProbeCell) -> None:
             self.cell = cell
 
-        def start(self, call: object) -> bool:
-            return self.cell.flag
+        def start(self, call: object) -> Job:
+            return Job.answer(self.cell.flag)
 
     cap.add(manifest, lambda env: IsSet(env.interface("probe")))
     return cap
@@ -53,16 +55,6 @@ def _probe() -> Capability:
 def _tree(cell: Any, node: NodeSpec) -> BehaviorTree:
     registry = CapabilityRegistry([timing(), debug(), _probe()], cell=cell)
     return build_tree(PlanSpec(node, "t"), registry, clock=cell.clock)
-
-
-def test_wait_counts_seconds_on_the_cells_clock() -> None:
-    cell = ProbeCell()
-    tree = _tree(cell, op("timing.wait", seconds=1.5))
-    assert tree.tick() is Status.RUNNING
-    cell.now = 1.49
-    assert tree.tick() is Status.RUNNING
-    cell.now = 1.5
-    assert tree.tick() is Status.SUCCESS
 
 
 def test_wait_until_succeeds_when_the_condition_turns_true() -> None:
@@ -126,21 +118,6 @@ def session() -> Iterator[SimCellSession]:
 
 
 @pytest.mark.sim
-def test_wait_on_the_simulated_clock(session: SimCellSession) -> None:
-    tree = build(session, op("timing.wait", seconds=2.0))
-    start = session.clock()
-    assert tree.tick() is Status.RUNNING
-    for _ in sim_steps(session, 0.1, 3.0):
-        before = session.clock()
-        status = tree.tick()
-        if status is Status.SUCCESS:
-            assert session.clock() >= start + 2.0
-            return
-        assert status is Status.RUNNING and before < start + 2.0 + 1e-9
-    pytest.fail("the wait did not end")
-
-
-@pytest.mark.sim
 def test_wait_until_the_arm_moves_in_parallel_with_a_move(session: SimCellSession) -> None:
     registry = registry_for(session)
     parallel = NodeSpec(
@@ -153,3 +130,24 @@ def test_wait_until_the_arm_moves_in_parallel_with_a_move(session: SimCellSessio
     run = run_plan(session, parallel, registry)
     assert run.status is Status.SUCCESS, run.failure()
     assert run.messages()["until moving"] == "motion.is_moving became true"
+
+
+@pytest.mark.parametrize(
+    ("condition", "expected"),
+    [
+        ("", "needs the id of a condition operation"),
+        ("probe.is_sett", "names no operation: 'probe.is_sett' (did you mean"),
+        ("debug.succeed", "debug.succeed is an action, not a condition"),
+    ],
+)
+def test_validation_checks_the_condition_id(condition: str, expected: str) -> None:
+    registry = CapabilityRegistry([timing(), debug(), _probe()], cell=ProbeCell())
+    plan = PlanSpec(op("timing.wait_until", condition=condition), "t")
+    messages = [p.message for p in validate_plan(plan, registry) if p.severity == "error"]
+    assert len(messages) == 1 and expected in messages[0], messages
+
+
+def test_validation_accepts_a_runnable_condition() -> None:
+    registry = CapabilityRegistry([timing(), debug(), _probe()], cell=ProbeCell())
+    plan = PlanSpec(op("timing.wait_until", condition="probe.is_set"), "t")
+    assert validate_plan(plan, registry) == []

@@ -8,19 +8,11 @@ from collections.abc import Iterator
 import pytest
 
 from capabilities.sim.session import SimCellSession
+from capabilities.sim.testing import distance, down_at
 from capabilities.world_model import Detection
 from engine.status import Status
 from engine.types import Pose, Waypoint, WaypointFrame
-from tests.capabilities.motion.plans import (
-    DOWN,
-    build,
-    distance,
-    down_at,
-    op,
-    run_plan,
-    seq,
-    sim_steps,
-)
+from tests.capabilities.motion.plans import DOWN, build, op, run_plan, seq, sim_steps
 
 pytestmark = pytest.mark.sim
 

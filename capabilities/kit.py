@@ -1,0 +1,175 @@
+"""The capability kit: the one way to declare a capability's operations and settings.
+
+A capability module declares each operation as a manifest (made with :func:`manifest`)
+next to the class that runs it, as BehaviorTree.CPP puts ``CreateManifest`` beside a node
+class, and one function ``capability() -> Capability`` adds them. Per-cell state and
+settings come through one hook, as py_trees' ``setup()``: a capability declares its
+settings as :class:`Setting` fields (typed, with defaults and docs) and a ``setup``
+function that makes its per-cell state object from them; the registry calls ``setup`` once
+per cell, and every operation factory finds that object as ``env.state`` and the checked
+settings as ``env.settings``. The cell file supplies the settings in its ``capabilities``
+block; an unknown key or a wrong type is a :class:`CapabilitySettingsError` naming the file
+and the key, and an explicit 0 is 0.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from capabilities.errors import CapabilityError
+from engine.operations import OperationFailed, OperationKind, OperationManifest, PortSpec
+from engine.types import ParamType, Pose, decode_value
+
+if TYPE_CHECKING:
+    from capabilities.base import CapabilityEnv
+
+__all__ = [
+    "CAMERAS",
+    "CapabilitySettingsError",
+    "Setting",
+    "camera",
+    "manifest",
+    "parse_settings",
+    "stateful",
+]
+
+CAMERAS = ("shoulder", "wrist")
+"""The RGB-D cameras a cell may have (the choices of a ``camera`` port)."""
+
+
+def camera(env: CapabilityEnv, name: str) -> Any:
+    """The RGB-D camera ``name`` of the cell (its interface ``rgbd:<name>``).
+
+    Raises:
+        OperationFailed: the cell has no such camera.
+    """
+    found = env.cell.interfaces().get(f"rgbd:{name}")
+    if found is None:
+        raise OperationFailed(f"the {env.cell.name} cell has no {name} camera")
+    return found
+
+
+class CapabilitySettingsError(CapabilityError):
+    """A cell file's ``capabilities`` block has an unknown key or a value of the wrong type."""
+
+
+def manifest(
+    capability: str,
+    name: str,
+    kind: OperationKind,
+    doc: str,
+    *ports: PortSpec,
+    aliases: tuple[str, ...] = (),
+) -> OperationManifest:
+    """The manifest of operation ``capability.name`` (the one manifest helper).
+
+    Example::
+
+        LAMP_IS_LIT = manifest("template", "lamp_is_lit", OperationKind.CONDITION,
+                               "True when the stack light shows the given colour.",
+                               PortSpec("colour", (ParamType.TEXT,), default="green"))
+    """
+    return OperationManifest(f"{capability}.{name}", kind, doc, capability, ports, aliases)
+
+
+def stateful(cls: Callable[..., Any], *extra: Any) -> Callable[[CapabilityEnv], Any]:
+    """The factory of an operation class whose first argument is the per-cell state:
+    ``cap.add(IS_EMPTY, stateful(RegionCondition, False))`` makes
+    ``RegionCondition(env.state, False)`` for each leaf."""
+    return lambda env: cls(env.state, *extra)
+
+
+_PY_TYPES: dict[type, str] = {float: "a number", int: "an integer", bool: "true or false",
+                              str: "a text", Pose: "a pose"}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Setting:
+    """One per-cell setting of a capability, as the cell file's ``capabilities`` block gives it.
+
+    Attributes:
+        name: the key in the block.
+        type: float (SI units; an integer is taken as a float), int, bool, str, Pose
+            (the JSON form of a Pose parameter) or tuple (a list of ``size`` numbers,
+            read as a tuple of floats).
+        default: the value when the cell file does not give one (None: not set).
+        doc: one line saying what it does and its unit.
+        size: how many numbers a tuple setting has.
+    """
+
+    name: str
+    type: type
+    default: Any = None
+    doc: str = ""
+    size: int = 0
+
+    def parse(self, value: Any, where: str) -> Any:
+        """The setting's value from its JSON form; raises CapabilitySettingsError."""
+        if value is None:
+            return None
+        if self.type is Pose and isinstance(value, Pose):  # given in code, not from a file
+            return value
+        if self.type is Pose:
+            try:
+                return decode_value(ParamType.POSE, value, where)
+            except ValueError as exc:
+                raise CapabilitySettingsError(str(exc)) from exc
+        if self.type is tuple:
+            return self._numbers(value, where)
+        ok = isinstance(value, self.type) and not (
+            self.type is not bool and isinstance(value, bool)
+        )
+        if self.type is float and isinstance(value, int) and not isinstance(value, bool):
+            return float(value)
+        if not ok:
+            expected = _PY_TYPES.get(self.type, self.type.__name__)
+            raise CapabilitySettingsError(f"{where}: expected {expected}, got {value!r}")
+        return value
+
+    def _numbers(self, value: Any, where: str) -> tuple[float, ...]:
+        if (
+            not isinstance(value, (list, tuple))
+            or len(value) != self.size
+            or any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in value)
+        ):
+            raise CapabilitySettingsError(
+                f"{where}: expected a list of {self.size} numbers, got {value!r}"
+            )
+        return tuple(float(v) for v in value)
+
+
+def parse_settings(
+    capability: str, schema: tuple[Setting, ...], raw: Mapping[str, Any], source: str
+) -> dict[str, Any]:
+    """A capability's settings: every schema field, from ``raw`` or its default.
+
+    Args:
+        capability: the capability's name (the key of its block).
+        schema: the capability's declared settings.
+        raw: the block from the cell file (JSON values).
+        source: the file the block came from, for error messages.
+
+    Raises:
+        CapabilitySettingsError: an unknown key or a wrong type, naming the file and key.
+    """
+    if not isinstance(raw, Mapping):
+        raise CapabilitySettingsError(
+            f"{source}: $.capabilities.{capability}: expected an object, got {raw!r}"
+        )
+    fields = {s.name: s for s in schema}
+    for key in raw:
+        if key not in fields:
+            known = ", ".join(fields) or "none"
+            raise CapabilitySettingsError(
+                f"{source}: $.capabilities.{capability}.{key}: unknown setting "
+                f"(the {capability} capability has: {known})"
+            )
+    values: dict[str, Any] = {}
+    for setting in schema:
+        where = f"{source}: $.capabilities.{capability}.{setting.name}"
+        values[setting.name] = (
+            setting.parse(raw[setting.name], where) if setting.name in raw else setting.default
+        )
+    return values
