@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 from capabilities.errors import CapabilityError
 from engine.operations import OperationFailed, OperationKind, OperationManifest, PortSpec
-from engine.types import ParamType, Pose, decode_value
+from engine.types import ParamType, Pose, ValueShapeError, decode_value
 
 if TYPE_CHECKING:
     from capabilities.base import CapabilityEnv
@@ -114,7 +114,7 @@ class Setting:
         if self.type is Pose:
             try:
                 return decode_value(ParamType.POSE, value, where)
-            except ValueError as exc:
+            except ValueShapeError as exc:
                 raise CapabilitySettingsError(str(exc)) from exc
         if self.type is tuple:
             return self._numbers(value, where)
