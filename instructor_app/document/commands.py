@@ -22,7 +22,6 @@ __all__ = [
     "RemoveNodeCommand",
     "MoveNodeCommand",
     "SetParamCommand",
-    "SetConfigCommand",
     "RenameCommand",
     "SetLayoutCommand",
     "SetPlanFieldCommand",
@@ -119,24 +118,6 @@ class SetParamCommand(_Command):
 
     def undo(self) -> None:
         self.document._apply_param(self.node_id, self.port, self.old)
-
-
-class SetConfigCommand(_Command):
-    """Change a logic node's setting (None removes it)."""
-
-    def __init__(self, document: PlanDocument, node_id: str, key: str, value: Any) -> None:
-        node = document.node(node_id)
-        super().__init__(document, f"Set {key} of {node.label}")
-        self.node_id = node_id
-        self.key = key
-        self.new = value
-        self.old = node.config.get(key)
-
-    def redo(self) -> None:
-        self.document._apply_config(self.node_id, self.key, self.new)
-
-    def undo(self) -> None:
-        self.document._apply_config(self.node_id, self.key, self.old)
 
 
 class RenameCommand(_Command):

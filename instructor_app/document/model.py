@@ -24,7 +24,6 @@ from instructor_app.document.commands import (
     MoveNodeCommand,
     RemoveNodeCommand,
     RenameCommand,
-    SetConfigCommand,
     SetLayoutCommand,
     SetParamCommand,
     SetPlanFieldCommand,
@@ -152,9 +151,6 @@ class PlanDocument(QObject):
 
     def set_param(self, node_id: str, port: str, binding: Binding | None) -> None:
         self._push(SetParamCommand(self, node_id, port, binding))
-
-    def set_config(self, node_id: str, key: str, value: Any) -> None:
-        self._push(SetConfigCommand(self, node_id, key, value))
 
     def rename(self, node_id: str, name: str) -> None:
         if self.node(node_id).name != name:
@@ -285,15 +281,6 @@ class PlanDocument(QObject):
             node.params.pop(port, None)
         else:
             node.params[port] = binding
-        self.node_changed.emit(node_id)
-        self.plan_changed.emit()
-
-    def _apply_config(self, node_id: str, key: str, value: Any) -> None:
-        node = self.node(node_id)
-        if value is None:
-            node.config.pop(key, None)
-        else:
-            node.config[key] = value
         self.node_changed.emit(node_id)
         self.plan_changed.emit()
 
