@@ -13,7 +13,8 @@ import pytest
 from engine.spec import Binding, NodeKind, NodeLayout, NodeSpec, ParameterDecl, PlanSpec
 from engine.tree import RunPolicy
 from engine.types import ParamType, Pose, Waypoint
-from instructor_app.document.model import DocumentError, PlanDocument
+from instructor_app.document.editing import PlanDocument
+from instructor_app.document.model import DocumentError
 
 Edit = Callable[[PlanDocument], Any]
 
