@@ -113,6 +113,10 @@ class MainWindow(QMainWindow):
             self.tabifyDockWidget(first, self.docks[name])
         first.raise_()
         self.resizeDocks([first], [180], Qt.Orientation.Vertical)
+        # The inspector gets most of the right-hand column; the Plan tabs below it less.
+        self.resizeDocks(
+            [self.docks["inspector"], self.docks["plan"]], [700, 200], Qt.Orientation.Vertical
+        )
         self.resizeDocks(
             [self.docks["palette"], self.docks["inspector"]], [240, 320], Qt.Orientation.Horizontal
         )

@@ -16,6 +16,7 @@ from PySide6.QtWidgets import (
     QLabel,
     QLineEdit,
     QScrollArea,
+    QSizePolicy,
     QVBoxLayout,
     QWidget,
 )
@@ -82,14 +83,18 @@ class InspectorPanel(QWidget):
         self.form.setFieldGrowthPolicy(QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
         holder_layout.addWidget(form_widget)
         holder_layout.addStretch(1)
-        scroll = QScrollArea()
-        scroll.setWidgetResizable(True)
-        scroll.setWidget(self._form_holder)
+        # The parameter area takes every pixel the panel has below the name and the doc line.
+        self.parameter_area = QScrollArea()
+        self.parameter_area.setWidgetResizable(True)
+        self.parameter_area.setWidget(self._form_holder)
+        self.parameter_area.setSizePolicy(
+            QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding
+        )
         layout = QVBoxLayout(self)
         layout.setContentsMargins(4, 4, 4, 4)
         for widget in (self.name_field, self.kind_label, self.doc_label):
-            layout.addWidget(widget)
-        layout.addWidget(scroll, 1)
+            layout.addWidget(widget, 0)
+        layout.addWidget(self.parameter_area, 1)
 
     # ------------------------------------------------------------------ public
 

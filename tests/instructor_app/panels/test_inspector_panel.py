@@ -224,3 +224,18 @@ def test_problems_are_marked_next_to_the_field(
     with qtbot.waitSignal(validation.problems_changed):
         pass
     assert panel.field_problem("target") == ""
+
+
+def test_the_parameter_area_grows_with_the_panel(qtbot: QtBot, panel: InspectorPanel) -> None:
+    panel.show_node("move")
+    panel.resize(360, 300)
+    panel.show()
+    qtbot.waitExposed(panel)
+    qtbot.waitUntil(lambda: panel.parameter_area.height() > 0)
+    small = panel.parameter_area.height()
+    panel.resize(360, 900)
+    qtbot.waitUntil(lambda: panel.parameter_area.height() >= small + 550)
+    # Everything but the name field and the two labels above it is the parameter area.
+    above = panel.parameter_area.geometry().top()
+    assert panel.parameter_area.geometry().bottom() >= panel.height() - 10
+    assert above < 200
