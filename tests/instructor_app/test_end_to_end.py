@@ -79,7 +79,7 @@ STEPS: list[Step] = [
      [("reference", ("ref", "BIN_POSE")), ("target", ("value", "over bin"))]),
     ("transfer", "", "gripper.open", "release", []),
     ("transfer or wait", "force failure", "force_failure", "then look again", []),
-    ("then look again", "timing.wait", "timing.wait", "WAIT", [("seconds", ("value", 1.0))]),
+    ("then look again", "wait", "wait", "WAIT", [("seconds", ("value", 1.0))]),
     ("cup to bin", "motion.move_to", "motion.move_to", "back to observe", OBSERVE),
 ]  # fmt: skip
 
