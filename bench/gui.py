@@ -91,7 +91,7 @@ class _PaintCounter(QObject):
 def measure_open(app: QApplication, path: Path) -> tuple[float, Any, Any]:
     """Seconds from ``document.open`` to the end of the first paint; (seconds, doc, view)."""
     from instructor_app.canvas import CanvasView
-    from instructor_app.document.model import PlanDocument
+    from instructor_app.document.editing import PlanDocument
 
     document = PlanDocument()
     view = CanvasView(document)

@@ -25,7 +25,8 @@ from PySide6.QtWidgets import (
 from engine.executor import ExecutorState
 from instructor_app.dialogs import APP_TITLE, DISCARD, SAVE, Dialogs
 from instructor_app.document.autosave import DEFAULT_INTERVAL_MS, Autosaver, offer_recoveries
-from instructor_app.document.model import DocumentError, PlanDocument
+from instructor_app.document.editing import PlanDocument
+from instructor_app.document.model import DocumentError
 from instructor_app.document.tree_ops import can_have_child
 from instructor_app.node_factory import make_node, manifest_or_none
 from instructor_app.panels.operator import OperatorPanel
@@ -129,6 +130,10 @@ class MainWindow(QMainWindow):
             self.tabifyDockWidget(first, self.docks[name])
         first.raise_()
         self.resizeDocks([first], [180], Qt.Orientation.Vertical)
+        # The inspector gets most of the right-hand column; the Plan tabs below it less.
+        self.resizeDocks(
+            [self.docks["inspector"], self.docks["plan"]], [700, 200], Qt.Orientation.Vertical
+        )
         self.resizeDocks(
             [self.docks["palette"], self.docks["inspector"]], [240, 320], Qt.Orientation.Horizontal
         )

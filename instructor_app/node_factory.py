@@ -11,7 +11,7 @@ import json
 from dataclasses import dataclass
 from typing import Any
 
-from engine.kinds import KIND_CONFIG, KIND_DOC
+from engine.kinds import KIND_DOC, KIND_PORTS, setting
 from engine.operations import OperationKind, OperationManifest, OperationNotFound, OperationSource
 from engine.spec import KIND_CATEGORY, Category, NodeKind, NodeSpec
 from instructor_app.errors import InstructorError
@@ -39,8 +39,13 @@ LOGIC_GROUPS: dict[Category, str] = {
     Category.LEAF: "Leaves",
 }
 
-# Values a fresh node's required settings start with, by ConfigField.kind.
-_SETTING_DEFAULTS: dict[str, Any] = {"count": 2, "seconds": 5.0, "wait_seconds": 1.0}
+# Values a fresh node's required ports start with (optional ones use the manifest's default).
+_START_VALUES: dict[NodeKind, float] = {
+    NodeKind.REPEAT: 2,
+    NodeKind.RETRY: 2,
+    NodeKind.TIMEOUT: 5.0,
+    NodeKind.WAIT: 1.0,
+}
 
 
 class NodeFactoryError(InstructorError):
@@ -133,12 +138,12 @@ def make_node(item: PaletteItem, manifest: OperationManifest | None = None) -> N
             raise NodeFactoryError(f"palette item {item.label!r} names no operation")
         name = readable(manifest.id if manifest is not None else item.op)
         return NodeSpec(NodeKind.OPERATION, name=name, op=item.op)
-    config = {
-        field.name: _SETTING_DEFAULTS[field.kind]
-        for field in KIND_CONFIG.get(item.kind, ())
-        if field.required and field.kind in _SETTING_DEFAULTS
+    params = {
+        port.name: setting(item.kind, port.name, _START_VALUES[item.kind])
+        for port in KIND_PORTS.get(item.kind, ())
+        if port.required and item.kind in _START_VALUES
     }
-    return NodeSpec(item.kind, name=item.label, config=config)
+    return NodeSpec(item.kind, name=item.label, params=params)
 
 
 def item_from_payload(payload: Any, registry: OperationSource) -> PaletteItem:

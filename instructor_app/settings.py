@@ -80,10 +80,6 @@ class AppSettings:
         self._set_recent(files[:MAX_RECENT])
         self.set_last_dir(Path(text).parent)
 
-    def remove_recent(self, path: str | Path) -> None:
-        text = str(Path(path).resolve())
-        self._set_recent([f for f in self.recent_files() if f != text])
-
     def clear_recent(self) -> None:
         self._set_recent([])
 

@@ -9,7 +9,7 @@ from PySide6.QtGui import QAction
 from PySide6.QtWidgets import QWidget
 
 from engine.spec import NodeKind
-from instructor_app.document.model import PlanDocument
+from instructor_app.document.editing import PlanDocument
 from instructor_app.node_factory import PaletteItem, make_node, manifest_or_none, readable
 from instructor_app.runtime.session import CellSession
 

@@ -16,7 +16,8 @@ from PySide6.QtWidgets import QMenu, QWidget
 from engine.spec import KIND_CATEGORY, Category, NodeKind, NodeLayout, NodeSpec
 from instructor_app.canvas.style import default_title
 from instructor_app.canvas.sync import has_position
-from instructor_app.document.model import SUBTREE_MIME, DocumentError, PlanDocument
+from instructor_app.document.editing import PlanDocument
+from instructor_app.document.model import SUBTREE_MIME, DocumentError
 from instructor_app.document.tree_ops import can_have_child
 
 __all__ = ["CanvasActions", "NodeFactory", "default_node_factory", "LOGIC_KINDS"]

@@ -103,9 +103,11 @@ def binding_text(binding: Binding) -> str:
 
 
 def _config_text(node: NodeSpec) -> str:
-    if not node.config:
-        return ""
-    return ", ".join(f"{key} {value}" for key, value in sorted(node.config.items()))
+    """A logic node's settings in one line ("count 3", "success any")."""
+    return ", ".join(
+        f"{port} {binding_text(binding).strip(chr(34))}"
+        for port, binding in sorted(node.params.items())
+    )
 
 
 def _param_lines(node: NodeSpec) -> tuple[str, ...]:

@@ -21,7 +21,7 @@ from instructor_app.canvas import ngqt_fast
 from instructor_app.canvas.items import TreeNode
 from instructor_app.canvas.layout import LayoutMetrics, descendant_count, tidy_layout
 from instructor_app.canvas.style import NodeLook, look_of
-from instructor_app.document.model import PlanDocument
+from instructor_app.document.editing import PlanDocument
 
 __all__ = ["GraphMirror", "has_position", "METRICS"]
 

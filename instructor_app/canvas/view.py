@@ -22,7 +22,8 @@ from instructor_app.canvas.actions import CanvasActions, NodeFactory, default_no
 from instructor_app.canvas.items import CHILD_PORT, PARENT_PORT, TreeNodeItem
 from instructor_app.canvas.sync import GraphMirror, has_position
 from instructor_app.canvas.viewer import PALETTE_MIME, CanvasViewer
-from instructor_app.document.model import DocumentError, PlanDocument
+from instructor_app.document.editing import PlanDocument
+from instructor_app.document.model import DocumentError
 from instructor_app.document.tree_ops import can_have_child
 
 __all__ = ["CanvasView", "PALETTE_MIME", "MIN_FIT_ZOOM"]

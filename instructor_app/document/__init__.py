@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
-from instructor_app.document.model import DocumentError, PlanDocument
+from instructor_app.document.editing import PlanDocument
+from instructor_app.document.model import DocumentError, PlanModel
 
-__all__ = ["DocumentError", "PlanDocument"]
+__all__ = ["DocumentError", "PlanDocument", "PlanModel"]

@@ -22,7 +22,8 @@ from pathlib import Path
 
 from PySide6.QtCore import QObject, QStandardPaths, QTimer, Signal
 
-from instructor_app.document.model import DocumentError, PlanDocument
+from instructor_app.document.editing import PlanDocument
+from instructor_app.document.model import DocumentError
 from instructor_app.errors import InstructorError
 
 __all__ = [

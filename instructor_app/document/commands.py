@@ -2,27 +2,24 @@
 
 Each command keeps exactly what it needs to put the plan back, so that undo restores the
 saved file byte for byte. Commands change the plan only through the document's
-``_apply_*`` primitives, which also tell the views.
+public mutators, which also tell the views.
 """
 
 from __future__ import annotations
 
 import copy
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from PySide6.QtGui import QUndoCommand
 
 from engine.spec import Binding, NodeLayout, NodeSpec
-
-if TYPE_CHECKING:
-    from instructor_app.document.model import PlanDocument
+from instructor_app.document.model import PlanModel
 
 __all__ = [
     "AddNodeCommand",
     "RemoveNodeCommand",
     "MoveNodeCommand",
     "SetParamCommand",
-    "SetConfigCommand",
     "RenameCommand",
     "SetLayoutCommand",
     "SetPlanFieldCommand",
@@ -30,7 +27,7 @@ __all__ = [
 
 
 class _Command(QUndoCommand):
-    def __init__(self, document: PlanDocument, text: str) -> None:
+    def __init__(self, document: PlanModel, text: str) -> None:
         super().__init__(text)
         self.document = document
 
@@ -40,7 +37,7 @@ class AddNodeCommand(_Command):
 
     def __init__(
         self,
-        document: PlanDocument,
+        document: PlanModel,
         node: NodeSpec,
         parent_id: str | None,
         index: int,
@@ -56,18 +53,16 @@ class AddNodeCommand(_Command):
         self.layout = {k: v for k, v in (layout or {}).items() if k in ids}
 
     def redo(self) -> None:
-        self.document._apply_insert(
-            copy.deepcopy(self.node), self.parent_id, self.index, self.layout
-        )
+        self.document.insert_node(copy.deepcopy(self.node), self.parent_id, self.index, self.layout)
 
     def undo(self) -> None:
-        self.document._apply_detach(self.node.id)
+        self.document.detach_node(self.node.id)
 
 
 class RemoveNodeCommand(_Command):
     """Delete a node with its subtree; undo puts back the subtree and its layout."""
 
-    def __init__(self, document: PlanDocument, node_id: str) -> None:
+    def __init__(self, document: PlanModel, node_id: str) -> None:
         parent_id, index, node = document.locate(node_id)
         super().__init__(document, f"Delete {node.label}")
         self.node_id = node_id
@@ -77,17 +72,17 @@ class RemoveNodeCommand(_Command):
         self.saved_layout: dict[str, NodeLayout] = {}
 
     def redo(self) -> None:
-        self.saved, self.saved_layout = self.document._apply_detach(self.node_id)
+        self.saved, self.saved_layout = self.document.detach_node(self.node_id)
 
     def undo(self) -> None:
         assert self.saved is not None
-        self.document._apply_insert(self.saved, self.parent_id, self.index, self.saved_layout)
+        self.document.insert_node(self.saved, self.parent_id, self.index, self.saved_layout)
 
 
 class MoveNodeCommand(_Command):
     """Reparent or reorder a node (its subtree moves with it)."""
 
-    def __init__(self, document: PlanDocument, node_id: str, parent_id: str, index: int) -> None:
+    def __init__(self, document: PlanModel, node_id: str, parent_id: str, index: int) -> None:
         old_parent, old_index, node = document.locate(node_id)
         super().__init__(document, f"Move {node.label}")
         self.node_id = node_id
@@ -95,17 +90,17 @@ class MoveNodeCommand(_Command):
         self.new = (parent_id, index)
 
     def redo(self) -> None:
-        self.document._apply_move(self.node_id, *self.new)
+        self.document.relocate_node(self.node_id, *self.new)
 
     def undo(self) -> None:
-        self.document._apply_move(self.node_id, *self.old)
+        self.document.relocate_node(self.node_id, *self.old)
 
 
 class SetParamCommand(_Command):
     """Bind an operation port to a fixed value or a reference, or unbind it (None)."""
 
     def __init__(
-        self, document: PlanDocument, node_id: str, port: str, binding: Binding | None
+        self, document: PlanModel, node_id: str, port: str, binding: Binding | None
     ) -> None:
         node = document.node(node_id)
         super().__init__(document, f"Set {port} of {node.label}")
@@ -115,32 +110,14 @@ class SetParamCommand(_Command):
         self.old = node.params.get(port)
 
     def redo(self) -> None:
-        self.document._apply_param(self.node_id, self.port, self.new)
+        self.document.set_binding(self.node_id, self.port, self.new)
 
     def undo(self) -> None:
-        self.document._apply_param(self.node_id, self.port, self.old)
-
-
-class SetConfigCommand(_Command):
-    """Change a logic node's setting (None removes it)."""
-
-    def __init__(self, document: PlanDocument, node_id: str, key: str, value: Any) -> None:
-        node = document.node(node_id)
-        super().__init__(document, f"Set {key} of {node.label}")
-        self.node_id = node_id
-        self.key = key
-        self.new = value
-        self.old = node.config.get(key)
-
-    def redo(self) -> None:
-        self.document._apply_config(self.node_id, self.key, self.new)
-
-    def undo(self) -> None:
-        self.document._apply_config(self.node_id, self.key, self.old)
+        self.document.set_binding(self.node_id, self.port, self.old)
 
 
 class RenameCommand(_Command):
-    def __init__(self, document: PlanDocument, node_id: str, name: str) -> None:
+    def __init__(self, document: PlanModel, node_id: str, name: str) -> None:
         node = document.node(node_id)
         super().__init__(document, f"Rename {node.label}")
         self.node_id = node_id
@@ -148,27 +125,27 @@ class RenameCommand(_Command):
         self.old = node.name
 
     def redo(self) -> None:
-        self.document._apply_rename(self.node_id, self.new)
+        self.document.rename_node(self.node_id, self.new)
 
     def undo(self) -> None:
-        self.document._apply_rename(self.node_id, self.old)
+        self.document.rename_node(self.node_id, self.old)
 
 
 class SetLayoutCommand(_Command):
     """Move nodes on the canvas or collapse/expand them (None: no stored layout)."""
 
     def __init__(
-        self, document: PlanDocument, layouts: dict[str, NodeLayout | None], text: str
+        self, document: PlanModel, layouts: dict[str, NodeLayout | None], text: str
     ) -> None:
         super().__init__(document, text)
         self.new = {k: copy.copy(v) for k, v in layouts.items()}
         self.old = {k: copy.copy(document.plan.layout.get(k)) for k in layouts}
 
     def redo(self) -> None:
-        self.document._apply_layout(self.new)
+        self.document.apply_layout(self.new)
 
     def undo(self) -> None:
-        self.document._apply_layout(self.old)
+        self.document.apply_layout(self.old)
 
 
 class SetPlanFieldCommand(_Command):
@@ -185,7 +162,7 @@ class SetPlanFieldCommand(_Command):
         "objects",
     )
 
-    def __init__(self, document: PlanDocument, field: str, value: Any) -> None:
+    def __init__(self, document: PlanModel, field: str, value: Any) -> None:
         if field not in self.FIELDS:
             raise ValueError(f"{field!r} is not a plan field")
         super().__init__(document, f"Change the plan's {field.replace('_', ' ')}")
@@ -194,7 +171,7 @@ class SetPlanFieldCommand(_Command):
         self.old = copy.deepcopy(getattr(document.plan, field))
 
     def redo(self) -> None:
-        self.document._apply_plan_field(self.field, copy.deepcopy(self.new))
+        self.document.apply_plan_field(self.field, copy.deepcopy(self.new))
 
     def undo(self) -> None:
-        self.document._apply_plan_field(self.field, copy.deepcopy(self.old))
+        self.document.apply_plan_field(self.field, copy.deepcopy(self.old))

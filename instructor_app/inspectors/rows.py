@@ -13,25 +13,22 @@ from PySide6.QtCore import QStringListModel, Qt, Signal
 from PySide6.QtWidgets import (
     QComboBox,
     QCompleter,
-    QDoubleSpinBox,
     QHBoxLayout,
     QLabel,
     QLineEdit,
-    QSpinBox,
     QStackedWidget,
     QVBoxLayout,
     QWidget,
 )
 
-from engine.kinds import ConfigField
 from engine.operations import Direction, PortSpec
 from engine.spec import Binding
 from engine.types import ParamType
 from instructor_app.inspectors.base import EditorContext, ParamEditor
 from instructor_app.inspectors.factory import concrete_types, editor_for
-from instructor_app.inspectors.units import display_unit, format_value
+from instructor_app.inspectors.units import format_value
 
-__all__ = ["PortRow", "ConfigRow", "MODE_UNSET", "MODE_VALUE", "MODE_REFERENCE"]
+__all__ = ["PortRow", "MODE_UNSET", "MODE_VALUE", "MODE_REFERENCE"]
 
 MODE_UNSET, MODE_VALUE, MODE_REFERENCE = 0, 1, 2
 
@@ -185,75 +182,3 @@ class PortRow(QWidget):
             self.binding_committed.emit(Binding.reference(name))
         elif self.port.direction is Direction.OUT:
             self.binding_committed.emit(None)
-
-
-class ConfigRow(QWidget):
-    """One setting of a logic node (count, seconds, parallel policy).
-
-    Signals:
-        value_committed(object): the new value, or None to remove an optional setting.
-    """
-
-    value_committed = Signal(object)
-
-    def __init__(self, field: ConfigField, parent: QWidget | None = None) -> None:
-        super().__init__(parent)
-        self.field = field
-        layout = QHBoxLayout(self)
-        layout.setContentsMargins(0, 0, 0, 0)
-        self.widget: QWidget = self._make_widget()
-        layout.addWidget(self.widget)
-        self.setToolTip(field.doc)
-
-    def _make_widget(self) -> QWidget:
-        optional = not self.field.required
-        if self.field.kind == "count":
-            spin = QSpinBox()
-            spin.setRange(0 if optional else 1, 1_000_000)
-            spin.setSpecialValueText("off" if optional else "")
-            spin.setKeyboardTracking(False)
-            spin.valueChanged.connect(lambda v: self.value_committed.emit(v or None))
-            return spin
-        if self.field.kind in ("seconds", "wait_seconds"):
-            spin_f = QDoubleSpinBox()
-            minimum = 0.0 if optional or self.field.kind == "wait_seconds" else 0.001
-            spin_f.setRange(minimum, 1e6)
-            spin_f.setDecimals(3)
-            spin_f.setSuffix(" " + display_unit("s").suffix)
-            spin_f.setSpecialValueText("off" if optional else "")
-            spin_f.setKeyboardTracking(False)
-            spin_f.valueChanged.connect(
-                lambda v: self.value_committed.emit(v if v or not optional else None)
-            )
-            return spin_f
-        combo = QComboBox()
-        combo.setEditable(True)
-        combo.setInsertPolicy(QComboBox.InsertPolicy.NoInsert)
-        combo.addItems(["all", "any"] if self.field.kind == "policy_success" else ["any"])
-        combo.setToolTip("a word, or a number of children")
-        combo.activated.connect(lambda _i: self._policy_finished())
-        line = combo.lineEdit()
-        if line is not None:
-            line.editingFinished.connect(self._policy_finished)
-        return combo
-
-    def _policy_finished(self) -> None:
-        assert isinstance(self.widget, QComboBox)
-        text = self.widget.currentText().strip().lower()
-        if text.isdigit() and int(text) >= 1:
-            self.value_committed.emit(int(text))
-        elif text in ("all", "any"):
-            self.value_committed.emit(text)
-        # Anything else is not a policy: the next load shows the stored one again.
-
-    def load(self, value: Any) -> None:
-        """Show the stored value (None: the default) without emitting."""
-        shown = self.field.default if value is None else value
-        self.widget.blockSignals(True)
-        if isinstance(self.widget, QSpinBox):
-            self.widget.setValue(int(shown or 0))
-        elif isinstance(self.widget, QDoubleSpinBox):
-            self.widget.setValue(float(shown or 0.0))
-        elif isinstance(self.widget, QComboBox):
-            self.widget.setEditText(str(shown))
-        self.widget.blockSignals(False)

@@ -1,7 +1,7 @@
 """The inspector: the parameter area of the paper's Figure 5 (3) for the selected node.
 
 It shows the node's name (editable), what it is and its doc, then the settings of a logic
-node (engine.kinds.KIND_CONFIG) or one row per port of an operation (from its manifest).
+node kind (engine.kinds.KIND_PORTS) or of an operation (from its manifest), one row type.
 Every finished edit is exactly one document command; edits that change nothing push none.
 The panel follows the document: a change of the shown node refreshes the rows in place.
 """
@@ -9,7 +9,6 @@ The panel follows the document: a change of the shown node refreshes the rows in
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
 
 from PySide6.QtCore import QStringListModel, Qt
 from PySide6.QtWidgets import (
@@ -17,18 +16,19 @@ from PySide6.QtWidgets import (
     QLabel,
     QLineEdit,
     QScrollArea,
+    QSizePolicy,
     QVBoxLayout,
     QWidget,
 )
 
-from engine.kinds import KIND_CONFIG, KIND_DOC
-from engine.operations import Direction, OperationSource
+from engine.kinds import KIND_DOC, KIND_PORTS
+from engine.operations import Direction, OperationSource, PortSpec
 from engine.spec import Binding, NodeKind, NodeSpec
 from engine.validation import ERROR, Problem
 from instructor_app.document import DocumentError, PlanDocument
 from instructor_app.inspectors.base import EditorContext
 from instructor_app.inspectors.factory import type_names
-from instructor_app.inspectors.rows import ConfigRow, PortRow
+from instructor_app.inspectors.rows import MODE_REFERENCE, PortRow
 from instructor_app.inspectors.units import display_unit
 from instructor_app.node_factory import manifest_or_none, readable
 
@@ -54,7 +54,6 @@ class InspectorPanel(QWidget):
         self._object_names: list[str] = []
         self._names = QStringListModel(self)
         self._port_rows: dict[str, PortRow] = {}
-        self._config_rows: dict[str, ConfigRow] = {}
         self._last_context = EditorContext()
         self._problems: list[Problem] = []
         self._field_labels: dict[str, QLabel] = {}
@@ -84,14 +83,18 @@ class InspectorPanel(QWidget):
         self.form.setFieldGrowthPolicy(QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
         holder_layout.addWidget(form_widget)
         holder_layout.addStretch(1)
-        scroll = QScrollArea()
-        scroll.setWidgetResizable(True)
-        scroll.setWidget(self._form_holder)
+        # The parameter area takes every pixel the panel has below the name and the doc line.
+        self.parameter_area = QScrollArea()
+        self.parameter_area.setWidgetResizable(True)
+        self.parameter_area.setWidget(self._form_holder)
+        self.parameter_area.setSizePolicy(
+            QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding
+        )
         layout = QVBoxLayout(self)
         layout.setContentsMargins(4, 4, 4, 4)
         for widget in (self.name_field, self.kind_label, self.doc_label):
-            layout.addWidget(widget)
-        layout.addWidget(scroll, 1)
+            layout.addWidget(widget, 0)
+        layout.addWidget(self.parameter_area, 1)
 
     # ------------------------------------------------------------------ public
 
@@ -143,9 +146,6 @@ class InspectorPanel(QWidget):
     def port_row(self, port: str) -> PortRow:
         return self._port_rows[port]
 
-    def config_row(self, key: str) -> ConfigRow:
-        return self._config_rows[key]
-
     # ------------------------------------------------------------------ layout
 
     def _find(self, node_id: str | None) -> NodeSpec | None:
@@ -164,7 +164,6 @@ class InspectorPanel(QWidget):
         while self.form.rowCount():
             self.form.removeRow(0)
         self._port_rows.clear()
-        self._config_rows.clear()
         self._field_labels.clear()
 
     def _add_row(self, name: str, text: str, tip: str, row: QWidget) -> None:
@@ -205,11 +204,9 @@ class InspectorPanel(QWidget):
         else:
             self.kind_label.setText(f"<b>{readable(node.kind.value)}</b>")
             self.doc_label.setText(KIND_DOC.get(node.kind, ""))
-            for field in KIND_CONFIG.get(node.kind, ()):
-                row = ConfigRow(field)
-                row.value_committed.connect(lambda v, key=field.name: self._set_config(key, v))
-                self._config_rows[field.name] = row
-                self._add_row(field.name, field.name, field.doc, row)
+            self._add_port_rows(KIND_PORTS.get(node.kind, ()))
+            for row in self._port_rows.values():  # logic-node ports take fixed values only
+                row.mode_combo.removeItem(MODE_REFERENCE)
         self._refresh(node)
         self._mark_problems()
 
@@ -223,8 +220,12 @@ class InspectorPanel(QWidget):
             return
         self.kind_label.setText(f"<b>{manifest.id}</b> ({manifest.kind.value})")
         self.doc_label.setText(manifest.doc)
+        self._add_port_rows(manifest.ports)
+
+    def _add_port_rows(self, ports: tuple[PortSpec, ...]) -> None:
+        """One row per port, of an operation or of a logic node kind: one row type for both."""
         context = self._last_context = self._context()
-        for port in manifest.ports:
+        for port in ports:
             row = PortRow(port, self._names, context)
             row.binding_committed.connect(lambda b, name=port.name: self._set_param(name, b))
             self._port_rows[port.name] = row
@@ -240,8 +241,6 @@ class InspectorPanel(QWidget):
             self.name_field.setText(node.name)
         for port, row in self._port_rows.items():
             row.load(node.params.get(port))
-        for key, config_row in self._config_rows.items():
-            config_row.load(node.config.get(key))
 
     def _update_context(self) -> None:
         context = self._context()
@@ -286,9 +285,3 @@ class InspectorPanel(QWidget):
         if node is None or node.params.get(port) == binding:
             return
         self.document.set_param(node.id, port, binding)
-
-    def _set_config(self, key: str, value: Any) -> None:
-        node = self._find(self._node_id)
-        if node is None or node.config.get(key) == value:
-            return
-        self.document.set_config(node.id, key, value)

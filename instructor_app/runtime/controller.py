@@ -20,7 +20,7 @@ from engine.executor import Executor, ExecutorState
 from engine.spec import PlanSpec
 from engine.status import Status
 from engine.validation import ERROR, Problem, has_errors, validate_plan
-from instructor_app.document.model import PlanDocument
+from instructor_app.document.editing import PlanDocument
 from instructor_app.runtime.pump import Batch, EventPump
 from instructor_app.runtime.session import CellSession
 

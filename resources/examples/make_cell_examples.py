@@ -61,7 +61,13 @@ class _Maker:
         return uuid.uuid5(_NAMESPACE, f"{self.example}/{self.count}").hex
 
     def node(self, kind: NodeKind, name: str, *children: NodeSpec, **config: Any) -> NodeSpec:
-        return NodeSpec(kind, name, self._id(), params={k: setting(kind, k, v) for k, v in config.items()}, children=list(children))
+        return NodeSpec(
+            kind,
+            name,
+            self._id(),
+            params={k: setting(kind, k, v) for k, v in config.items()},
+            children=list(children),
+        )
 
     def op(self, op: str, name: str, **params: Binding) -> NodeSpec:
         return NodeSpec(NodeKind.OPERATION, name, self._id(), op=op, params=params)

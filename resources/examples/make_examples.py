@@ -41,7 +41,13 @@ class _Maker:
         self.ids = _Ids(example)
 
     def node(self, kind: NodeKind, name: str = "", *children: NodeSpec, **config: Any) -> NodeSpec:
-        return NodeSpec(kind, name, self.ids(), params={k: setting(kind, k, v) for k, v in config.items()}, children=list(children))
+        return NodeSpec(
+            kind,
+            name,
+            self.ids(),
+            params={k: setting(kind, k, v) for k, v in config.items()},
+            children=list(children),
+        )
 
     def op(self, op: str, label: str = "", **params: Binding) -> NodeSpec:
         return NodeSpec(NodeKind.OPERATION, label, self.ids(), op=f"debug.{op}", params=params)

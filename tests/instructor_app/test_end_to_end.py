@@ -126,7 +126,7 @@ def shape(node: NodeSpec) -> tuple[Any, ...]:
     """A node and its subtree without ids: kind, op, name, bindings, settings."""
     params = {port: _binding(b) for port, b in sorted(node.params.items())}
     children = tuple(shape(child) for child in node.children)
-    return (node.kind, node.op, node.name, params, dict(node.config), children)
+    return (node.kind, node.op, node.name, params, children)
 
 
 def _binding(binding: Binding) -> tuple[Any, ...]:

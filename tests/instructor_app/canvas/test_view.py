@@ -18,7 +18,7 @@ from engine.status import Status
 from engine.types import ParamType
 from instructor_app.canvas import PALETTE_MIME, CanvasView
 from instructor_app.canvas.style import STATUS_COLOURS
-from instructor_app.document.model import PlanDocument
+from instructor_app.document.editing import PlanDocument
 
 
 def op_leaf(name: str = "", op: str = "motion.move_to") -> NodeSpec:

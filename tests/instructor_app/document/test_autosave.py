@@ -16,7 +16,7 @@ from instructor_app.document.autosave import (
     find_recoveries,
     offer_recoveries,
 )
-from instructor_app.document.model import PlanDocument
+from instructor_app.document.editing import PlanDocument
 
 
 @pytest.fixture

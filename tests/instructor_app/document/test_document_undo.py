@@ -13,7 +13,8 @@ import pytest
 from engine.spec import Binding, NodeKind, NodeLayout, NodeSpec, ParameterDecl, PlanSpec
 from engine.tree import RunPolicy
 from engine.types import ParamType, Pose, Waypoint
-from instructor_app.document.model import DocumentError, PlanDocument
+from instructor_app.document.editing import PlanDocument
+from instructor_app.document.model import DocumentError
 
 Edit = Callable[[PlanDocument], Any]
 
@@ -66,7 +67,9 @@ EDITS: dict[str, Edit] = {
         named(d, "detect CUP"), "then", Binding.reference("WHAT")
     ),
     "unbind param": lambda d: d.set_param(named(d, "detect CUP"), "ticks", None),
-    "set config": lambda d: d.set_config(named(d, "detect objects"), "success", "any"),
+    "set setting": lambda d: d.set_param(
+        named(d, "detect objects"), "success", Binding.fixed("any", ParamType.TEXT)
+    ),
     "rename": lambda d: d.rename(named(d, "detect BIN"), "find the bin"),
     "collapse": lambda d: d.set_collapsed(named(d, "transfer"), True),
     "layout": lambda d: d.set_layout(

@@ -7,7 +7,8 @@ import pytest
 from capabilities.base import CapabilityRegistry, NullCell
 from capabilities.debug import capability as debug_capability
 from capabilities.template import capability as template_capability
-from engine.spec import NodeKind, NodeSpec
+from engine.spec import Binding, NodeKind, NodeSpec
+from engine.types import ParamType
 from instructor_app.document import PlanDocument
 
 
@@ -24,6 +25,14 @@ def document(qapp: object) -> PlanDocument:
     root = doc.add_node(NodeSpec(NodeKind.SEQUENCE, "Main", id="root"))
     doc.add_node(NodeSpec(NodeKind.OPERATION, "Find", id="query", op="debug.query"), root)
     doc.add_node(NodeSpec(NodeKind.OPERATION, "Go", id="move", op="debug.pretend_move"), root)
-    doc.add_node(NodeSpec(NodeKind.WAIT, "Pause", id="wait", config={"seconds": 1.0}), root)
+    doc.add_node(
+        NodeSpec(
+            NodeKind.WAIT,
+            "Pause",
+            id="wait",
+            params={"seconds": Binding.fixed(1.0, ParamType.DURATION)},
+        ),
+        root,
+    )
     doc.undo_stack.clear()
     return doc

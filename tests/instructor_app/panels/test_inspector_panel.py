@@ -152,36 +152,28 @@ def test_output_name_and_completion(
     _undo_all_restores(document, before)
 
 
-def test_logic_settings_are_one_command_each(panel: InspectorPanel, document: PlanDocument) -> None:
-    before = document.serialized()
-    panel.show_node("wait")
-    row = panel.config_row("seconds")
-    assert row.widget.value() == 1.0
-    row.widget.setValue(2.5)
-    assert document.node("wait").config == {"seconds": 2.5}
-    root = document.add_node(NodeSpec(NodeKind.PARALLEL, id="par"), "root")
-    panel.show_node(root)
-    policy = panel.config_row("success")
-    assert policy.widget.currentText() == "all"
-    policy.widget.setEditText("2")
-    policy.widget.lineEdit().editingFinished.emit()
-    policy.widget.setEditText("nonsense")
-    policy.widget.lineEdit().editingFinished.emit()
-    assert document.node("par").config == {"success": 2}
-    assert document.undo_stack.count() == 3
-    _undo_all_restores(document, before)
-
-
-def test_optional_count_off_removes_the_setting(
+def test_logic_settings_are_port_rows_one_command_each(
     panel: InspectorPanel, document: PlanDocument
 ) -> None:
-    document.add_node(NodeSpec(NodeKind.ENFORCE, id="enf", config={"count": 3}), "root")
-    panel.show_node("enf")
-    spin = panel.config_row("count").widget
-    assert spin.value() == 3
-    spin.setValue(0)
-    assert document.node("enf").config == {}
-    assert spin.specialValueText() == "off"
+    before = document.serialized()
+    panel.show_node("wait")
+    row = panel.port_row("seconds")
+    assert row.mode == MODE_VALUE and row.mode_combo.count() == 2  # no reference for settings
+    assert row.editor is not None and row.editor.value() == 1.0
+    row.editor.set_value(2.5)
+    row.editor.value_committed.emit(2.5)
+    assert document.node("wait").params == {"seconds": Binding.fixed(2.5, ParamType.DURATION)}
+    root = document.add_node(NodeSpec(NodeKind.PARALLEL, id="par"), "root")
+    panel.show_node(root)
+    policy = panel.port_row("success")
+    assert policy.mode == MODE_UNSET and "default: all" in policy.mode_combo.currentText()
+    _choose(policy.type_combo, 1)
+    _choose(policy.mode_combo, MODE_VALUE)
+    assert policy.editor is not None
+    policy.editor.value_committed.emit(2.0)
+    assert document.node("par").params["success"] == Binding.fixed(2.0, ParamType.NUMBER)
+    assert document.undo_stack.count() >= 3
+    _undo_all_restores(document, before)
 
 
 def test_follows_document_changes(panel: InspectorPanel, document: PlanDocument) -> None:
@@ -232,3 +224,18 @@ def test_problems_are_marked_next_to_the_field(
     with qtbot.waitSignal(validation.problems_changed):
         pass
     assert panel.field_problem("target") == ""
+
+
+def test_the_parameter_area_grows_with_the_panel(qtbot: QtBot, panel: InspectorPanel) -> None:
+    panel.show_node("move")
+    panel.resize(360, 300)
+    panel.show()
+    qtbot.waitExposed(panel)
+    qtbot.waitUntil(lambda: panel.parameter_area.height() > 0)
+    small = panel.parameter_area.height()
+    panel.resize(360, 900)
+    qtbot.waitUntil(lambda: panel.parameter_area.height() >= small + 550)
+    # Everything but the name field and the two labels above it is the parameter area.
+    above = panel.parameter_area.geometry().top()
+    assert panel.parameter_area.geometry().bottom() >= panel.height() - 10
+    assert above < 200

@@ -7,9 +7,10 @@ import json
 import pytest
 
 from capabilities.base import Capability, CapabilityRegistry, NullCell
-from engine.kinds import check_config
+from engine.kinds import settings_of
 from engine.operations import OperationKind, OperationManifest
-from engine.spec import NodeKind
+from engine.spec import Binding, NodeKind
+from engine.types import ParamType
 from instructor_app.node_factory import (
     NodeFactoryError,
     PaletteItem,
@@ -66,8 +67,9 @@ def test_logic_nodes_start_with_valid_settings(
     registry: CapabilityRegistry, kind: NodeKind, config: dict[str, object]
 ) -> None:
     node = make_node(_item(registry, kind))
-    assert node.kind is kind and node.config == config
-    assert check_config(kind, node.config) == []
+    assert node.kind is kind
+    assert {k: b.value for k, b in node.params.items()} == config
+    settings_of(kind, node.params)  # raises when a start value does not fit
 
 
 def test_operation_node_has_fresh_id_readable_name_and_no_bindings(
@@ -108,6 +110,8 @@ def test_search_matches_every_word(registry: CapabilityRegistry) -> None:
 def test_make_node_for_kind_and_op(registry: CapabilityRegistry) -> None:
     node = make_node_for(NodeKind.OPERATION, "debug.query", registry)
     assert node.op == "debug.query" and node.name == "Query"
-    assert make_node_for("timeout", None, registry).config == {"seconds": 5.0}
+    assert make_node_for("timeout", None, registry).params == {
+        "seconds": Binding.fixed(5.0, ParamType.DURATION)
+    }
     with pytest.raises(NodeFactoryError):
         make_node_for("no_such_kind", None, registry)

@@ -9,7 +9,7 @@ import pytest
 from PySide6.QtCore import QObject
 
 from engine.status import Status
-from instructor_app.document.model import PlanDocument
+from instructor_app.document.editing import PlanDocument
 from instructor_app.runtime.controller import RunController, RunOutcome
 from instructor_app.runtime.session import CellSession
 from tests.instructor_app.runtime.plans import endless_plan, failing_plan, invalid_plan

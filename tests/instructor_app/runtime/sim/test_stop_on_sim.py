@@ -11,7 +11,7 @@ import pytest
 from engine.files import dump_plan
 from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
 from engine.types import JointConfig, ParamType
-from instructor_app.document.model import PlanDocument
+from instructor_app.document.editing import PlanDocument
 from instructor_app.runtime.controller import RunController
 from instructor_app.runtime.session import CellSession
 
