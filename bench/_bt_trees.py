@@ -1,4 +1,4 @@
-"""The benchmark trees of ``shared/bench/trees.json``, built in our engine and in py_trees.
+"""The benchmark trees of ``bench/trees/trees.json``, built in our engine and in py_trees.
 
 The file holds flat node tables (pre-order, node 0 the root) plus, per tree, the leaf
 behaviour, how to measure it and the counts a reference interpreter with memory semantics
@@ -98,8 +98,8 @@ class BuiltTree:
 
 
 def default_trees_path() -> Path:
-    """``../shared/bench/trees.json`` relative to the repository root."""
-    return Path(__file__).resolve().parents[1].parent / "shared" / "bench" / "trees.json"
+    """``bench/trees/trees.json``, the copy kept in this repository (see its README)."""
+    return Path(__file__).resolve().parent / "trees" / "trees.json"
 
 
 def load_trees(path: Path) -> list[TreeDef]:

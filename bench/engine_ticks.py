@@ -1,6 +1,6 @@
 """Tick cost of our engine against py_trees 2.x, and the executor's wake-up latency.
 
-Builds the four trees of ``shared/bench/trees.json`` in both engines in this process (see
+Builds the four trees of ``bench/trees/trees.json`` in both engines in this process (see
 ``bench/_bt_trees.py``), checks them against the file's expected counts (:func:`verify`, a
 counting pass on an instance of their own, never timed), then times them:
 
