@@ -45,7 +45,7 @@ class CollisionWorld:
         tool_center: tuple[float, float, float] = (0.0, 0.0, -0.065),
     ) -> None:
         # Imported here: loading the capability (the palette, the CLI) needs no pybullet.
-        p = importlib.import_module("pybullet")
+        p = importlib.import_module("capabilities.bullet").pybullet
         self._p = p
         self._library = library
         self._lock = threading.Lock()

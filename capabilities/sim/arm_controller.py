@@ -13,8 +13,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-import pybullet
 
+from capabilities.bullet import pybullet
 from capabilities.sim.commands import CommandHandle
 from capabilities.sim.freedrive import Freedrive
 from capabilities.sim.kinematics import UR5Kinematics

@@ -18,8 +18,8 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import pybullet as p
 
+from capabilities.bullet import pybullet as p
 from capabilities.sim.objects import SceneError
 from capabilities.sim.transforms import matrix_to_pose, pose_to_matrix
 from engine.types import Pose

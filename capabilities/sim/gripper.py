@@ -8,8 +8,7 @@ gripper's position sensor: closed, yet the fingers stopped apart.
 
 from __future__ import annotations
 
-import pybullet
-
+from capabilities.bullet import pybullet
 from capabilities.sim.commands import CommandHandle
 from capabilities.sim.physics_thread import PhysicsThread
 from capabilities.sim.robot import post_command

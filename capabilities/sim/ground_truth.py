@@ -10,8 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TypeVar
 
-import pybullet
-
+from capabilities.bullet import pybullet
 from capabilities.sim.gripper import GripperController
 from capabilities.sim.physics_thread import PhysicsThread
 from capabilities.sim.suction import SuctionController

@@ -20,7 +20,8 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-import pybullet as p
+
+from capabilities.bullet import pybullet as p
 
 __all__ = [
     "ARUCO_DICTIONARY",

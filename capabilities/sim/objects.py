@@ -5,8 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import pybullet as p
-
+from capabilities.bullet import pybullet as p
 from capabilities.object_library import (
     BoxPart,
     CollisionSpec,

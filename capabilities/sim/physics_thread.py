@@ -19,8 +19,7 @@ from collections.abc import Callable
 from concurrent.futures import Future
 from typing import Any, TypeVar
 
-import pybullet
-
+from capabilities.bullet import pybullet
 from capabilities.sim.errors import SimError
 
 __all__ = ["PhysicsThread", "StepHook"]

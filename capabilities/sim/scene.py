@@ -18,8 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import pybullet as p
-
+from capabilities.bullet import pybullet as p
 from capabilities.sim.markers_texture import MarkerTextures
 from capabilities.sim.objects import (
     ObjectLibrary,

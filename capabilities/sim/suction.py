@@ -11,8 +11,8 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-import pybullet
 
+from capabilities.bullet import pybullet
 from capabilities.sim.commands import CommandHandle
 from capabilities.sim.physics_thread import PhysicsThread
 from capabilities.sim.robot import post_command

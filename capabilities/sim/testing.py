@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import math
 
-import pybullet
-
+from capabilities.bullet import pybullet
 from capabilities.sim.cell import SimCell
 from capabilities.sim.commands import CommandHandle
 from engine.types import Pose

@@ -8,8 +8,8 @@ for friction or vacuum, decided by contact, never by perception.
 from __future__ import annotations
 
 import numpy as np
-import pybullet
 
+from capabilities.bullet import pybullet
 from capabilities.sim.transforms import matrix_to_pose, pose_to_matrix
 from engine.types import Pose
 

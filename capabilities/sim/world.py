@@ -10,8 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import pybullet
-
+from capabilities.bullet import pybullet
 from capabilities.sim.config import CellConfig
 from capabilities.sim.kinematics import UR5_JOINT_NAMES
 from capabilities.sim.robot_model import ROBOTS_DIR, robot_urdf_path
