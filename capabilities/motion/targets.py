@@ -19,7 +19,7 @@ from capabilities.motion.symmetry import ObjectSymmetry, SymmetryTable
 from engine.operations import OperationFailed
 from engine.types import JointConfig, Pose, Waypoint, WaypointFrame
 
-__all__ = ["ResolvedTarget", "TargetResolver", "symmetric_tool_poses"]
+__all__ = ["ResolvedTarget", "TargetResolver", "symmetric_rotations", "symmetric_tool_poses"]
 
 _CONTINUOUS_STEPS = 24  # fallbacks tried around a continuous symmetry, 15 deg apart
 
@@ -33,10 +33,12 @@ class ResolvedTarget:
     joints: JointConfig | None = None
 
 
-def symmetric_tool_poses(
+def symmetric_rotations(
     object_pose: Pose, tool_in_object: Pose, symmetry: ObjectSymmetry, current: Pose
 ) -> list[Pose]:
-    """The tool poses equivalent under the object's symmetry, least wrist rotation first.
+    """The object's symmetry rotations (object frame) that bring ``tool_in_object`` nearest
+    the tool's ``current`` orientation first: turn any pose taught relative to the object by
+    one of them and the object looks the same to it.
 
     For a continuous symmetry the best angle is found in closed form: with
     m = q_obj^-1 * q_now * q_tool^-1, the rotation r(t) about axis a that maximises
@@ -50,11 +52,22 @@ def symmetric_tool_poses(
         angles = tuple(best + 2 * math.pi * k / _CONTINUOUS_STEPS for k in range(_CONTINUOUS_STEPS))
     else:
         angles = symmetry.angles or (0.0,)
-    poses = [
-        object_pose.compose(axis_rotation(symmetry.axis, angle)).compose(tool_in_object)
-        for angle in angles
+    rotations = [axis_rotation(symmetry.axis, angle) for angle in angles]
+
+    def turn(rotation: Pose) -> float:
+        return rotation_between(current, object_pose.compose(rotation).compose(tool_in_object))
+
+    return sorted(rotations, key=turn)
+
+
+def symmetric_tool_poses(
+    object_pose: Pose, tool_in_object: Pose, symmetry: ObjectSymmetry, current: Pose
+) -> list[Pose]:
+    """The tool poses equivalent under the object's symmetry, least wrist rotation first."""
+    return [
+        object_pose.compose(rotation).compose(tool_in_object)
+        for rotation in symmetric_rotations(object_pose, tool_in_object, symmetry, current)
     ]
-    return sorted(poses, key=lambda pose: rotation_between(current, pose))
 
 
 class TargetResolver:

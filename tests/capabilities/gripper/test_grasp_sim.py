@@ -1,0 +1,75 @@
+"""gripper.grasp on the simulated cell: "grasp CUP at CUP_POSE" with the cup's pose from its
+markers in a rendered image, and a plate taken with the suction tool at its pose from
+model-based recognition. Ground truth is read only here, to check the object is lifted."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from capabilities.base import CapabilityRegistry
+from capabilities.sim.session import SimCellSession
+from engine.spec import Binding, NodeSpec
+from engine.status import Status
+from engine.types import JointConfig, ObjectModel, ParamType, Pose, Waypoint, WaypointFrame
+from tests.capabilities.motion.plans import op, run_plan, seq
+
+pytestmark = pytest.mark.sim
+
+OBSERVE = Waypoint("observe", WaypointFrame.JOINTS, joints=JointConfig((1.2, -1.9, 2.0, -1.6, -1.57, 0.0)))  # fmt: skip
+
+
+def _object(name: str) -> Binding:
+    return Binding.fixed(ObjectModel(name), ParamType.OBJECT)
+
+
+def _look_and_grasp(finder: str, detect: str, model: str, **grasp: object) -> NodeSpec:
+    return seq(
+        op("motion.move_to", "step out of view", target=OBSERVE),
+        op(f"{finder}.{detect}", "detect", camera="shoulder"),
+        op(f"{finder}.object_pose", "pose", object=_object(model), pose=Binding.reference("POSE")),
+        op("gripper.grasp", "grasp at POSE", object=_object(model), pose="$POSE", **grasp),
+    )
+
+
+@pytest.mark.parametrize(("seed", "grasp"), [(0, "first"), (4, "first"), (7, "rim")])
+def test_grasp_cup_at_cup_pose_lifts_the_cup(seed: int, grasp: str) -> None:
+    with SimCellSession("cup_to_bin", seed=seed) as session:
+        before = session.truth_pose("cup")
+        plan = _look_and_grasp("markers", "detect_markers", "cup", grasp=grasp)
+        run = run_plan(session, plan, CapabilityRegistry(cell=session), timeout=60)
+        assert run.status is Status.SUCCESS, run.failure()
+        assert session.sim.gripper.is_holding()
+        lifted = session.truth_pose("cup")
+        assert lifted.position[2] - before.position[2] > 0.12  # lifted back to the approach
+        assert math.dist(lifted.position[:2], before.position[:2]) < 0.02
+        tcp_height = 0.06 if grasp == "first" else 0.085  # where the fingers hold the cup
+        tcp = session.sim.robot.tcp_pose()
+        assert tcp.position[2] - lifted.position[2] == pytest.approx(tcp_height, abs=0.01)
+
+
+def test_grasp_plate_with_the_suction_tool_at_its_recognised_pose() -> None:
+    with SimCellSession("kitting", seed=0) as session:
+        before = session.truth_pose("plate_4_holes")
+        plan = seq(
+            op("tool.unholster"),
+            _look_and_grasp("perception", "detect_objects", "plate_4_holes"),
+        )
+        run = run_plan(session, plan, CapabilityRegistry(cell=session), timeout=120)
+        assert run.status is Status.SUCCESS, run.failure()
+        assert session.sim.suction.has_part()
+        lifted = session.truth_pose("plate_4_holes")
+        assert lifted.position[2] - before.position[2] > 0.08
+        assert math.dist(lifted.position[:2], before.position[:2]) < 0.02
+
+
+def test_a_gripper_grasp_with_the_suction_tool_in_hand_says_what_to_do() -> None:
+    with SimCellSession("cup_to_bin", seed=0) as session:
+        plan = seq(
+            op("tool.unholster"),
+            op("gripper.grasp", "grasp", object=_object("cup"), pose=Pose((0.5, 0.0, 0.0))),
+        )
+        run = run_plan(session, plan, CapabilityRegistry(cell=session), timeout=60)
+        assert run.status is Status.FAILURE
+        assert "put it back first (tool.holster)" in run.messages()["grasp"]
