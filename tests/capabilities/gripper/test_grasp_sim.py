@@ -73,3 +73,27 @@ def test_a_gripper_grasp_with_the_suction_tool_in_hand_says_what_to_do() -> None
         run = run_plan(session, plan, CapabilityRegistry(cell=session), timeout=60)
         assert run.status is Status.FAILURE
         assert "put it back first (tool.holster)" in run.messages()["grasp"]
+
+
+def test_figure3_literal_move_to_cup_pose_with_a_grasp_reference_then_close() -> None:
+    """The paper's "move to CUP_POSE", then "grasp" (close): the grasp reference makes the
+    move go through the grasp's approach to where the fingers close around the cup."""
+    with SimCellSession("cup_to_bin", seed=2) as session:
+        before = session.truth_pose("cup")
+        plan = seq(
+            op("motion.move_to", "step out of view", target=OBSERVE),
+            op("markers.detect_markers", "detect", camera="shoulder"),
+            op("markers.object_pose", "pose", object=_object("cup"), pose=Binding.reference("P")),
+            op("gripper.open"),
+            op("motion.move_to", "move to CUP_POSE", target="$P", reference="cup/top"),
+            op("gripper.close", "grasp"),
+            op("gripper.is_holding", "holding"),
+            op("motion.move_relative", "lift", dz=0.1),
+            op("motion.move_to", "bad reference", target="$P", reference="cup/side"),
+        )
+        run = run_plan(session, plan, CapabilityRegistry(cell=session), timeout=60)
+        assert run.statuses()["lift"] is Status.SUCCESS, run.failure()
+        assert session.truth_pose("cup").position[2] - before.position[2] > 0.08
+        assert run.status is Status.FAILURE
+        message = run.messages()["bad reference"]
+        assert "grasp reference 'cup/side'" in message and "(it has top, rim)" in message
