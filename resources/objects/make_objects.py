@@ -7,7 +7,8 @@ frame at the bottom centre, z up. The output is byte for byte reproducible; run
     python resources/objects/make_objects.py --check    # exit 1 if a file differs
 
 Needs numpy only. Objects: the paper's cup and waste bin (transport task) and the kitting
-task's metal plates with 3, 4 and 8 holes and the kit bin. Marker ids (DICT_4X4_50): cup 1-2,
+task's metal plates with 3, 4 and 8 holes and the kit bin. Grasps are taught here, once per
+model, relative to the object: the cup's for the gripper, the plates' for the suction tool. Marker ids (DICT_4X4_50): cup 1-2,
 waste bin 10-15, kit bin 20-25; scenes use 40-49 for fixed markers.
 """
 
