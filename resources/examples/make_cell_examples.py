@@ -111,6 +111,7 @@ def cup_to_bin() -> PlanSpec:
         "back to WAIT (forced to fail) and the root, which runs until success, looks again. "
         "Run it with: costar run cup_to_bin.costar.json --cell sim --seed N. Runs to SUCCESS.",
         RunPolicy.UNTIL_SUCCESS, waypoints=waypoints(), objects=["cup", "waste_bin"],
+        reset_cell=True,  # each run in the Instructor starts from the scene's seed
         id=uuid.uuid5(_NAMESPACE, "cup_to_bin").hex,
     )  # fmt: skip
 
@@ -127,6 +128,7 @@ def cup_to_bin_vision() -> PlanSpec:
         "object model and drops it over the bin; when the cup is not recognised it waits and looks "
         "again. Run it with: costar run cup_to_bin_vision.costar.json --cell sim --seed N.",
         RunPolicy.UNTIL_SUCCESS, waypoints=waypoints(), objects=["cup", "waste_bin"],
+        reset_cell=True,  # each run in the Instructor starts from the scene's seed
         id=uuid.uuid5(_NAMESPACE, "cup_to_bin_vision").hex,
     )  # fmt: skip
 
