@@ -13,7 +13,7 @@ from capabilities.sim.session import SimCellSession
 from engine.spec import Binding, NodeSpec
 from engine.status import Status
 from engine.types import JointConfig, ObjectModel, ParamType, Pose, Waypoint, WaypointFrame
-from tests.capabilities.motion.plans import op, run_plan, seq
+from tests.capabilities.motion.plans import build, op, run_plan, seq, sim_steps
 
 pytestmark = pytest.mark.sim
 
@@ -97,3 +97,21 @@ def test_figure3_literal_move_to_cup_pose_with_a_grasp_reference_then_close() ->
         assert run.status is Status.FAILURE
         message = run.messages()["bad reference"]
         assert "grasp reference 'cup/side'" in message and "(it has top, rim)" in message
+
+
+def test_halting_a_grasp_stops_the_arm() -> None:
+    with SimCellSession("cup_to_bin", seed=0) as session:
+        arm = session.sim.robot
+        cup = Pose((0.55, -0.1, 0.0))  # a pose as a query would give it; the cup need not be there
+        tree = build(session, op("gripper.grasp", object=_object("cup"), pose=cup))
+        assert tree.tick() is Status.RUNNING
+        moving = False
+        for _ in sim_steps(session, 0.05, 3.0):
+            assert tree.tick() is Status.RUNNING
+            if arm.is_moving():
+                moving = True
+                break
+        assert moving
+        tree.reset()
+        session.sim.wait_sim(0.3)
+        assert max(abs(v) for v in arm.joint_velocities()) < 0.01
