@@ -29,10 +29,12 @@ from engine.events import Event, LogMessage, RunFinished, StatusChanged
 from engine.executor import Executor
 from engine.files import PlanFileError, load_plan
 from engine.operations import OperationManifest
+from engine.run_report import FailureLog
 from engine.spec import PlanSpec
 from engine.status import Status
 from engine.trace import TraceError, TraceRecorder, format_timeline, read_trace
 from engine.types import encode_value
+from engine.units import format_value
 from engine.validation import Problem, has_errors, validate_plan
 from resources import plan_argument
 
@@ -148,7 +150,8 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         except BuildError as exc:
             print(f"error: {exc}", file=err)
             return EXIT_INVALID
-        listeners: list[Callable[[Event], None]] = []
+        failures = FailureLog(plan)
+        listeners: list[Callable[[Event], None]] = [failures]
         if args.verbose:
             listeners.append(_VerbosePrinter(plan, out))
         if args.trace:
@@ -164,7 +167,9 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             restore()
             if answerer is not None:
                 answerer.detach()
-        return _report(result, plan, tree.blackboard.snapshot(), out, args.verbose)
+        code = _report(result, plan, tree.blackboard.snapshot(), out, args.verbose)
+        _report_caught(failures, out)
+        return code
 
 
 def _wait(executor: Executor, timeout: float | None) -> RunFinished:
@@ -187,7 +192,7 @@ def _report(
 ) -> int:
     if verbose and board:
         for key, value in sorted(board.items()):
-            print(f"  {key} = {json.dumps(encode_value(value))}", file=out)
+            print(f"  {key} = {format_value(value)}", file=out)
     name = plan.name or "plan"
     if result.reason in ("stopped", "timeout"):
         print(f"{name}: {result.reason} after {result.tick} ticks", file=out)
@@ -198,6 +203,15 @@ def _report(
     note = f" ({result.message})" if result.message else ""
     print(f"{name}: {result.status.value} after {result.tick} ticks{note}", file=out)
     return EXIT_SUCCESS if result.status is Status.SUCCESS else EXIT_FAILURE
+
+
+def _report_caught(failures: FailureLog, out: TextIO) -> None:
+    """The failures the plan carried on past (a fallback, a retry), one line each."""
+    caught = failures.caught()
+    if caught:
+        print("  on the way:", file=out)
+        for failure in caught:
+            print(f"  - {failure.describe()}", file=out)
 
 
 def _manifest_json(manifest: OperationManifest, available: bool, reason: str) -> dict[str, Any]:

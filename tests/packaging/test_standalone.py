@@ -35,8 +35,8 @@ def test_a_clone_in_an_empty_folder_passes_the_bench_tests(tmp_path: Path) -> No
     assert sorted(p.name for p in tmp_path.iterdir()) == ["repo"]  # no ../shared beside it
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTEST_XDIST_WORKER")}
     result = subprocess.run(
-        [sys.executable, "-m", "pytest", "-q", "-p", "no:xdist", "-p", "no:cacheprovider"]
-        + ["tests/bench"],
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:xdist", "-p", "no:cacheprovider",
+         "tests/bench"],  # fmt: skip
         cwd=clone,
         env=env,
         capture_output=True,
