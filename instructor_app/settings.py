@@ -52,7 +52,7 @@ def app_version() -> str:
 def is_shipped_example(path: Path) -> bool:
     """Whether ``path`` is in the shipped examples folder (those files stay as shipped)."""
     try:
-        return path.resolve().is_relative_to(EXAMPLES_DIR)
+        return path.resolve().is_relative_to(EXAMPLES_DIR.resolve())
     except OSError:
         return False
 
