@@ -90,7 +90,6 @@ def measure_cameras(cell: SimCell) -> dict[str, Any]:
 
 def measure_cup_to_bin(seed: int = 0) -> dict[str, Any]:
     """Real-time factor of the cup-to-bin plan run by the engine on a fresh simulated cell."""
-    from pathlib import Path
 
     from capabilities.base import CapabilityRegistry
     from capabilities.sim.session import SimCellSession
