@@ -67,7 +67,14 @@ def test_none_cell_still_chooses_no_robot() -> None:
     assert "the none cell has no arm" in out and "leave out --cell none" in out
 
 
-@pytest.mark.parametrize("argv", [["validate", "--help"], ["validate", "example:cup_to_bin"]])
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["validate", "--help"],
+        ["validate", "example:cup_to_bin"],
+        ["run", "example:nodes/sequence", "--rate", "200"],
+    ],
+)
 def test_no_pybullet_banner_in_the_output(argv: list[str]) -> None:
     env = {k: v for k, v in os.environ.items() if k != "PYTEST_XDIST_WORKER"}
     done = subprocess.run(
