@@ -2,7 +2,8 @@
 
 Each check is a small function that returns a :class:`CheckResult`; :func:`checks` lists
 them in the order they are printed. A check of a real cell (the robot answers, the cameras
-stream) is one more such function, added by :func:`checks` when a cell file is given.
+stream) is one more such function, returned by :func:`cell_checks` for the cell file the
+command line names.
 
 Qt and OpenGL are probed in a child Python process: a missing platform plugin makes Qt abort
 the process, and a broken OpenGL driver can crash it, and neither may take the doctor down.
@@ -16,14 +17,13 @@ import argparse
 import os
 import subprocess
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TextIO
 
 from resources import example_plans, resource_path
 
-__all__ = ["CheckResult", "checks", "cmd_doctor", "run_checks"]
+__all__ = ["CheckResult", "cell_checks", "checks", "cmd_doctor", "run_checks"]
 
 MIN_PYTHON = (3, 11)
 PROBE_TIMEOUT = 60.0  # s; a first start of Qt or Mesa on a slow PC can take a while
@@ -156,22 +156,22 @@ def check_simulated_cell() -> CheckResult:
     return CheckResult("simulated cell", True, f"started with {arm} and closed")
 
 
-def checks(cell_file: Path | None = None) -> list[Check]:
-    """The checks to run, in order; with ``cell_file``, also those of that real cell.
-
-    Raises:
-        NotImplementedError: ``cell_file`` was given (the real cell's checks are not here yet).
-    """
-    base: list[Check] = [
+def checks(extra: Sequence[Check] = ()) -> list[Check]:
+    """The checks to run, in order: this computer's, then ``extra`` (a real cell's)."""
+    return [
         check_python,
         check_shipped_files,
         check_qt_platform,
         check_opengl,
         check_simulated_cell,
+        *extra,
     ]
-    if cell_file is not None:
-        raise NotImplementedError("checks of a real cell file are not available yet")
-    return base
+
+
+def cell_checks(args: argparse.Namespace) -> list[Check]:
+    """The checks of the real cell the command line names (the robot answers, the cameras
+    stream): the hook for ``costar doctor --cell FILE``; none until that option exists."""
+    return []
 
 
 def run_checks(to_run: list[Check], out: TextIO) -> int:
@@ -192,4 +192,4 @@ def run_checks(to_run: list[Check], out: TextIO) -> int:
 
 def cmd_doctor(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """``costar doctor``: exit 0 when every check is ok, 1 when one needs a fix."""
-    return run_checks(checks(), out)
+    return run_checks(checks(cell_checks(args)), out)

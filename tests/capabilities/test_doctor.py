@@ -46,14 +46,18 @@ def test_without_a_display_qt_and_opengl_say_how_to_get_one(
         assert "no display" in result.detail and "xvfb-run" in result.detail
 
 
-def test_the_checks_cover_python_files_qt_opengl_and_the_simulated_cell() -> None:
-    names = [check.__name__ for check in checks()]
+def test_the_checks_cover_python_files_qt_opengl_and_the_simulated_cell_then_a_cell() -> None:
+    def robot_answers() -> CheckResult:
+        return CheckResult("robot", True, "answers")
+
+    names = [check.__name__ for check in checks([robot_answers])]
     assert names == [
         "check_python",
         "check_shipped_files",
         "check_qt_platform",
         "check_opengl",
         "check_simulated_cell",
+        "robot_answers",
     ]
 
 
