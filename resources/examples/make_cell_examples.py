@@ -125,7 +125,7 @@ def cup_to_bin() -> PlanSpec:
         "markers, check the cup was found, query both poses, grasp the cup with waypoints taught "
         "relative to it and drop it over the bin. When the cup is not visible the selector falls "
         "back to WAIT (forced to fail) and the root, which runs until success, looks again. "
-        "Run it with: costar run example:cup_to_bin --seed N. Runs to SUCCESS.",
+        "Run it with: costar run cup_to_bin.costar.json --cell sim --seed N. Runs to SUCCESS.",
         RunPolicy.UNTIL_SUCCESS, waypoints=waypoints(), objects=["cup", "waste_bin"],
         id=uuid.uuid5(_NAMESPACE, "cup_to_bin").hex,
     )  # fmt: skip
@@ -141,7 +141,7 @@ def cup_to_bin_vision() -> PlanSpec:
         "camera's point cloud is matched to the cup and waste-bin models, the plan checks the "
         "cup was found, queries both poses, grasps the cup with waypoints taught relative to "
         "it and drops it over the bin; when the cup is not recognised it waits and looks "
-        "again. Run it with: costar run example:cup_to_bin_vision --seed N.",
+        "again. Run it with: costar run cup_to_bin_vision.costar.json --cell sim --seed N.",
         RunPolicy.UNTIL_SUCCESS, waypoints=waypoints(), objects=["cup", "waste_bin"],
         id=uuid.uuid5(_NAMESPACE, "cup_to_bin_vision").hex,
     )  # fmt: skip
