@@ -24,12 +24,12 @@ from PySide6.QtWidgets import (
 from engine.kinds import KIND_DOC, KIND_PORTS
 from engine.operations import Direction, OperationSource, PortSpec
 from engine.spec import Binding, NodeKind, NodeSpec
+from engine.units import display_unit
 from engine.validation import ERROR, Problem
 from instructor_app.document import DocumentError, PlanDocument
 from instructor_app.inspectors.base import EditorContext
 from instructor_app.inspectors.factory import type_names
 from instructor_app.inspectors.rows import MODE_REFERENCE, PortRow
-from instructor_app.inspectors.units import display_unit
 from instructor_app.node_factory import manifest_or_none, readable
 
 __all__ = ["InspectorPanel"]
