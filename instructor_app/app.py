@@ -141,6 +141,7 @@ def _screenshot(args: argparse.Namespace) -> int:
             return code
         finally:
             window.controller.shutdown()
+            window.cell_views.stop()
             window.autosaver.stop()
             window.hide()
             window.deleteLater()

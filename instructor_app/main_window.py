@@ -29,6 +29,7 @@ from instructor_app.document.editing import PlanDocument
 from instructor_app.document.model import DocumentError
 from instructor_app.document.tree_ops import can_have_child
 from instructor_app.node_factory import make_node, manifest_or_none
+from instructor_app.panels.cell_views import CellViews
 from instructor_app.panels.operator import OperatorPanel
 from instructor_app.panels.start_page import StartPage, find_examples
 from instructor_app.runtime.controller import RunController
@@ -87,6 +88,7 @@ class MainWindow(QMainWindow):
         self.operator_panel = OperatorPanel(self)
         self.failure_button = FailureButton(self._node_label, self)
         self.selection: list[str] = []
+        self.cell_views = CellViews(self.document, session, self._selected_node, parent=self)
         self._build_layout()
         self.actions_by_name: dict[str, QAction] = {}
         self._build_menus()
@@ -110,6 +112,13 @@ class MainWindow(QMainWindow):
         area = Qt.DockWidgetArea
         self._dock("palette", "Palette", self.views.palette, area.LeftDockWidgetArea)
         self._dock("inspector", "Inspector", self.views.inspector, area.RightDockWidgetArea)
+        # The cell's views: a column right of the inspector, cameras above the 3D scene.
+        self._dock("cameras", "Cameras", self.cell_views.cameras, area.RightDockWidgetArea)
+        self._dock("scene3d", "3D scene", self.cell_views.scene3d, area.RightDockWidgetArea)
+        self.splitDockWidget(
+            self.docks["inspector"], self.docks["cameras"], Qt.Orientation.Horizontal
+        )
+        self.splitDockWidget(self.docks["cameras"], self.docks["scene3d"], Qt.Orientation.Vertical)
         self._dock("plan", "Plan", self.views.plan_settings, area.RightDockWidgetArea)
         self._dock("waypoints", "Waypoints", self.views.waypoints, area.RightDockWidgetArea)
         self._dock("operator", "Operator", self.operator_panel, area.RightDockWidgetArea)
@@ -117,6 +126,9 @@ class MainWindow(QMainWindow):
         self.tabifyDockWidget(self.docks["plan"], self.docks["waypoints"])
         self.tabifyDockWidget(self.docks["waypoints"], self.docks["operator"])
         self.docks["plan"].raise_()  # the operator tab comes forward when the robot asks
+        self.resizeDocks(
+            [self.docks["cameras"], self.docks["scene3d"]], [420, 480], Qt.Orientation.Vertical
+        )
         bottom = [
             ("validation", "Problems", self.views.validation),
             ("log", "Log", self.views.log),
@@ -135,7 +147,9 @@ class MainWindow(QMainWindow):
             [self.docks["inspector"], self.docks["plan"]], [700, 200], Qt.Orientation.Vertical
         )
         self.resizeDocks(
-            [self.docks["palette"], self.docks["inspector"]], [240, 320], Qt.Orientation.Horizontal
+            [self.docks[n] for n in ("palette", "inspector", "cameras")],
+            [240, 320, 560],
+            Qt.Orientation.Horizontal,
         )
         self.cell_label = QLabel(" Cell: ")
         self.cell_combo = QComboBox(self)
@@ -225,6 +239,7 @@ class MainWindow(QMainWindow):
         views.canvas.selection_changed.connect(self._on_selection)
         views.canvas.message.connect(self.show_message)
         views.waypoints.message.connect(self.show_message)
+        self.cell_views.message.connect(self.show_message)
         self.session.cell_changed.connect(lambda _name: self._attach_operator())
         self.operator_panel.prompt_shown.connect(lambda _text: self._raise_dock("operator"))
         self._attach_operator()
@@ -267,6 +282,9 @@ class MainWindow(QMainWindow):
         """The operator panel answers the prompts of the cell in use (its "operator")."""
         cell = self.session.cell
         self.operator_panel.set_console(cell.interfaces().get("operator") if cell else None)
+
+    def _selected_node(self) -> str | None:
+        return self.selection[0] if len(self.selection) == 1 else None
 
     def _raise_dock(self, name: str) -> None:
         self.docks[name].show()
@@ -503,6 +521,7 @@ class MainWindow(QMainWindow):
             event.ignore()
             return
         self.controller.shutdown()
+        self.cell_views.stop()
         self.autosaver.stop()
         self.settings.save_window(self.saveGeometry(), self.saveState())
         event.accept()
