@@ -115,7 +115,9 @@ class Scene3DPanel(QWidget):
         view.setBackgroundColor((32, 32, 36))
         view.setMinimumHeight(260)
         # From behind the robot's left, looking at the table (the robot base is at the origin).
-        view.setCameraPosition(pos=pg_vector(0.35, 0.0, 0.1), distance=2.0, elevation=32, azimuth=200)
+        view.setCameraPosition(
+            pos=pg_vector(0.35, 0.0, 0.1), distance=2.0, elevation=32, azimuth=200
+        )
         view.gizmo_position = lambda: (
             None if self._gizmo is None else np.array(self._gizmo.position)
         )

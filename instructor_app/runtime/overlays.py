@@ -144,7 +144,7 @@ class OverlayPainter:
         for image in images:
             if len(pts) >= 3:
                 hull = cv2.convexHull(pts.reshape(-1, 1, 2))
-                cv2.polylines(image, [hull], True, OBJECT_COLOUR, 1, cv2.LINE_AA)
+                cv2.polylines(image, [hull], True, OBJECT_COLOUR, 1, cv2.LINE_8)
             else:
                 cv2.drawMarker(
                     image, tuple(int(c) for c in pts[0]), OBJECT_COLOUR, cv2.MARKER_CROSS, 12
@@ -163,7 +163,7 @@ class OverlayPainter:
             return
         pts = np.round(uv).astype(np.int32).reshape(-1, 1, 2)
         for image in images:
-            cv2.polylines(image, [pts], True, MARKER_COLOUR, 1, cv2.LINE_AA)
+            cv2.polylines(image, [pts], True, MARKER_COLOUR, 1, cv2.LINE_8)
             _text(
                 image,
                 f"#{marker_id}",
