@@ -212,7 +212,7 @@ class SimCellSession:
                     self.sim.config.holster_pose.compose(Pose((0.0, 0.0, 0.05))),
                     (0.12, 0.12, 0.10),
                 ),
-            ],  # fmt: skip
+            ],
         }
 
     def clock(self) -> float:

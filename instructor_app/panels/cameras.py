@@ -277,7 +277,7 @@ class CameraPanel(QWidget):
         shown = self.shown.get(camera)
         if shown is None:
             return False
-        z = _depth_near(shown.frame.depth, int(round(u)), int(round(v)))
+        z = _depth_near(shown.frame.depth, round(u), round(v))
         if z is None:
             self.message.emit("No depth there: press on something the camera sees")
             return False

@@ -9,7 +9,6 @@ from typing import Any
 
 from PySide6.QtCore import QObject, Signal
 
-from engine.types import Region
 from instructor_app.document.editing import PlanDocument
 from instructor_app.document.regions import plan_regions, save_region
 from instructor_app.panels.cameras import CameraPanel
@@ -75,8 +74,8 @@ class CellViews(QObject):
         self.scene3d.set_regions(regions)
         self.scene3d.set_waypoints(plan.waypoints)
 
-    def save_region(self, region: Region) -> str:
-        """Save a drawn region in the plan; returns where it went."""
+    def save_region(self, region: Any) -> str:
+        """Save a drawn region (an ``engine.types.Region``) in the plan; returns where it went."""
         where = save_region(self.document, region, self._selected(), self.region_name)
         c = region.center
         self.message.emit(

@@ -225,10 +225,11 @@ class Scene3DPanel(QWidget):
             if pose is not None:
                 set_pose(item, pose_to_matrix(pose))
 
-    def _on_gizmo_moved(self, position: np.ndarray, done: bool) -> None:
+    def _on_gizmo_moved(self, position: Any, done: Any) -> None:
         if self._gizmo is None:
             return
-        pose = Pose(tuple(float(v) for v in position), self._gizmo.orientation)
+        x, y, z = (float(v) for v in position)
+        pose = Pose((x, y, z), self._gizmo.orientation)
         self.set_gizmo(pose)
         (self.gizmo_released if done else self.gizmo_dragged).emit(pose)
 
@@ -299,14 +300,14 @@ class Scene3DPanel(QWidget):
     ) -> list[Any]:
         library = (self._cell.interfaces() if self._cell else {}).get("objects")
         try:
-            data = mesh_data(str(library.get(name).mesh_file))
-        except Exception:
+            data = mesh_data(str(library.get(name).mesh_file))  # type: ignore[union-attr]
+        except Exception:  # no library or an unknown class: a ball marks where it was seen
             data = gl.MeshData.sphere(rows=6, cols=8, radius=0.03)
         mesh = gl.GLMeshItem(meshdata=data, color=colour, shader="shaded",
                              glOptions="translucent" if colour[3] < 1 else "opaque")  # fmt: skip
         set_pose(mesh, pose_to_matrix(pose))
         text = gl.GLTextItem(
-            pos=np.array(pose.position) + (0, 0, 0.12), text=label, color=(230, 230, 230, 255)
+            pos=np.add(pose.position, (0, 0, 0.12)), text=label, color=(230, 230, 230, 255)
         )
         return [mesh, text]
 
@@ -352,7 +353,7 @@ class Scene3DPanel(QWidget):
         for name, region in self._regions:
             sphere = sphere_item(region.radius, REGION_RGBA)
             sphere.translate(*region.center)
-            items += [sphere, gl.GLTextItem(pos=np.array(region.center) + (0, 0, region.radius + 0.02),
+            items += [sphere, gl.GLTextItem(pos=np.add(region.center, (0, 0, region.radius + 0.02)),
                                             text=name, color=(255, 120, 220, 255))]  # fmt: skip
         self._replace("regions", items)
 
@@ -389,7 +390,7 @@ class Scene3DPanel(QWidget):
                 continue
             axes = axes_item()
             set_pose(axes, pose_to_matrix(pose))
-            items += [axes, gl.GLTextItem(pos=np.array(pose.position) + (0, 0, 0.03), text=waypoint.name,
+            items += [axes, gl.GLTextItem(pos=np.add(pose.position, (0, 0, 0.03)), text=waypoint.name,
                                           color=(200, 230, 255, 255))]  # fmt: skip
         self._replace("waypoints", items)
 
@@ -404,13 +405,13 @@ class Scene3DPanel(QWidget):
             return hit
         return ray_hit_plane(origin, direction, np.zeros(3), np.array([0.0, 0.0, 1.0]))
 
-    def _on_click(self, origin: np.ndarray, direction: np.ndarray) -> None:
+    def _on_click(self, origin: Any, direction: Any) -> None:
         hit = self.pick(origin, direction)
         if hit is not None:
             self.point_picked.emit(tuple(float(v) for v in hit))
             self.message.emit("Point: ({:.0f}, {:.0f}, {:.0f}) mm".format(*(hit * 1000)))
 
-    def _on_press(self, origin: np.ndarray, direction: np.ndarray) -> None:
+    def _on_press(self, origin: Any, direction: Any) -> None:
         hit = self.pick(origin, direction)
         self._draft = None if hit is None else (hit, -direction)
         self._replace("draft", [])
@@ -422,14 +423,14 @@ class Scene3DPanel(QWidget):
         edge = ray_hit_plane(origin, direction, centre, normal)
         return 0.0 if edge is None else float(np.linalg.norm(edge - centre))
 
-    def _on_drag(self, origin: np.ndarray, direction: np.ndarray) -> None:
+    def _on_drag(self, origin: Any, direction: Any) -> None:
         radius = self._draft_radius(origin, direction)
         if self._draft is not None and radius > 0.005:
             sphere = sphere_item(radius, (1.0, 0.25, 0.8, 0.35))
             sphere.translate(*self._draft[0])
             self._replace("draft", [sphere])
 
-    def _on_release(self, origin: np.ndarray, direction: np.ndarray) -> None:
+    def _on_release(self, origin: Any, direction: Any) -> None:
         radius = self._draft_radius(origin, direction)
         centre = self._draft[0] if self._draft is not None else None
         self._draft = None
@@ -437,7 +438,8 @@ class Scene3DPanel(QWidget):
         if centre is None or radius < 0.01:
             self.message.emit("Press on a surface and drag out the region's radius (at least 1 cm)")
             return
-        self.region_drawn.emit(Region(tuple(float(v) for v in centre), radius))
+        x, y, z = (float(v) for v in centre)
+        self.region_drawn.emit(Region((x, y, z), radius))
 
 
 def pg_vector(x: float, y: float, z: float) -> Any:

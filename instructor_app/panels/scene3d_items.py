@@ -53,7 +53,7 @@ def mesh_data(path: str) -> gl.MeshData:
     """The triangles of a mesh file as MeshData (read once per file)."""
     import open3d as o3d
 
-    mesh = o3d.io.read_triangle_mesh(path)
+    mesh = o3d.io.read_triangle_mesh(path)  # type: ignore[arg-type]  # open3d stubs want os.PathLike; str works
     if len(mesh.triangles) == 0:
         raise ValueError(f"{path}: no triangles")
     return gl.MeshData(

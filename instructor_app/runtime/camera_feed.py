@@ -54,6 +54,10 @@ class CameraFeed:
             ``rgbd:shoulder`` and ``rgbd:wrist``.
         painter: draws detections, markers and regions into the pictures (None: none).
         fps: the target rate of each camera.
+        max_duty: the largest share of wall time spent capturing: after a capture that took
+            d seconds the next waits at least d * (1 / max_duty - 1). A simulated camera
+            renders on the physics thread (and holds Python's GIL while it does), so this
+            keeps the simulation and the engine's ticks going when rendering is slow.
         size: (width, height) to capture at, for cameras whose ``capture`` takes a ``size``
             (a smaller preview renders faster); others give their own size.
         clock: monotonic seconds (tests may pass their own).
@@ -65,10 +69,12 @@ class CameraFeed:
         painter: OverlayPainter | None = None,
         fps: float = 15.0,
         size: tuple[int, int] | None = (320, 240),
+        max_duty: float = 0.3,
         clock: Callable[[], float] = time.perf_counter,
     ) -> None:
         self.cameras = dict(cameras)
         self.size = size
+        self.max_duty = max_duty
         self.painter = painter
         self.fps = fps
         self._clock = clock
@@ -116,6 +122,7 @@ class CameraFeed:
     def _run(self) -> None:
         next_due: dict[str, float] = {}
         seq: dict[str, int] = {}
+        not_before = 0.0
         while not self._stop.is_set():
             active = sorted(self._active)
             if not active:
@@ -125,7 +132,7 @@ class CameraFeed:
             period = 1.0 / max(self.fps, 0.1)
             now = self._clock()
             name = min(active, key=lambda n: next_due.get(n, 0.0))
-            wait = next_due.get(name, 0.0) - now
+            wait = max(next_due.get(name, 0.0), not_before) - now
             if wait > 0:
                 self._wake.wait(wait)
                 self._wake.clear()
@@ -134,7 +141,10 @@ class CameraFeed:
             # while a capture takes a good part of the period; a late camera does not burst.
             next_due[name] = max(next_due.get(name, now) + period, now)
             seq[name] = seq.get(name, 0) + 1
+            started = self._clock()
             self._capture(name, seq[name])
+            took = self._clock() - started
+            not_before = self._clock() + took * (1.0 / max(self.max_duty, 0.01) - 1.0)
 
     def _capture(self, name: str, seq: int) -> None:
         try:

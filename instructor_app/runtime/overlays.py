@@ -68,7 +68,7 @@ def unproject(frame: Any, u: float, v: float, depth: float) -> tuple[float, floa
 def _mesh_vertices(path: Any) -> np.ndarray:
     import open3d as o3d
 
-    mesh = o3d.io.read_triangle_mesh(str(path))
+    mesh = o3d.io.read_triangle_mesh(str(path))  # type: ignore[arg-type]  # open3d stubs want os.PathLike; str works
     vertices = np.asarray(mesh.vertices, dtype=float)
     if len(vertices) > _MESH_SAMPLE:
         vertices = vertices[np.linspace(0, len(vertices) - 1, _MESH_SAMPLE).astype(int)]
@@ -175,8 +175,8 @@ class OverlayPainter:
         uv, z = project(frame, np.array([region.center]))
         if z[0] <= 0.02:
             return
-        radius = int(round(frame.K[1, 1] * region.radius / z[0]))
-        centre = (int(round(uv[0, 0])), int(round(uv[0, 1])))
+        radius = round(frame.K[1, 1] * region.radius / z[0])
+        centre = (round(uv[0, 0]), round(uv[0, 1]))
         for image in images:
             overlay = image.copy()
             cv2.circle(overlay, centre, radius, REGION_COLOUR, -1, cv2.LINE_AA)

@@ -65,7 +65,9 @@ def test_detections_of_the_world_model_are_outlined_with_class_and_confidence(
     # in the test only).
     cell.world_model.replace("test", [Detection("cup", cell.truth_pose("cup"), 0.9, 0.0, "test")])
     try:
-        qtbot.waitUntil(lambda: panel.shown["shoulder"].seq > before + 1, timeout=20000)
+        # A frame painted after the detection arrived (the next one may have been painted
+        # before); a generous bound: on a loaded machine a CPU-rendered frame takes ~0.5 s.
+        qtbot.waitUntil(lambda: panel.shown["shoulder"].seq > before + 1, timeout=60000)
         shown = panel.shown["shoulder"]
         uv, _ = project(shown.frame, np.array([cell.truth_pose("cup").position]))
         u, v = (int(c) for c in uv[0])
