@@ -22,7 +22,7 @@ from typing import Any
 import cv2
 import numpy as np
 import pyqtgraph as pg
-from PySide6.QtCore import QPointF, Qt, QTimer, Signal
+from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtWidgets import (
     QCheckBox,
     QFileDialog,
@@ -107,7 +107,10 @@ class CameraPanel(QWidget):
         self.shown: dict[str, FeedFrame] = {}
         self.frames_shown = 0  # pictures put on screen (a camera's frame counts once)
         self.drawing = False
+        self._regions: tuple[tuple[str, Region], ...] = ()
+        # A region being drawn: (camera, centre in the world, its depth, centre pixel u, v).
         self._draft: tuple[str, tuple[float, float, float], float, float, float] | None = None
+        self._draft_radius_px = 0.0
         self._pictures: dict[str, tuple[_Picture, _Picture]] = {}
         self._build()
         self._timer = QTimer(self)
@@ -169,7 +172,10 @@ class CameraPanel(QWidget):
                 picture = _Picture(self, name, depth)
                 box.addItem(picture)
                 label = pg.TextItem(
-                    f"{name} {'depth' if depth else 'colour'}", color=(230, 230, 230), anchor=(0, 0)
+                    f"{name} {'depth' if depth else 'colour'}",
+                    color=(240, 240, 240),
+                    anchor=(0, 0),
+                    fill=(0, 0, 0, 140),
                 )
                 box.addItem(label)
                 pictures.append(picture)
@@ -178,8 +184,6 @@ class CameraPanel(QWidget):
         if not cameras:
             self.rate_label.setText("this cell has no cameras")
         self._update_active()
-
-    _regions: tuple[tuple[str, Region], ...] = ()
 
     def set_regions(self, regions: Iterable[tuple[str, Region]]) -> None:
         """The plan's regions to draw (name, sphere)."""
@@ -295,7 +299,6 @@ class CameraPanel(QWidget):
         _, _, _, u0, v0 = self._draft
         r = float(np.hypot(u - u0, v - v0))
         self._draft_item.setRect(u0 - r, v0 - r, 2 * r, 2 * r)
-        self._draft = (*self._draft[:3], u0, v0)
         self._draft_radius_px = r
 
     def finish_region(self) -> Region | None:
@@ -306,8 +309,7 @@ class CameraPanel(QWidget):
         self._draft = None
         if self._draft_item.scene() is not None:
             self._draft_item.scene().removeItem(self._draft_item)
-        radius_px = getattr(self, "_draft_radius_px", 0.0)
-        self._draft_radius_px = 0.0
+        radius_px, self._draft_radius_px = self._draft_radius_px, 0.0
         radius = radius_px * z / float(self.shown[camera].frame.K[1, 1])
         if radius < 0.01:
             self.message.emit("Drag out the region's radius (at least 1 cm)")
@@ -327,11 +329,3 @@ def _depth_near(depth: np.ndarray, u: int, v: int, reach: int = 4) -> float | No
         return float(depth[v, u])
     valid = patch[np.isfinite(patch)]
     return float(np.median(valid)) if valid.size else None
-
-
-def region_center_pixel(frame: Any, region: Region) -> QPointF:
-    """Where a region's centre shows in a frame (for tests and tooltips)."""
-    from instructor_app.runtime.overlays import project
-
-    uv, _ = project(frame, np.array([region.center]))
-    return QPointF(float(uv[0, 0]), float(uv[0, 1]))

@@ -25,7 +25,10 @@ from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtWidgets import QCheckBox, QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget
 
 from capabilities.geometry import pose_to_matrix
+from capabilities.motion.symmetry import SymmetryTable
+from capabilities.motion.targets import TargetResolver
 from capabilities.robot_body import robot_base_from_arm
+from engine.operations import OperationFailed
 from engine.types import Pose, Region, Waypoint, WaypointFrame
 from instructor_app.panels.scene3d_items import (
     RobotItems,
@@ -33,11 +36,10 @@ from instructor_app.panels.scene3d_items import (
     box_item,
     frustum_lines,
     mesh_data,
-    ray_hit_plane,
-    ray_hit_points,
     set_pose,
     sphere_item,
 )
+from instructor_app.panels.scene3d_pointing import PointingMixin
 from instructor_app.panels.scene3d_view import SceneView, opengl_problem
 
 __all__ = ["Scene3DPanel"]
@@ -49,7 +51,7 @@ TRUTH_RGBA = (1.0, 0.6, 0.1, 0.45)
 FrameSource = Callable[[str], Any]
 
 
-class Scene3DPanel(QWidget):
+class Scene3DPanel(PointingMixin, QWidget):
     """The cell in 3D (see the module doc).
 
     Signals:
@@ -143,10 +145,13 @@ class Scene3DPanel(QWidget):
         self.robot = self.ghost = None
         view.addItem(gl.GLGridItem(size=pg_vector(3, 3, 1), color=(255, 255, 255, 40)))
         interfaces = cell.interfaces() if cell is not None else {}
-        for _name, pose, size in (interfaces.get("scene_layout") or {}).get("fixtures", []):
+        self.table_z = 0.0  # picks fall on the table top when they miss the point cloud
+        for name, pose, size in (interfaces.get("scene_layout") or {}).get("fixtures", []):
             box = box_item(size, (0.55, 0.45, 0.35, 1.0))
             set_pose(box, pose_to_matrix(pose))
             view.addItem(box)
+            if name == "table":
+                self.table_z = pose.position[2] + size[2] / 2
         self.arm = interfaces.get("arm")
         if self.arm is not None:
             base = robot_base_from_arm(self.arm)
@@ -279,10 +284,12 @@ class Scene3DPanel(QWidget):
             return
         frame = latest.frame
         stride = max(1, frame.depth.shape[1] // 120)
-        points = frame.point_cloud(stride)
-        colours = frame.point_colors(stride).astype(np.float32) / 255.0
+        # The floor around the table says nothing about the task: only what is on the table.
+        keep = frame.point_cloud(stride)[:, 2] > self.table_z - 0.02
+        points = frame.point_cloud(stride)[keep]
+        colours = frame.point_colors(stride)[keep].astype(np.float32) / 255.0
         self.cloud.setData(
-            pos=points, color=np.column_stack((colours, np.ones(len(colours), np.float32)))
+            pos=points, color=np.column_stack((colours, np.full(len(colours), 0.8, np.float32)))
         )
         self.cloud.setVisible(True)
         self._cloud_points = points
@@ -358,29 +365,17 @@ class Scene3DPanel(QWidget):
         self._replace("regions", items)
 
     def _waypoint_pose(self, waypoint: Waypoint) -> Pose | None:
-        interfaces = self._cell.interfaces() if self._cell else {}
-        world = interfaces.get("world")
-        if (
-            waypoint.frame is WaypointFrame.JOINTS
-            and waypoint.joints is not None
-            and self.arm is not None
-        ):
-            return (
-                self.arm.forward_kinematics(waypoint.joints.positions)
-                if hasattr(self.arm, "forward_kinematics")
-                else None
-            )
-        if waypoint.pose is None:
+        """Where a waypoint is now, resolved as motion.move_to resolves it (a relative one
+        against the object or marker last seen); None when that cannot be told."""
+        if waypoint.frame is WaypointFrame.JOINTS:
+            fk = getattr(self.arm, "forward_kinematics", None)
+            return fk(waypoint.joints.positions) if fk and waypoint.joints else None
+        world = (self._cell.interfaces() if self._cell else {}).get("world")
+        try:
+            resolved = TargetResolver(world, SymmetryTable()).resolve(waypoint, None, Pose())
+        except OperationFailed:
             return None
-        if waypoint.frame is WaypointFrame.WORLD:
-            return waypoint.pose
-        if world is None:
-            return None
-        if waypoint.frame is WaypointFrame.OBJECT:
-            seen = world.best(waypoint.reference)
-            return seen.pose.compose(waypoint.pose) if seen is not None else None
-        marker = world.marker(int(waypoint.reference)) if waypoint.reference.isdigit() else None
-        return marker[0].compose(waypoint.pose) if marker is not None else None
+        return resolved.poses[0] if resolved.poses else None
 
     def _show_waypoints(self) -> None:
         items: list[Any] = []
@@ -393,53 +388,6 @@ class Scene3DPanel(QWidget):
             items += [axes, gl.GLTextItem(pos=np.add(pose.position, (0, 0, 0.03)), text=waypoint.name,
                                           color=(200, 230, 255, 255))]  # fmt: skip
         self._replace("waypoints", items)
-
-    # ------------------------------------------------------------------ picking
-
-    def pick(self, origin: np.ndarray, direction: np.ndarray) -> np.ndarray | None:
-        """The surface point a ray meets first: the point cloud, else the table top."""
-        hit = ray_hit_points(
-            origin, direction, getattr(self, "_cloud_points", np.zeros((0, 3))), 0.008
-        )
-        if hit is not None:
-            return hit
-        return ray_hit_plane(origin, direction, np.zeros(3), np.array([0.0, 0.0, 1.0]))
-
-    def _on_click(self, origin: Any, direction: Any) -> None:
-        hit = self.pick(origin, direction)
-        if hit is not None:
-            self.point_picked.emit(tuple(float(v) for v in hit))
-            self.message.emit("Point: ({:.0f}, {:.0f}, {:.0f}) mm".format(*(hit * 1000)))
-
-    def _on_press(self, origin: Any, direction: Any) -> None:
-        hit = self.pick(origin, direction)
-        self._draft = None if hit is None else (hit, -direction)
-        self._replace("draft", [])
-
-    def _draft_radius(self, origin: np.ndarray, direction: np.ndarray) -> float:
-        if self._draft is None:
-            return 0.0
-        centre, normal = self._draft
-        edge = ray_hit_plane(origin, direction, centre, normal)
-        return 0.0 if edge is None else float(np.linalg.norm(edge - centre))
-
-    def _on_drag(self, origin: Any, direction: Any) -> None:
-        radius = self._draft_radius(origin, direction)
-        if self._draft is not None and radius > 0.005:
-            sphere = sphere_item(radius, (1.0, 0.25, 0.8, 0.35))
-            sphere.translate(*self._draft[0])
-            self._replace("draft", [sphere])
-
-    def _on_release(self, origin: Any, direction: Any) -> None:
-        radius = self._draft_radius(origin, direction)
-        centre = self._draft[0] if self._draft is not None else None
-        self._draft = None
-        self._replace("draft", [])
-        if centre is None or radius < 0.01:
-            self.message.emit("Press on a surface and drag out the region's radius (at least 1 cm)")
-            return
-        x, y, z = (float(v) for v in centre)
-        self.region_drawn.emit(Region((x, y, z), radius))
 
 
 def pg_vector(x: float, y: float, z: float) -> Any:
