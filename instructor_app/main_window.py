@@ -155,8 +155,8 @@ class MainWindow(QMainWindow):
 
     def arrange_cell_views(self) -> None:
         """Cameras above the 3D scene in a column of their own right of the inspector when
-        the window is wide enough for it (1700 px); tabs beside the inspector otherwise (the
-        canvas keeps its room). Called when no saved layout is restored, and after a resize
+        the window is wide enough for it (1700 px); tabs beside Plan, Waypoints and Operator
+        otherwise (the canvas and the inspector keep their room). Called when no saved layout is restored, and after a resize
         for a picture."""
         docks = self.docks
         if self.width() >= 1700:
@@ -170,9 +170,9 @@ class MainWindow(QMainWindow):
                 [docks["palette"], docks["cameras"]], [240, 560], Qt.Orientation.Horizontal
             )
         else:
-            self.tabifyDockWidget(docks["inspector"], docks["cameras"])
+            self.tabifyDockWidget(docks["operator"], docks["cameras"])
             self.tabifyDockWidget(docks["cameras"], docks["scene3d"])
-            docks["inspector"].raise_()
+            docks["plan"].raise_()
 
     def _dock(self, name: str, title: str, widget: QWidget, area: Qt.DockWidgetArea) -> None:
         dock = QDockWidget(title, self)
