@@ -141,7 +141,8 @@ class Scene3DPanel(PointingMixin, QWidget):
             view.removeItem(item)
         self._cell = cell
         self.robot = self.ghost = None
-        view.addItem(gl.GLGridItem(size=pg_vector(3, 3, 1), color=(255, 255, 255, 40)))
+        grid = gl.GLGridItem(size=pg_vector(3, 3, 1), color=(255, 255, 255, 40))
+        view.addItem(grid)
         interfaces = cell.interfaces() if cell is not None else {}
         self.table_z = 0.0  # picks fall on the table top when they miss the point cloud
         for name, pose, size in (interfaces.get("scene_layout") or {}).get("fixtures", []):
@@ -150,6 +151,7 @@ class Scene3DPanel(PointingMixin, QWidget):
             view.addItem(box)
             if name == "table":
                 self.table_z = pose.position[2] + size[2] / 2
+                grid.translate(0.0, 0.0, pose.position[2] - size[2] / 2)  # the floor
         self.arm = interfaces.get("arm")
         if self.arm is not None:
             base = robot_base_from_arm(self.arm)
