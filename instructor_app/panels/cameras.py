@@ -179,6 +179,8 @@ class CameraPanel(QWidget):
                 pictures.append(picture)
             self._pictures[name] = (pictures[0], pictures[1])
         self.feed = CameraFeed(cameras, self.painter, self.fps)
+        feed = self.feed  # a panel deleted without stop() still ends its thread
+        self.destroyed.connect(lambda *_: feed.stop(0.5))
         if not cameras:
             self.rate_label.setText("this cell has no cameras")
         self._update_active()
