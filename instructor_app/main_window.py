@@ -29,6 +29,7 @@ from instructor_app.document.editing import PlanDocument
 from instructor_app.document.model import DocumentError
 from instructor_app.document.tree_ops import can_have_child
 from instructor_app.node_factory import make_node, manifest_or_none
+from instructor_app.panels.cell_views import CellViews
 from instructor_app.panels.operator import OperatorPanel
 from instructor_app.panels.start_page import StartPage, find_examples
 from instructor_app.runtime.controller import RunController
@@ -87,6 +88,7 @@ class MainWindow(QMainWindow):
         self.operator_panel = OperatorPanel(self)
         self.failure_button = FailureButton(self._node_label, self)
         self.selection: list[str] = []
+        self.cell_views = CellViews(self.document, session, self._selected_node, parent=self)
         self._build_layout()
         self.actions_by_name: dict[str, QAction] = {}
         self._build_menus()
@@ -110,6 +112,9 @@ class MainWindow(QMainWindow):
         area = Qt.DockWidgetArea
         self._dock("palette", "Palette", self.views.palette, area.LeftDockWidgetArea)
         self._dock("inspector", "Inspector", self.views.inspector, area.RightDockWidgetArea)
+        # The cell's views; where they go depends on the window's width (arrange_cell_views).
+        self._dock("cameras", "Cameras", self.cell_views.cameras, area.RightDockWidgetArea)
+        self._dock("scene3d", "3D scene", self.cell_views.scene3d, area.RightDockWidgetArea)
         self._dock("plan", "Plan", self.views.plan_settings, area.RightDockWidgetArea)
         self._dock("waypoints", "Waypoints", self.views.waypoints, area.RightDockWidgetArea)
         self._dock("operator", "Operator", self.operator_panel, area.RightDockWidgetArea)
@@ -147,6 +152,27 @@ class MainWindow(QMainWindow):
         # permanent: a temporary status message would hide a normal status-bar widget
         self.statusBar().addPermanentWidget(self.failure_button)
         self.statusBar().addPermanentWidget(self.problems_label)
+
+    def arrange_cell_views(self) -> None:
+        """Cameras above the 3D scene in a column of their own right of the inspector when
+        the window is wide enough for it (1700 px); tabs beside Plan, Waypoints and Operator
+        otherwise (the canvas and the inspector keep their room). Called when no saved layout is restored, and after a resize
+        for a picture."""
+        docks = self.docks
+        if self.width() >= 1700:
+            right, across = Qt.DockWidgetArea.RightDockWidgetArea, Qt.Orientation.Horizontal
+            self.addDockWidget(right, docks["cameras"], across)  # a full-height column
+            self.splitDockWidget(docks["cameras"], docks["scene3d"], Qt.Orientation.Vertical)
+            self.resizeDocks(
+                [docks["cameras"], docks["scene3d"]], [420, 480], Qt.Orientation.Vertical
+            )
+            self.resizeDocks(
+                [docks["palette"], docks["cameras"]], [240, 560], Qt.Orientation.Horizontal
+            )
+        else:
+            self.tabifyDockWidget(docks["operator"], docks["cameras"])
+            self.tabifyDockWidget(docks["cameras"], docks["scene3d"])
+            docks["plan"].raise_()
 
     def _dock(self, name: str, title: str, widget: QWidget, area: Qt.DockWidgetArea) -> None:
         dock = QDockWidget(title, self)
@@ -225,6 +251,7 @@ class MainWindow(QMainWindow):
         views.canvas.selection_changed.connect(self._on_selection)
         views.canvas.message.connect(self.show_message)
         views.waypoints.message.connect(self.show_message)
+        self.cell_views.message.connect(self.show_message)
         self.session.cell_changed.connect(lambda _name: self._attach_operator())
         self.operator_panel.prompt_shown.connect(lambda _text: self._raise_dock("operator"))
         self._attach_operator()
@@ -267,6 +294,9 @@ class MainWindow(QMainWindow):
         """The operator panel answers the prompts of the cell in use (its "operator")."""
         cell = self.session.cell
         self.operator_panel.set_console(cell.interfaces().get("operator") if cell else None)
+
+    def _selected_node(self) -> str | None:
+        return self.selection[0] if len(self.selection) == 1 else None
 
     def _raise_dock(self, name: str) -> None:
         self.docks[name].show()
@@ -497,12 +527,15 @@ class MainWindow(QMainWindow):
             self.resize(1400, 900)
         if state is not None:
             self.restoreState(state)
+        else:
+            self.arrange_cell_views()
 
     def closeEvent(self, event: QCloseEvent) -> None:
         if not self.maybe_save():
             event.ignore()
             return
         self.controller.shutdown()
+        self.cell_views.stop()
         self.autosaver.stop()
         self.settings.save_window(self.saveGeometry(), self.saveState())
         event.accept()
