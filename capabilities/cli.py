@@ -20,7 +20,7 @@ from capabilities.base import CapabilityError, CapabilityRegistry
 from capabilities.cells import CELL_NAMES, CellError, open_cell
 from capabilities.collaboration.answers import CONFIRM_MODES, PromptAnswerer
 from engine.build import BuildError, build_tree
-from engine.events import Event, LogMessage, RunFinished, StatusChanged
+from engine.events import Event, LogMessage, RunFinished, RunHeld, StatusChanged
 from engine.executor import Executor
 from engine.files import PlanFileError, load_plan
 from engine.operations import OperationManifest
@@ -100,21 +100,39 @@ class _VerbosePrinter:
             print(f"tick {event.tick:>5}  {path}: {event.message}", file=self._out, flush=True)
 
 
+_STOP_SIGNALS = ("SIGINT", "SIGTERM", "SIGHUP")  # Ctrl-C, kill, a closed terminal
+
+
 def _install_interrupt(executor: Executor) -> Callable[[], None]:
-    """Ctrl-C stops the run cleanly (halting what runs); returns a function to undo it."""
-    if threading.current_thread() is threading.main_thread():
-        previous = signal.getsignal(signal.SIGINT)
+    """Ctrl-C, SIGTERM and a closed terminal (SIGHUP) stop the run cleanly, halting what runs;
+    returns a function to undo it."""
+    if threading.current_thread() is not threading.main_thread():
+        return lambda: None
+    signals = [getattr(signal, name) for name in _STOP_SIGNALS if hasattr(signal, name)]
+    previous = {signum: signal.getsignal(signum) for signum in signals}
 
-        def on_interrupt(signum: int, frame: Any) -> None:
-            executor.stop("stopped", timeout=0)
+    def on_stop(signum: int, frame: Any) -> None:
+        executor.stop("stopped", timeout=0)
 
-        signal.signal(signal.SIGINT, on_interrupt)
+    for signum in signals:
+        signal.signal(signum, on_stop)
 
-        def restore() -> None:
-            signal.signal(signal.SIGINT, previous)
+    def restore() -> None:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
 
-        return restore
-    return lambda: None
+    return restore
+
+
+def _print_holds(out: TextIO) -> Callable[[Event], None]:
+    """A listener that says when a run is held by its cell (and when it goes on)."""
+
+    def on_event(event: Event) -> None:
+        if isinstance(event, RunHeld):
+            text = f"held: {event.reason}" if event.reason else "the cell is ready: resumed"
+            print(f"tick {event.tick:>5}  {text}", file=out, flush=True)
+
+    return on_event
 
 
 def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
@@ -136,12 +154,13 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         except BuildError as exc:
             print(f"error: {exc}", file=err)
             return EXIT_INVALID
-        listeners: list[Callable[[Event], None]] = []
+        listeners: list[Callable[[Event], None]] = [_print_holds(out)]
+        if args.trace:  # first: what a line on screen says is already in the trace
+            listeners.append(TraceRecorder(args.trace, plan))
         if args.verbose:
             listeners.append(_VerbosePrinter(plan, out))
-        if args.trace:
-            listeners.append(TraceRecorder(args.trace, plan))
-        executor = Executor(tree, args.rate, listeners, plan_name=plan.name)
+        hold = getattr(cell, "hold_reason", None)
+        executor = Executor(tree, args.rate, listeners, plan_name=plan.name, hold=hold)
         restore = _install_interrupt(executor)
         console = cell.interfaces().get("operator")
         answerer = PromptAnswerer(console, args.confirm, args.stdin, out) if console else None
