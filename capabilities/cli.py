@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from capabilities.base import CapabilityError, CapabilityRegistry
-from capabilities.cells import CELL_NAMES, CellError, open_cell
+from capabilities.cells import CELL_NAMES, CellError, is_cell_file, open_cell
 from capabilities.collaboration.answers import CONFIRM_MODES, PromptAnswerer
 from engine.build import BuildError, build_tree
 from engine.events import Event, LogMessage, RunFinished, RunHeld, StatusChanged
@@ -276,6 +276,15 @@ def _cmd_trace_show(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     return EXIT_SUCCESS
 
 
+def _cell_argument(value: str) -> str:
+    """A built-in cell name or the path of a cell file."""
+    if value in CELL_NAMES or is_cell_file(value):
+        return value
+    raise argparse.ArgumentTypeError(
+        f"{value!r} is not a cell: {', '.join(CELL_NAMES)}, or a cell file (*.cell.json)"
+    )
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="costar", description="CoSTAR task plans from the command line."
@@ -285,9 +294,10 @@ def _parser() -> argparse.ArgumentParser:
     def add_cell(p: argparse.ArgumentParser) -> None:
         p.add_argument(
             "--cell",
-            choices=CELL_NAMES,
+            type=_cell_argument,
             default="none",
-            help="the cell to run on (default: none, only cell-free capabilities)",
+            help="the cell to run on: none (only cell-free capabilities, the default), sim, "
+            "or a cell file (*.cell.json)",
         )
         p.add_argument("--seed", type=int, default=0, help="scene seed of the simulated cell")
         p.add_argument(
@@ -317,8 +327,14 @@ def _parser() -> argparse.ArgumentParser:
 
     ops = sub.add_parser("ops", help="list every operation with its parameters")
     ops.add_argument("--json", action="store_true")
-    ops.add_argument("--cell", choices=CELL_NAMES, default="none")
+    ops.add_argument("--cell", type=_cell_argument, default="none")
     ops.set_defaults(func=_cmd_ops)
+
+    sub.add_parser(  # handled in main(): its own options are the emulator's
+        "ur-emulator",
+        add_help=False,
+        help="a loopback UR controller backed by the simulated cell (--help for its options)",
+    )
 
     trace = sub.add_parser("trace", help="traces of runs")
     trace_sub = trace.add_subparsers(dest="trace_command", required=True)
@@ -337,6 +353,14 @@ def main(
     """Entry point of ``costar``; returns the exit code (``inp``: answers to prompts)."""
     out = out or sys.stdout
     err = err or sys.stderr
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv[:1] == ["ur-emulator"]:
+        from capabilities.ur.emulator.__main__ import main as emulator_main
+
+        try:
+            return emulator_main(argv[1:], prog="costar ur-emulator")
+        except SystemExit as exc:  # its argparse: bad arguments or --help
+            return int(exc.code or 0)
     parser = _parser()
     try:
         args = parser.parse_args(argv)

@@ -1,8 +1,11 @@
-"""Configuration of the simulated cell: where things stand, home joints, tool offsets.
+"""The cell file: where things stand, home joints, tool offsets, cameras, and the robot.
 
-Loaded from versioned JSON (``resources/cells/sim_default.json``). The world frame has z up;
-the UR base frame (what the robot's controller calls "base") stands at ``robot_base`` and
-the table top is at ``table_top_z``.
+One file type describes every cell (``*.cell.json``, schema ``resources/schemas/cell.schema
+.json``; the simulated cell's default is ``resources/cells/sim_default.json``). Its ``robot``
+block (``capabilities/cell_robot.py``) says whether the arm is the simulated one or a UR
+controller at a host. The world frame has z up; the UR base frame (what the robot's
+controller calls "base") stands at ``robot_base`` (the mounting) and the table top is at
+``table_top_z``. Format version 2 added ``robot`` and ``objects``; version 1 files still read.
 """
 
 from __future__ import annotations
@@ -11,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from capabilities.cell_robot import RobotSettings, read_robot
 from capabilities.sim.cameras import SHOULDER_EYE, SHOULDER_TARGET, WRIST_MOUNT, look_at
 from capabilities.sim.errors import SimError
 from engine.json_reader import JsonFileError, JsonReader, read_json_file
@@ -25,7 +29,8 @@ __all__ = [
     "FORMAT_VERSION",
 ]
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
+READABLE_VERSIONS = (1, 2)
 DEFAULT_CONFIG_PATH = (
     Path(__file__).resolve().parents[2] / "resources" / "cells" / "sim_default.json"
 )
@@ -101,6 +106,9 @@ class CellConfig:
         stand_size: width and depth (m) of the robot's stand, which reaches from the floor up
             to the robot base.
         cameras: the RGB-D cameras by name ("shoulder", "wrist").
+        robot: the ``robot`` block: the simulated arm, or a UR controller at a host.
+        objects: the object model library folder ("" for ``resources/objects``); a relative
+            path is relative to the cell file.
         capabilities: the raw ``capabilities`` block (capability name -> its settings),
             checked by the capability registry against each capability's declared settings.
         source: the file this configuration was read from ("" when made in code).
@@ -120,6 +128,8 @@ class CellConfig:
     stand_size: tuple[float, float] = (0.2, 0.2)
     cameras: dict[str, CameraSettings] = field(default_factory=_default_cameras)
     capabilities: dict[str, Any] = field(default_factory=dict)
+    robot: RobotSettings = field(default_factory=RobotSettings)
+    objects: str = ""
     source: str = field(default="", compare=False)
 
     @classmethod
@@ -178,17 +188,29 @@ class CellConfig:
                 for name, c in self.cameras.items()
             },
             "capabilities": self.capabilities,
+            "robot": self.robot.to_json(),
+            **({"objects": self.objects} if self.objects else {}),
         }
+
+    def objects_path(self) -> Path | None:
+        """The object library folder the file names (None: the default library)."""
+        if not self.objects:
+            return None
+        path = Path(self.objects)
+        return path if path.is_absolute() or not self.source else Path(self.source).parent / path
 
 
 FIELDS: tuple[str, ...] = ("format_version", "_comment", "robot_base", "home_joints", "tcp_offsets")
 FIELDS += ("holster_pose", "handle_grasp", "table", "stand_size", "cameras", "capabilities")
+FIELDS += ("robot", "objects")
 CAMERA_FIELDS = ("pose", "on_wrist", "size", "fov_y_deg", "near", "far")
 
 
 def _config(r: JsonReader) -> CellConfig:
     r.as_object(FIELDS)
-    r.check_version((FORMAT_VERSION,))
+    version = r.check_version(READABLE_VERSIONS)
+    if version == 1:
+        r.as_object(FIELDS[:-2])  # robot and objects came with version 2
     default = CellConfig()
     table = r.child("table", ("size", "center", "top_z"))
     home = r.vector("home_joints", 6, default.home_joints)
@@ -208,6 +230,8 @@ def _config(r: JsonReader) -> CellConfig:
         cameras=_cameras(r, default.cameras),
         # Each capability checks its own block against its settings schema (capabilities.kit).
         capabilities={name: entry.value for name, entry in r.entries("capabilities", "settings")},
+        robot=read_robot(r),
+        objects=r.text("objects", "", nonempty=False),
         source=r.file,
     )
 

@@ -12,7 +12,7 @@ import logging
 import queue
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from concurrent.futures import Future
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
@@ -83,12 +83,20 @@ class URConnection:
         host: the controller's address.
         tcp: the TCP as ``[x, y, z, rx, ry, rz]`` in the flange frame (sent with setTcp).
         rate: state polls per second.
+        payload: (mass kg, centre of gravity m in the flange frame), set with setPayload.
     """
 
-    def __init__(self, host: str, tcp: list[float] | None = None, rate: float = 125.0) -> None:
+    def __init__(
+        self,
+        host: str,
+        tcp: list[float] | None = None,
+        rate: float = 125.0,
+        payload: tuple[float, Sequence[float]] | None = None,
+    ) -> None:
         self.host = host
         self.version: PolyScopeVersion = (0, 0)
         self._tcp = list(tcp) if tcp is not None else [0.0] * 6
+        self._payload = payload
         self._period = 1.0 / rate
         self.state = URState()
         self._tasks: queue.Queue[Callable[[], None] | None] = queue.Queue()
@@ -216,11 +224,22 @@ class URConnection:
                 time.sleep(0.01)
         if any(self._tcp):
             self.control.setTcp(self._tcp)
+        if self._payload is not None and self._payload[0] > 0:
+            self.control.setPayload(self._payload[0], list(self._payload[1]))
         deadline = time.monotonic() + 2.0
         self.refresh()
         while not self.state.program_running and time.monotonic() < deadline:
             time.sleep(0.005)
             self.refresh()
+
+    def reconnect(self) -> None:
+        """(I/O thread) Drop the interfaces and connect afresh (the socket is really gone).
+
+        Raises:
+            Exception: whatever ur_rtde raises while the controller is still away.
+        """
+        self._disconnect()
+        self._connect()
 
     def with_io(self, fn: Callable[[Any], T]) -> T:
         """(I/O thread) ``fn(RTDEIOInterface)`` on an I/O interface opened for this call.

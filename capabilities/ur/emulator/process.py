@@ -33,6 +33,9 @@ class EmulatorProcess:
         speed: real-time factor of the simulated cell.
         unlock_delay: seconds before a protective stop can be unlocked.
         timeout: seconds to wait for the child to start and for each answer.
+        scene: a scene of the simulated cell around the arm (None: the arm alone).
+        seed: the scene's seed.
+        write_cell: write a cell file whose robot is this emulator.
     """
 
     def __init__(
@@ -42,6 +45,9 @@ class EmulatorProcess:
         speed: float = 1.0,
         unlock_delay: float = 5.0,
         timeout: float = 60.0,
+        scene: str | None = None,
+        seed: int = 0,
+        write_cell: str | Path | None = None,
     ) -> None:
         self.host = check_loopback(host)
         self.version = version
@@ -50,6 +56,10 @@ class EmulatorProcess:
             "--version", version, "--speed", str(speed), "--unlock-delay", str(unlock_delay),
             "--control", "stdin",
         ]  # fmt: skip
+        if scene is not None:
+            self._args += ["--scene", scene, "--seed", str(seed)]
+        if write_cell is not None:
+            self._args += ["--write-cell", str(write_cell)]
         self._timeout = timeout
         self._proc: subprocess.Popen[str] | None = None
         self._lock = threading.Lock()
