@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from capabilities.camera_source import SOURCE_KINDS
 from capabilities.cell_robot import RobotSettings, read_robot
 from capabilities.sim.cameras import SHOULDER_EYE, SHOULDER_TARGET, WRIST_MOUNT, look_at
 from capabilities.sim.errors import SimError
@@ -69,6 +70,9 @@ class CameraSettings:
         size: (width, height) of the images in pixels.
         fov_y_deg: vertical field of view in degrees.
         near, far: depth range (m); beyond it depth reads NaN.
+        source: where the frames come from: "sim" (rendered by the simulated cell),
+            "recorded" (a recording folder, ``where``) or "realsense" (serial ``where``).
+        where: the recording folder (relative to the cell file) or the RealSense serial.
     """
 
     pose: Pose
@@ -77,6 +81,8 @@ class CameraSettings:
     fov_y_deg: float = 45.0
     near: float = 0.1
     far: float = 3.0
+    source: str = "sim"
+    where: str = ""
 
 
 def _default_cameras() -> dict[str, CameraSettings]:
@@ -184,6 +190,7 @@ class CellConfig:
                     "fov_y_deg": c.fov_y_deg,
                     "near": c.near,
                     "far": c.far,
+                    **({"source": _source_json(c)} if c.source != "sim" else {}),
                 }
                 for name, c in self.cameras.items()
             },
@@ -191,6 +198,10 @@ class CellConfig:
             "robot": self.robot.to_json(),
             **({"objects": self.objects} if self.objects else {}),
         }
+
+    def folder(self) -> Path | None:
+        """The cell file's folder (None for a configuration made in code)."""
+        return Path(self.source).parent if self.source else None
 
     def objects_path(self) -> Path | None:
         """The object library folder the file names (None: the default library)."""
@@ -203,7 +214,28 @@ class CellConfig:
 FIELDS: tuple[str, ...] = ("format_version", "_comment", "robot_base", "home_joints", "tcp_offsets")
 FIELDS += ("holster_pose", "handle_grasp", "table", "stand_size", "cameras", "capabilities")
 FIELDS += ("robot", "objects")
-CAMERA_FIELDS = ("pose", "on_wrist", "size", "fov_y_deg", "near", "far")
+CAMERA_FIELDS = ("pose", "on_wrist", "size", "fov_y_deg", "near", "far", "source")
+_WHERE = {"recorded": "path", "realsense": "serial"}
+
+
+def _source_json(c: CameraSettings) -> dict[str, str]:
+    return {"kind": c.source, _WHERE[c.source]: c.where}
+
+
+def _source(entry: JsonReader, base: CameraSettings) -> tuple[str, str]:
+    """A camera's ``source``: {"kind": "sim"}, {"kind": "recorded", "path": FOLDER} or
+    {"kind": "realsense", "serial": SERIAL}."""
+    if not entry.has("source"):
+        return base.source, base.where
+    block = entry.child("source", ("kind", "path", "serial"), ("kind",))
+    kind = block.choice("kind", SOURCE_KINDS)
+    if kind == "sim":
+        block.as_object(("kind",))
+        return kind, ""
+    block.as_object(("kind", _WHERE[kind]))
+    if kind == "recorded":
+        return kind, block.text("path", nonempty=True)
+    return kind, block.text("serial", "")
 
 
 def _config(r: JsonReader) -> CellConfig:
@@ -253,6 +285,7 @@ def _cameras(r: JsonReader, default: dict[str, CameraSettings]) -> dict[str, Cam
             fov,
             near,
             far,
+            *_source(entry, base),
         )
     return cameras
 
