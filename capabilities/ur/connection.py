@@ -214,7 +214,7 @@ class URConnection:
         import rtde_control
 
         if self.control is None:
-            self.control = rtde_control.RTDEControlInterface(self.host)
+            self.control = _control_interface(rtde_control, self.host)
         elif not self.control.isProgramRunning():
             if not self.control.isConnected():
                 self.control.reconnect()
@@ -315,6 +315,24 @@ class URConnection:
                 obj.disconnect()
             except Exception:  # a dead controller: nothing more to close
                 _log.debug("disconnecting %s failed", name, exc_info=True)
+
+
+def _control_interface(module: Any, host: str, attempts: int = 3) -> Any:
+    """ur_rtde's RTDEControlInterface, tried again when its start-up races a script ending.
+
+    At start-up it stops a control script left running by an earlier client through the
+    dashboard; when that script ends on its own in between, "stop" fails ("Failed to
+    execute: stop") and the constructor throws, though a second try finds nothing to stop.
+    """
+    for attempt in range(attempts):
+        try:
+            return module.RTDEControlInterface(host)
+        except RuntimeError as exc:
+            if "stop" not in str(exc) or attempt == attempts - 1:
+                raise
+            _log.info("RTDEControlInterface start-up raced a script ending: %s", exc)
+            time.sleep(0.2)
+    raise AssertionError("unreachable")
 
 
 _POLL: Callable[[], None] = lambda: None  # noqa: E731  (marks a poll turn of the loop)
