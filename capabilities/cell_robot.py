@@ -6,6 +6,7 @@ its ``robot`` block says what moves: ``{"kind": "sim"}`` (the pybullet cell, the
     {"kind": "ur", "host": "192.168.1.10", "model": "UR5e",
      "payload": {"mass": 1.2, "center_of_gravity": [0, 0, 0.05]},
      "tool": {"kind": "suction", "vacuum": "tool 0", "sensor": "standard 1"},
+     (or "tool": {"kind": "robotiq"})
      "inputs": {"pedal": "standard 0"}}
 
 The mounting is the file's ``robot_base`` and the TCP its ``tcp_offsets`` entry for the tool.
@@ -22,7 +23,8 @@ __all__ = ["DigitalPinName", "Payload", "RobotSettings", "ToolSettings", "read_r
 
 ROBOT_KINDS = ("sim", "ur")
 UR_MODELS = ("UR5 CB3", "UR5e")  # CB3 controllers run PolyScope 3, e-Series PolyScope 5
-UR_TOOL_KINDS = ("suction",)
+UR_TOOL_KINDS = ("suction", "robotiq")
+TCP_OF_TOOL = {"suction": "suction", "robotiq": "gripper"}  # the tool's tcp_offsets entry
 INPUT_ROLES = ("pedal",)
 _BANKS = {"standard": 8, "configurable": 8, "tool": 2}
 
@@ -42,8 +44,9 @@ class ToolSettings:
     """The tool on the flange and the digital pins that drive it.
 
     Attributes:
-        kind: "suction" (a vacuum cup switched by a digital output).
-        vacuum: the output that switches the vacuum.
+        kind: "suction" (a vacuum cup switched by a digital output) or "robotiq" (a Robotiq
+            gripper through its URCap's socket on the controller, port 63352).
+        vacuum: the output that switches the vacuum (suction).
         sensor: the input that reads "part held" (None: the vacuum state stands in for it).
     """
 

@@ -1,7 +1,8 @@
 """A real UR cell as capabilities see it: the arm, its tool, and what the operator clears.
 
-``interfaces()`` gives ``arm`` and ``freedrive`` (the URArm), ``suction`` (a cup on a digital
-output), ``world``, ``workers``, ``objects`` (the cell file's object library),
+``interfaces()`` gives ``arm`` and ``freedrive`` (the URArm), the tool (``suction``, a cup on
+a digital output, or ``gripper``, a Robotiq gripper through its URCap), ``rgbd:<name>`` (the cell file's cameras whose source is recorded frames or a RealSense: a
+real cell renders nothing), ``world``, ``workers``, ``objects`` (the cell file's object library),
 ``scene_layout`` (marker sizes of the library) and ``operator``. :meth:`URCellSession.
 hold_reason` is the executor's hold check: it names a protective stop, an emergency stop, power
 off, a lost connection or a dead control script in words, so the run is held within one tick.
@@ -20,6 +21,9 @@ from dataclasses import dataclass
 from types import TracebackType
 from typing import Any
 
+from capabilities.camera_source import CameraSource
+from capabilities.camera_sources import open_source
+from capabilities.cell_robot import TCP_OF_TOOL
 from capabilities.collaboration.console import OperatorConsole
 from capabilities.jobs import WorkerPool
 from capabilities.object_library import ObjectLibrary
@@ -28,6 +32,7 @@ from capabilities.ur.arm import URArm
 from capabilities.ur.connection import NO_SCRIPT, URConnection, fault_reason
 from capabilities.ur.frames import URFrames
 from capabilities.ur.modes import RobotMode, SafetyMode
+from capabilities.ur.robotiq import RobotiqGripper
 from capabilities.ur.tool_io import DigitalPin, URSuctionCup
 from capabilities.world_model import WorldModel
 from engine.types import Pose
@@ -66,7 +71,7 @@ class URCellSession:
     def __init__(self, config: CellConfig, connect_timeout: float = 30.0) -> None:
         robot = config.robot
         self.config = config
-        tool_tcp = config.tcp_offsets.get(robot.tool.kind, Pose())
+        tool_tcp = config.tcp_offsets.get(TCP_OF_TOOL[robot.tool.kind], Pose())
         self.connection = URConnection(
             robot.host,
             tcp=URFrames(Pose()).to_ur(tool_tcp),
@@ -82,12 +87,26 @@ class URCellSession:
             self.workers.close()
             raise
         self.arm = URArm(self.connection, config.robot_base, tool_tcp, config.home_joints)
-        self.suction = URSuctionCup(
-            self.connection,
-            DigitalPin(*robot.tool.vacuum),
-            DigitalPin(*robot.tool.sensor) if robot.tool.sensor else None,
-        )
+        self.tool: dict[str, Any] = {}
+        self.cameras: dict[str, CameraSource] = {}
+        try:
+            self.tool = self._tool()
+            self.cameras = {
+                name: open_source(name, c.source, c.where, config.folder())
+                for name, c in config.cameras.items()
+                if c.source != "sim"
+            }
+        except BaseException:
+            self.close()
+            raise
         self.connection.watch(_Recovery())
+
+    def _tool(self) -> dict[str, Any]:
+        tool = self.config.robot.tool
+        if tool.kind == "robotiq":
+            return {"gripper": RobotiqGripper(self.connection)}
+        sensor = DigitalPin(*tool.sensor) if tool.sensor else None
+        return {"suction": URSuctionCup(self.connection, DigitalPin(*tool.vacuum), sensor)}
 
     # ---------------------------------------------------------------- what capabilities use
 
@@ -95,7 +114,8 @@ class URCellSession:
         return {
             "arm": self.arm,
             "freedrive": self.arm,
-            "suction": self.suction,
+            **self.tool,
+            **{f"rgbd:{name}": camera for name, camera in self.cameras.items()},
             "world": self.world_model,
             "workers": self.workers,
             "objects": self.library,

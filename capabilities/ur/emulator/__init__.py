@@ -1,7 +1,7 @@
 """A loopback UR controller backed by the simulated cell, for ur_rtde without a robot.
 
-It serves the dashboard (29999), the script port (30003) and RTDE (30004) on a loopback
-address, speaks ur_rtde's register handshake (the command registers are interpreted, the
+It serves the dashboard (29999), the script port (30003), RTDE (30004) and the Robotiq
+gripper URCap's socket (63352) on a loopback address, speaks ur_rtde's register handshake (the command registers are interpreted, the
 URScript is not) and moves the simulated arm. Faults can be injected from a test or the
 command line. Example::
 
@@ -17,6 +17,7 @@ from types import TracebackType
 
 from capabilities.sim.cell import SimCell
 from capabilities.ur.emulator.controller import VERSIONS, EmulatedController
+from capabilities.ur.emulator.robotiq import ROBOTIQ_PORT, robotiq_client
 from capabilities.ur.emulator.servers import (
     Server,
     check_loopback,
@@ -25,13 +26,13 @@ from capabilities.ur.emulator.servers import (
     script_client,
 )
 
-__all__ = ["UREmulator", "VERSIONS", "DASHBOARD_PORT", "SCRIPT_PORT", "RTDE_PORT"]
+__all__ = ["UREmulator", "VERSIONS", "DASHBOARD_PORT", "SCRIPT_PORT", "RTDE_PORT", "ROBOTIQ_PORT"]
 
 DASHBOARD_PORT, SCRIPT_PORT, RTDE_PORT = 29999, 30003, 30004
 
 
 class UREmulator:
-    """The loopback UR controller; a context manager.
+    """The loopback UR controller (with a Robotiq gripper's URCap); a context manager.
 
     Args:
         host: a loopback address (127.0.0.0/8); anything else is refused.
@@ -72,6 +73,7 @@ class UREmulator:
                 (DASHBOARD_PORT, dashboard_client),
                 (SCRIPT_PORT, script_client),
                 (RTDE_PORT, rtde_client),
+                (ROBOTIQ_PORT, robotiq_client),
             ):
                 self._servers.append(Server(self.host, port, self.controller, handler))
         except BaseException:

@@ -52,6 +52,7 @@ def run_command(emulator: UREmulator, line: str) -> dict[str, Any]:
             "program_running": ctl.program_running(), "q": list(snap["actual_q"]),
             "digital_outputs": ctl.digital_outputs(), "freedrive": ctl.freedrive_on,
             "speed_fraction": ctl.speed_fraction, "sim_time": emulator.cell.time(),
+            "gripper_closed": emulator.cell.gripper.is_closed(),
             "moving": ctl.arm_moving(), "messages": ctl.messages[-5:],
         }  # fmt: skip
     elif name != "quit":
@@ -93,11 +94,14 @@ def write_cell_file(path: str | Path, host: str, version: str, config: Any) -> N
     Raises:
         EmulatorError: the file cannot be written.
     """
-    from capabilities.cell_robot import RobotSettings
+    from capabilities.cell_robot import RobotSettings, ToolSettings
     from engine.plan_writer import write_atomic
 
     model = "UR5 CB3" if version.startswith("3.") else "UR5e"
-    cell = replace(config, robot=RobotSettings(kind="ur", host=host, model=model))
+    robot = RobotSettings(kind="ur", host=host, model=model, tool=ToolSettings("robotiq"))
+    # The emulated cell's gripper answers as a Robotiq. Its cameras render in the emulator's
+    # process only: a UR cell uses the cameras whose source is recorded frames or a RealSense.
+    cell = replace(config, robot=robot)
     data = json.dumps(cell.to_json(), indent=2) + "\n"
     try:
         write_atomic(Path(path), data.encode("utf-8"))

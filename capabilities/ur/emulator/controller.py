@@ -22,6 +22,7 @@ from capabilities.sim.cell import SimCell
 from capabilities.sim.commands import CommandHandle
 from capabilities.ur.emulator.faults import ContactWatch
 from capabilities.ur.emulator.program import ControlProgram
+from capabilities.ur.emulator.robotiq import RobotiqURCap
 from capabilities.ur.emulator.wire import OUTPUT_TYPES, output_type
 from capabilities.ur.frames import matrix_from_rotvec_pose, rotvec_pose_from_matrix
 from capabilities.ur.modes import RobotMode, RuntimeState, SafetyMode
@@ -79,6 +80,7 @@ class EmulatedController:
         self._base = pose_to_matrix(cell.config.robot_base)
         self._base_inv = np.linalg.inv(self._base)
         self.faults = ContactWatch(cell, self)
+        self.robotiq = RobotiqURCap(self)
         self._snapshot: dict[str, Any] = {}
         self._stop_event = threading.Event()
         self._thread = threading.Thread(target=self._run, name="ur-emulator-ctl", daemon=True)

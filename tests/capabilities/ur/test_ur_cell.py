@@ -25,6 +25,7 @@ from engine.executor import Executor
 from engine.files import save_plan
 from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
 from engine.status import RUNNING, SUCCESS
+from engine.trace import read_trace
 from engine.types import JointConfig, ParamType
 from tests.capabilities.ur.emulators import HOME, wait_for
 
@@ -130,13 +131,21 @@ def test_costar_run_with_a_cell_file_written_by_the_emulator(
     cell_file = tmp_path / "emulated.cell.json"
     emulator = start_emulator("5.12", write_cell=cell_file)
     assert CellConfig.load(cell_file).robot.host == emulator.host
-    _, plan = _plan(tmp_path, (0.25, -0.1))
+    spec, _ = _plan(tmp_path, (0.25, -0.1))
+    assert spec.tree is not None
+    grip = [NodeSpec(NodeKind.OPERATION, op=op) for op in ("gripper.close", "gripper.open")]
+    spec.tree.children = [spec.tree.children[0], *grip, spec.tree.children[1]]
+    plan = str(tmp_path / "moves_and_gripper.costar.json")
+    save_plan(spec, plan)
     out, err = io.StringIO(), io.StringIO()
     trace = tmp_path / "run.trace.jsonl"
     code = main(["run", plan, "--cell", str(cell_file), "--trace", str(trace)], out, err)
     assert code == 0, out.getvalue() + err.getvalue()
     assert "SUCCESS" in out.getvalue()
     assert emulator.state()["q"] == pytest.approx(list(_joints(-0.1)), abs=0.01)
+    done = {e["node"] for e in read_trace(trace).events if e.get("new") == "SUCCESS"}
+    assert {node.id for node in grip} <= done  # the Robotiq closed and opened
+    assert emulator.state()["gripper_closed"] is False
 
 
 def _ids(plan: PlanSpec) -> list[str]:
