@@ -6,7 +6,8 @@ interfaces (``rgbd:<name>``, through ``capabilities.kit.camera``) and use only w
 engine's or the GUI's) returns an :class:`RGBDFrame`; ``extrinsics()`` is where the cell
 believes the camera is, ``set_extrinsics()`` stores a calibration. Backends: the simulated
 cell's cameras (``capabilities.sim.session.SimCameraDevice``), recorded frames
-(``capabilities.recorded_frames``) and an Intel RealSense (``capabilities.realsense``), so the
+(``capabilities.recorded_frames``), frames served over a loopback socket (the UR emulator's
+cameras, ``capabilities.stream_camera``) and an Intel RealSense (``capabilities.realsense``), so the
 same perception runs on simulated, recorded and real frames. No Qt here: a camera panel can
 consume the same interface.
 """
@@ -23,7 +24,7 @@ from engine.types import Pose
 
 __all__ = ["CameraSource", "RGBDFrame", "SOURCE_KINDS"]
 
-SOURCE_KINDS = ("sim", "recorded", "realsense")
+SOURCE_KINDS = ("sim", "recorded", "realsense", "stream")
 
 
 @dataclass(frozen=True, eq=False)

@@ -1,4 +1,4 @@
-"""Opening the camera source a cell file names: recorded frames or a RealSense.
+"""Opening the camera source a cell file names: recorded frames, a frame stream, a RealSense.
 
 (The simulated cell renders its own cameras: ``capabilities.sim.session``.)
 """
@@ -18,8 +18,9 @@ def open_source(name: str, kind: str, where: str, base: Path | None = None) -> C
 
     Args:
         name: the camera's name in the cell.
-        kind: "recorded" (``where`` is the recording folder) or "realsense" (``where`` is the
-            device's serial number, "" for the only one connected).
+        kind: "recorded" (``where`` is the recording folder), "stream" (``where`` is the frame
+            server's "host:port") or "realsense" (``where`` is the device's serial number, ""
+            for the only one connected).
         base: the cell file's folder (a relative recording folder is relative to it).
 
     Raises:
@@ -32,10 +33,14 @@ def open_source(name: str, kind: str, where: str, base: Path | None = None) -> C
         if not folder.is_absolute() and base is not None:
             folder = base / folder
         return RecordedCamera(folder, name)
+    if kind == "stream":
+        from capabilities.stream_camera import StreamCamera
+
+        return StreamCamera(name, where)
     if kind == "realsense":
         from capabilities.realsense import RealSenseCamera
 
         return RealSenseCamera(name, where)
     raise CapabilityError(
-        f"camera {name}: source {kind!r} cannot be opened here (sources: recorded, realsense)"
+        f"camera {name}: source {kind!r} cannot be opened here (sources: recorded, stream, realsense)"
     )

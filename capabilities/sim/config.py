@@ -71,8 +71,10 @@ class CameraSettings:
         fov_y_deg: vertical field of view in degrees.
         near, far: depth range (m); beyond it depth reads NaN.
         source: where the frames come from: "sim" (rendered by the simulated cell),
-            "recorded" (a recording folder, ``where``) or "realsense" (serial ``where``).
-        where: the recording folder (relative to the cell file) or the RealSense serial.
+            "recorded" (a recording folder, ``where``), "stream" (a frame server at ``where``,
+            "host:port") or "realsense" (serial ``where``).
+        where: the recording folder (relative to the cell file), the frame server's address
+            or the RealSense serial.
     """
 
     pose: Pose
@@ -215,7 +217,7 @@ FIELDS: tuple[str, ...] = ("format_version", "_comment", "robot_base", "home_joi
 FIELDS += ("holster_pose", "handle_grasp", "table", "stand_size", "cameras", "capabilities")
 FIELDS += ("robot", "objects")
 CAMERA_FIELDS = ("pose", "on_wrist", "size", "fov_y_deg", "near", "far", "source")
-_WHERE = {"recorded": "path", "realsense": "serial"}
+_WHERE = {"recorded": "path", "realsense": "serial", "stream": "address"}
 
 
 def _source_json(c: CameraSettings) -> dict[str, str]:
@@ -223,19 +225,19 @@ def _source_json(c: CameraSettings) -> dict[str, str]:
 
 
 def _source(entry: JsonReader, base: CameraSettings) -> tuple[str, str]:
-    """A camera's ``source``: {"kind": "sim"}, {"kind": "recorded", "path": FOLDER} or
-    {"kind": "realsense", "serial": SERIAL}."""
+    """A camera's ``source``: {"kind": "sim"}, {"kind": "recorded", "path": FOLDER},
+    {"kind": "stream", "address": "HOST:PORT"} or {"kind": "realsense", "serial": SERIAL}."""
     if not entry.has("source"):
         return base.source, base.where
-    block = entry.child("source", ("kind", "path", "serial"), ("kind",))
+    block = entry.child("source", ("kind", "path", "serial", "address"), ("kind",))
     kind = block.choice("kind", SOURCE_KINDS)
     if kind == "sim":
         block.as_object(("kind",))
         return kind, ""
     block.as_object(("kind", _WHERE[kind]))
-    if kind == "recorded":
-        return kind, block.text("path", nonempty=True)
-    return kind, block.text("serial", "")
+    if kind == "realsense":
+        return kind, block.text("serial", "")
+    return kind, block.text(_WHERE[kind], nonempty=True)
 
 
 def _config(r: JsonReader) -> CellConfig:

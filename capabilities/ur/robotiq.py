@@ -91,9 +91,7 @@ class RobotiqGripper:
                     time.sleep(0.05)
             self._closed = self._get("PRE") >= 128
         except OSError as exc:
-            raise URError(
-                f"no Robotiq URCap at {self._conn.host}:{self._port}: {exc}"
-            ) from exc
+            raise URError(f"no Robotiq URCap at {self._conn.host}:{self._port}: {exc}") from exc
 
     # ---------------------------------------------------------------- the backend
 

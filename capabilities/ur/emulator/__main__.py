@@ -21,6 +21,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+from capabilities.stream_camera import FRAME_PORT
 from capabilities.ur.emulator import VERSIONS, UREmulator
 from capabilities.ur.emulator.servers import check_loopback
 from capabilities.ur.errors import EmulatorError
@@ -55,6 +56,11 @@ def run_command(emulator: UREmulator, line: str) -> dict[str, Any]:
             "gripper_closed": emulator.cell.gripper.is_closed(),
             "moving": ctl.arm_moving(), "messages": ctl.messages[-5:],
         }  # fmt: skip
+    elif name == "truth":  # GROUND TRUTH of a scene object, for tests that score a run
+        if emulator.truth is None or not args:
+            return {"ok": False, "error": "truth needs a scene (--scene) and an object name"}
+        pose = emulator.truth(args[0])
+        return {"ok": True, "position": list(pose.position), "orientation": list(pose.orientation)}
     elif name != "quit":
         return {"ok": False, "error": f"unknown command {name!r}"}
     return {"ok": True}
@@ -88,8 +94,11 @@ def _serve(emulator: UREmulator, args: argparse.Namespace, done: threading.Event
         done.wait()
 
 
-def write_cell_file(path: str | Path, host: str, version: str, config: Any) -> None:
-    """Write a cell file (atomically) whose robot is the emulator at ``host``.
+def write_cell_file(
+    path: str | Path, host: str, version: str, config: Any, cameras: bool = False
+) -> None:
+    """Write a cell file (atomically) whose robot is the emulator at ``host``; with
+    ``cameras``, its cameras are the emulator's frame streams.
 
     Raises:
         EmulatorError: the file cannot be written.
@@ -99,9 +108,13 @@ def write_cell_file(path: str | Path, host: str, version: str, config: Any) -> N
 
     model = "UR5 CB3" if version.startswith("3.") else "UR5e"
     robot = RobotSettings(kind="ur", host=host, model=model, tool=ToolSettings("robotiq"))
-    # The emulated cell's gripper answers as a Robotiq. Its cameras render in the emulator's
-    # process only: a UR cell uses the cameras whose source is recorded frames or a RealSense.
-    cell = replace(config, robot=robot)
+    # The emulated cell's gripper answers as a Robotiq; its cameras (with a scene) are served
+    # from the emulator's process. A UR cell ignores cameras whose source is "sim".
+    streams = {
+        name: replace(c, source="stream", where=f"{host}:{FRAME_PORT}")
+        for name, c in config.cameras.items()
+    }
+    cell = replace(config, robot=robot, cameras=streams if cameras else config.cameras)
     data = json.dumps(cell.to_json(), indent=2) + "\n"
     try:
         write_atomic(Path(path), data.encode("utf-8"))
@@ -117,7 +130,10 @@ def _emulator(args: argparse.Namespace, stack: contextlib.ExitStack) -> UREmulat
 
     check_loopback(args.host)  # refuse a bad host before building a scene
     session = stack.enter_context(SimCellSession(args.scene, args.seed, args.speed))
-    return UREmulator(args.host, args.version, cell=session.sim, unlock_delay=args.unlock_delay)
+    return UREmulator(
+        args.host, args.version, cell=session.sim, unlock_delay=args.unlock_delay,
+        cameras=session.cameras, truth=session.truth_pose,
+    )  # fmt: skip
 
 
 def main(argv: list[str] | None = None, prog: str = "python -m capabilities.ur.emulator") -> int:
@@ -159,7 +175,10 @@ def main(argv: list[str] | None = None, prog: str = "python -m capabilities.ur.e
         with contextlib.ExitStack() as stack:
             emulator = stack.enter_context(_emulator(args, stack))
             if args.write_cell:
-                write_cell_file(args.write_cell, args.host, args.version, emulator.cell.config)
+                write_cell_file(
+                    args.write_cell, args.host, args.version, emulator.cell.config,
+                    cameras=args.scene is not None,
+                )  # fmt: skip
             _serve(emulator, args, done)
     except EmulatorError as exc:
         print(f"error: {exc}", file=sys.stderr, flush=True)

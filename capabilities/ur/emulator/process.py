@@ -18,6 +18,7 @@ from typing import Any
 
 from capabilities.ur.emulator.servers import check_loopback
 from capabilities.ur.errors import EmulatorError
+from engine.types import Pose
 
 __all__ = ["EmulatorProcess"]
 
@@ -117,6 +118,11 @@ class EmulatorProcess:
     def state(self) -> dict[str, Any]:
         """Robot mode, safety mode, program, joints, outputs, freedrive, sim time."""
         return self.command("state")
+
+    def truth_pose(self, name: str) -> Pose:
+        """GROUND TRUTH of a scene object's pose (tests and scores only)."""
+        answer = self.command(f"truth {name}")
+        return Pose(tuple(answer["position"]), tuple(answer["orientation"]))
 
     def protective_stop(self, at: float | None = None, on_contact: bool = False) -> None:
         arg = " on_contact" if on_contact else (f" at={at}" if at is not None else "")

@@ -53,8 +53,10 @@ class RobotiqURCap:
             elif self._values["STA"] != 3:
                 self._values["STA"] = 3  # activation: the fingers already know their range
                 self._open_gap = max(self._open_gap, self._ctl.cell.gripper.gap())
-            if self._values["STA"] == 3 and self._values["GTO"] and (
-                any(n in ("POS", "GTO") for n, _ in pairs)
+            if (
+                self._values["STA"] == 3
+                and self._values["GTO"]
+                and (any(n in ("POS", "GTO") for n, _ in pairs))
             ):
                 self._go(self._values["PRE"] >= _CLOSE_FROM)
         return True

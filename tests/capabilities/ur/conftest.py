@@ -20,7 +20,8 @@ def start_emulator() -> Iterator[Callable[..., EmulatorProcess]]:
     started: list[EmulatorProcess] = []
 
     def start(version: str = "5.12", **options: Any) -> EmulatorProcess:
-        emulator = EmulatorProcess(next_host(), version, unlock_delay=0.0, **options).start()
+        options.setdefault("unlock_delay", 0.0)
+        emulator = EmulatorProcess(next_host(), version, **options).start()
         started.append(emulator)
         return emulator
 

@@ -221,3 +221,20 @@ def test_a_killed_controller_mid_move_holds_the_run_with_connection_lost(
         executor.stop()
         result = executor.wait(20)
         assert result is not None and result.reason == "stopped"
+
+
+@pytest.mark.sim
+def test_cup_to_bin_runs_on_the_emulated_ur_cell_through_ur_rtde(
+    tmp_path: Path, start_emulator
+) -> None:
+    """The real-robot path end to end: ur_rtde moves, the Robotiq URCap grips, the cameras
+    are the emulator's frame streams; the cup ends in the bin (ground truth scores it)."""
+    from tests.capabilities.sim.test_cup_to_bin import cup_in_bin
+
+    cell_file = tmp_path / "emulated.cell.json"
+    emulator = start_emulator("5.12", speed=2.0, scene="cup_to_bin", seed=3, write_cell=cell_file)
+    out, err = io.StringIO(), io.StringIO()
+    plan = str(ROOT / "resources" / "examples" / "cup_to_bin.costar.json")
+    code = main(["run", plan, "--cell", str(cell_file), "--timeout", "120"], out, err)
+    assert code == 0, out.getvalue() + err.getvalue()
+    assert cup_in_bin(emulator.truth_pose("cup"), emulator.truth_pose("waste_bin"))
