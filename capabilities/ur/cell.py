@@ -6,6 +6,10 @@ real cell renders nothing), ``world``, ``workers``, ``objects`` (the cell file's
 ``scene_layout`` (marker sizes of the library) and ``operator``. :meth:`URCellSession.
 hold_reason` is the executor's hold check: it names a protective stop, an emergency stop, power
 off, a lost connection or a dead control script in words, so the run is held within one tick.
+Digital inputs named in the cell file (``inputs.pedal``) press the operator console's
+"continue" button on each rising edge, and releasing the pendant's teach button (after guiding
+the arm by hand) presses its "teach" button, so a plan waits for either with
+``collaboration.wait_for_button`` and records the waypoint with ``freedrive.record_waypoint``.
 A recovery monitor on the connection's I/O thread does the robot side of clearing it: once the
 operator has unlocked the stop (or released the button and powered on), it uploads the control
 script again, and it reconnects when the socket is really gone. Then the hold clears and the run
@@ -25,6 +29,7 @@ from capabilities.camera_source import CameraSource
 from capabilities.camera_sources import open_source
 from capabilities.cell_robot import TCP_OF_TOOL
 from capabilities.collaboration.console import OperatorConsole
+from capabilities.collaboration.inputs import DigitalInputButton
 from capabilities.jobs import WorkerPool
 from capabilities.object_library import ObjectLibrary
 from capabilities.sim.config import CellConfig
@@ -33,13 +38,19 @@ from capabilities.ur.connection import NO_SCRIPT, URConnection, fault_reason
 from capabilities.ur.frames import URFrames
 from capabilities.ur.modes import RobotMode, SafetyMode
 from capabilities.ur.robotiq import RobotiqGripper
-from capabilities.ur.tool_io import DigitalPin, URSuctionCup
+from capabilities.ur.tool_io import (
+    DigitalPin,
+    TeachButtonReleased,
+    URDigitalInput,
+    URSuctionCup,
+)
 from capabilities.world_model import WorldModel
 from engine.types import Pose
 
-__all__ = ["CellStatus", "URCellSession"]
+__all__ = ["CellStatus", "TEACH_BUTTON", "URCellSession"]
 
 _log = logging.getLogger(__name__)
+TEACH_BUTTON = "teach"  # the console button the pendant's teach button presses on release
 _RETRY_SCRIPT = 1.0  # s between uploads of the control script while it is not running
 _RETRY_CONNECT = 2.0  # s between reconnection attempts
 
@@ -79,7 +90,8 @@ class URCellSession:
         )
         self.world_model = WorldModel()
         self.workers = WorkerPool(2, "costar-ur-worker")
-        self.operator = OperatorConsole()
+        self.operator = OperatorConsole(("continue", TEACH_BUTTON))
+        self._buttons: list[DigitalInputButton] = []
         self.library = ObjectLibrary(config.objects_path())
         try:
             self.connection.open(connect_timeout)
@@ -100,6 +112,13 @@ class URCellSession:
             self.close()
             raise
         self.connection.watch(_Recovery())
+        self._buttons = [DigitalInputButton(TeachButtonReleased(self.connection), self.operator,
+                                            TEACH_BUTTON)]  # fmt: skip
+        if "pedal" in robot.inputs:
+            pedal = URDigitalInput(self.connection, DigitalPin(*robot.inputs["pedal"]))
+            self._buttons.append(DigitalInputButton(pedal, self.operator, "continue"))
+        for button in self._buttons:
+            button.start()
 
     def _tool(self) -> dict[str, Any]:
         tool = self.config.robot.tool
@@ -161,6 +180,8 @@ class URCellSession:
     # ---------------------------------------------------------------- lifetime
 
     def close(self) -> None:
+        for button in self._buttons:
+            button.stop()
         self.connection.close()
         self.workers.close()
 

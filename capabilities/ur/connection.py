@@ -42,10 +42,16 @@ class URState:
     tcp: tuple[float, ...] = (0.0,) * 6  # UR base frame, [x, y, z, rx, ry, rz]
     digital_outputs: int = 0
     digital_inputs: int = 0
+    status_bits: int = 0  # robot_status_bits: 0 power on, 1 program running, 2 teach button
     async_running: bool = False
     async_op_id: int = -1
     stamp: float = 0.0
     problem: str = field(default="")
+
+    @property
+    def teach_button(self) -> bool:
+        """The pendant's teach (freedrive) button is held down."""
+        return bool(self.status_bits & 4)
 
     @property
     def moving(self) -> bool:
@@ -300,6 +306,7 @@ class URConnection:
             tcp=tuple(receive.getActualTCPPose()),
             digital_outputs=int(receive.getActualDigitalOutputBits()),
             digital_inputs=int(receive.getActualDigitalInputBits()),
+            status_bits=int(receive.getRobotStatus()),
             async_running=async_running,
             async_op_id=op_id,
             stamp=time.monotonic(),

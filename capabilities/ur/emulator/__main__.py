@@ -56,6 +56,11 @@ def run_command(emulator: UREmulator, line: str) -> dict[str, Any]:
             "gripper_closed": emulator.cell.gripper.is_closed(),
             "moving": ctl.arm_moving(), "messages": ctl.messages[-5:],
         }  # fmt: skip
+    elif name == "input":  # input BANK INDEX 0|1: a digital input (a foot pedal)
+        shift = {"standard": 0, "configurable": 8, "tool": 16}[args[0]]
+        ctl.set_digital_input(shift + int(args[1]), args[2] == "1")
+    elif name == "teach_button":  # teach_button 0|1: the pendant's freedrive button
+        ctl.press_teach_button(args[0] == "1")
     elif name == "truth":  # GROUND TRUTH of a scene object, for tests that score a run
         if emulator.truth is None or not args:
             return {"ok": False, "error": "truth needs a scene (--scene) and an object name"}

@@ -119,6 +119,14 @@ class EmulatorProcess:
         """Robot mode, safety mode, program, joints, outputs, freedrive, sim time."""
         return self.command("state")
 
+    def set_input(self, bank: str, index: int, level: bool) -> None:
+        """Set a digital input ("standard", "configurable" or "tool"; a foot pedal)."""
+        self.command(f"input {bank} {index} {int(level)}")
+
+    def teach_button(self, down: bool) -> None:
+        """Press (True) or release the pendant's teach button."""
+        self.command(f"teach_button {int(down)}")
+
     def truth_pose(self, name: str) -> Pose:
         """GROUND TRUTH of a scene object's pose (tests and scores only)."""
         answer = self.command(f"truth {name}")

@@ -238,3 +238,50 @@ def test_cup_to_bin_runs_on_the_emulated_ur_cell_through_ur_rtde(
     code = main(["run", plan, "--cell", str(cell_file), "--timeout", "120"], out, err)
     assert code == 0, out.getvalue() + err.getvalue()
     assert cup_in_bin(emulator.truth_pose("cup"), emulator.truth_pose("waste_bin"))
+
+
+@pytest.mark.sim
+def test_the_pedal_and_the_pendant_teach_button_drive_a_plan(
+    tmp_path: Path, start_emulator
+) -> None:
+    """Pedal (a digital input) -> "continue"; the teach button, held to guide the arm by hand
+    and released -> "teach", after which the plan records the waypoint where the arm is."""
+    emulator_file = tmp_path / "emulated.cell.json"
+    emulator = start_emulator("5.12", write_cell=emulator_file)
+    data = json.loads(emulator_file.read_text("utf-8"))
+    data["robot"]["inputs"] = {"pedal": "standard 2"}
+    cell_file = tmp_path / "pedal.cell.json"
+    cell_file.write_text(json.dumps(data), "utf-8")
+
+    def op(op_id: str, **params: Binding) -> NodeSpec:
+        return NodeSpec(NodeKind.OPERATION, op=op_id, params=params)
+
+    text = ParamType.TEXT
+    plan = PlanSpec(NodeSpec(NodeKind.SEQUENCE, children=[
+        op("collaboration.wait_for_button"),
+        op("collaboration.wait_for_button", button=Binding.fixed("teach", text)),
+        op("freedrive.record_waypoint", name=Binding.fixed("taught", text),
+           frame=Binding.fixed("joints", text), waypoint=Binding.reference("TAUGHT")),
+    ]), "teach by hand")  # fmt: skip
+    events: list[Event] = []
+    with open_cell(str(cell_file)) as cell:
+        executor = _run(cell, plan, events)
+        first = _ids(plan)[0]
+        assert wait_for(lambda: executor.tree.nodes[first].status is RUNNING)
+        emulator.set_input("standard", 2, True)  # the foot pedal
+        assert wait_for(lambda: executor.tree.nodes[first].status is SUCCESS)
+        emulator.teach_button(True)
+        assert wait_for(lambda: emulator.state()["freedrive"] is True)  # guided by hand
+        joints = emulator.state()["q"]
+        assert wait_for(lambda: cell.connection.state.teach_button)
+        emulator.teach_button(False)
+        result = executor.wait(30)
+        assert result is not None and result.status is SUCCESS, (
+            [(n.name, n.status, n.message) for n in executor.tree.iterate()],
+            cell.operator.presses("teach"),
+            executor.held,
+        )
+        taught = executor.tree.blackboard.snapshot()["TAUGHT"]
+    assert taught.name == "taught"
+    assert list(taught.joints.positions) == pytest.approx(joints, abs=1e-3)
+    assert emulator.state()["freedrive"] is False
