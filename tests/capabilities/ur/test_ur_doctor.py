@@ -9,8 +9,8 @@ import pytest
 
 from capabilities.recorded_frames import FrameRecorder
 from capabilities.ur.doctor import cell_checks
-from tests.capabilities.ur.emulators import wait_for
 from tests.capabilities.test_recorded_frames import _frame
+from tests.capabilities.ur.emulators import wait_for
 
 
 def _by_name(checks: list) -> dict:
