@@ -112,10 +112,15 @@ class URCellSession:
             self.close()
             raise
         self.connection.watch(_Recovery())
-        self._buttons = [DigitalInputButton(TeachButtonReleased(self.connection), self.operator,
-                                            TEACH_BUTTON)]  # fmt: skip
-        if "pedal" in robot.inputs:
-            pedal = URDigitalInput(self.connection, DigitalPin(*robot.inputs["pedal"]))
+        self._start_buttons()
+
+    def _start_buttons(self) -> None:
+        """The pendant's teach button and the pedal press the operator console's buttons."""
+        teach = TeachButtonReleased(self.connection)
+        self._buttons = [DigitalInputButton(teach, self.operator, TEACH_BUTTON)]
+        pedal_pin = self.config.robot.inputs.get("pedal")
+        if pedal_pin is not None:
+            pedal = URDigitalInput(self.connection, DigitalPin(*pedal_pin))
             self._buttons.append(DigitalInputButton(pedal, self.operator, "continue"))
         for button in self._buttons:
             button.start()

@@ -68,3 +68,46 @@ def test_the_toolbar_shows_each_robot_state(qtbot, tmp_path: Path, emulator) -> 
         assert text().startswith("Robot: connection lost")
     finally:
         session.close()
+
+
+def test_a_protective_stop_during_a_run_is_said_in_words_and_the_run_goes_on(
+    qtbot, tmp_path: Path, emulator
+) -> None:
+    from engine.files import save_plan
+    from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
+    from engine.status import Status
+    from engine.types import JointConfig, ParamType
+    from instructor_app.document.editing import PlanDocument
+    from instructor_app.runtime.controller import RunController
+    from tests.capabilities.ur.emulators import HOME, wait_for
+
+    target = JointConfig((HOME[0] + 1.2, *HOME[1:]))
+    move = NodeSpec(NodeKind.OPERATION, "turn", op="motion.move_joints", params={
+        "target": Binding.fixed(target, ParamType.JOINTS),
+        "speed": Binding.fixed(0.5, ParamType.NUMBER),
+    })  # fmt: skip
+    plan_path = tmp_path / "turn.costar.json"
+    save_plan(PlanSpec(move, "turn"), plan_path)
+    session = CellSession(str(tmp_path / "emulated.cell.json"))
+    assert session.open()
+    try:
+        document = PlanDocument()
+        document.open(plan_path)
+        controller = RunController(document, session, rate_hz=20.0)
+        logs: list[tuple[str, str]] = []
+        controller.log_message.connect(lambda text, level: logs.append((text, level)))
+        with qtbot.waitSignal(controller.run_finished, timeout=60_000) as finished:
+            controller.run()
+            assert wait_for(lambda: emulator.state()["moving"], 20)
+            emulator.protective_stop()
+            qtbot.waitUntil(
+                lambda: ("The robot stopped the run: protective stop", "error") in logs,
+                timeout=WAIT_MS,
+            )
+            pendant = dashboard_client.DashboardClient(emulator.host)
+            pendant.connect()
+            pendant.unlockProtectiveStop()
+        assert finished.args[0].status is Status.SUCCESS
+        assert ("The robot is ready again: the run goes on", "info") in logs
+    finally:
+        session.close()
