@@ -22,6 +22,7 @@ Figures only, never pass/fail. ``--json`` prints one JSON object at the end.
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import statistics
 import sys
@@ -29,11 +30,12 @@ import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from capabilities.ur.arm import URArm
-from capabilities.ur.connection import URConnection
+from capabilities.ur.connection import URConnection, fault_reason
 from capabilities.ur.emulator.process import EmulatorProcess
 from engine.types import Pose
 
@@ -93,9 +95,7 @@ def stop_detection(emulator: EmulatorProcess, connection: URConnection, arm: URA
         raise RuntimeError(f"the stop was not seen: {handle.message}")
     elapsed = (time.perf_counter() - start) * 1000.0
     connection.call(connection.clear_protective_stop)
-    deadline = time.monotonic() + 10.0
-    while not connection.state.program_running and time.monotonic() < deadline:
-        time.sleep(0.01)
+    _wait(lambda: not fault_reason(connection.state))  # ready for the next move
     return elapsed
 
 
@@ -126,7 +126,7 @@ def halt_ticks(emulator: EmulatorProcess, cell_file: Path, repeats: int) -> int:
             emulator.protective_stop()
             _wait(lambda: cell.connection.state.safety_mode == 3)
             seen = tree.ctx.tick_count
-            _wait(lambda seen=events: any(isinstance(e, RunHeld) for e in seen))
+            _wait(functools.partial(_any_held, events))
             held = next(e for e in events if isinstance(e, RunHeld))
             worst = max(worst, held.tick - seen)
             executor.stop()
@@ -134,6 +134,12 @@ def halt_ticks(emulator: EmulatorProcess, cell_file: Path, repeats: int) -> int:
             cell.connection.call(cell.connection.clear_protective_stop)
             _wait(lambda: not cell.hold_reason())
     return worst
+
+
+def _any_held(events: list[Any]) -> bool:
+    from engine.events import RunHeld
+
+    return any(isinstance(e, RunHeld) for e in events)
 
 
 def _wait(predicate: Callable[[], bool], timeout: float = 20.0) -> None:
