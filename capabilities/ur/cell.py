@@ -53,6 +53,7 @@ _log = logging.getLogger(__name__)
 TEACH_BUTTON = "teach"  # the console button the pendant's teach button presses on release
 _RETRY_SCRIPT = 1.0  # s between uploads of the control script while it is not running
 _RETRY_CONNECT = 2.0  # s between reconnection attempts
+_LET_UR_RTDE_TRY = 5.0  # s of a lost connection before ours (see _Recovery)
 
 
 @dataclass(frozen=True)
@@ -212,14 +213,23 @@ class _Recovery:
 
     def __init__(self) -> None:
         self._next_try = 0.0
+        self._lost_since: float | None = None
 
     def __call__(self, conn: URConnection) -> bool:
         now = time.monotonic()
+        state = conn.state
+        if state.connected:
+            self._lost_since = None
+        elif self._lost_since is None:
+            self._lost_since = now
         if now < self._next_try:
             return False
-        state = conn.state
         try:
             if not state.connected:
+                # ur_rtde's control interface first tries to reconnect on its own thread;
+                # disconnecting it while it does crashes the process: let it finish first.
+                if now - self._lost_since < _LET_UR_RTDE_TRY:  # type: ignore[operator]
+                    return False
                 self._next_try = now + _RETRY_CONNECT
                 conn.reconnect()
             elif fault_reason(state) == NO_SCRIPT:

@@ -285,3 +285,24 @@ def test_the_pedal_and_the_pendant_teach_button_drive_a_plan(
     assert taught.name == "taught"
     assert list(taught.joints.positions) == pytest.approx(joints, abs=1e-3)
     assert emulator.state()["freedrive"] is False
+
+
+@pytest.mark.sim
+def test_a_dropped_connection_holds_the_run_and_it_goes_on_once_reconnected(
+    tmp_path: Path, start_emulator
+) -> None:
+    cell_file = tmp_path / "emulated.cell.json"
+    emulator = start_emulator("5.12", write_cell=cell_file)
+    plan, _ = _plan(tmp_path, (0.2, -0.6), speed=0.5)
+    events: list[Event] = []
+    with open_cell(str(cell_file)) as cell:
+        executor = _run(cell, plan, events)
+        second = _ids(plan)[1]
+        assert wait_for(lambda: executor.tree.nodes[second].status is RUNNING, 20)
+        emulator.disconnect()  # every socket drops; the controller is still there
+        assert wait_for(lambda: executor.held.startswith("connection lost"), 20), executor.held
+        result = executor.wait(60)  # the cell reconnects by itself, the run goes on
+        assert result is not None and result.status is SUCCESS, (result, executor.held)
+    reasons = [e.reason for e in events if isinstance(e, RunHeld)]
+    assert reasons[-1] == "" and any(r.startswith("connection lost") for r in reasons)
+    assert emulator.state()["q"] == pytest.approx(list(_joints(-0.6)), abs=0.01)
