@@ -228,7 +228,7 @@ class _Recovery:
             if not state.connected:
                 # ur_rtde's control interface first tries to reconnect on its own thread;
                 # disconnecting it while it does crashes the process: let it finish first.
-                if now - self._lost_since < _LET_UR_RTDE_TRY:  # type: ignore[operator]
+                if now - (self._lost_since or now) < _LET_UR_RTDE_TRY:
                     return False
                 self._next_try = now + _RETRY_CONNECT
                 conn.reconnect()
