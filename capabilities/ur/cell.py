@@ -12,7 +12,9 @@ the arm by hand) presses its "teach" button, so a plan waits for either with
 ``collaboration.wait_for_button`` and records the waypoint with ``freedrive.record_waypoint``.
 A recovery monitor on the connection's I/O thread does the robot side of clearing it: once the
 operator has unlocked the stop (or released the button and powered on), it uploads the control
-script again, and it reconnects when the socket is really gone. Then the hold clears and the run
+script again, and it reconnects when the socket is really gone. A script that ended with no
+stop (stopped on the pendant, a script error) is uploaded again only on the operator's
+:meth:`URCellSession.clear`. Then the hold clears and the run
 goes on from the node that was running.
 """
 
@@ -170,6 +172,12 @@ class URCellSession:
         """
         return fault_reason(self.connection.state)
 
+    def clear(self) -> None:
+        """The operator's clear of a control script that ended on its own (stopped on the
+        pendant, a script error): upload it again. Returns at once (the I/O thread does it);
+        the hold lifts when the script runs."""
+        self.connection.submit(self.connection.start_control)
+
     def status(self) -> CellStatus:
         """The robot's state for the toolbar (a snapshot; never blocks)."""
         state = self.connection.state
@@ -214,6 +222,7 @@ class _Recovery:
     def __init__(self) -> None:
         self._next_try = 0.0
         self._lost_since: float | None = None
+        self._fault_seen = False  # a stop or a power loss the operator must clear first
 
     def __call__(self, conn: URConnection) -> bool:
         now = time.monotonic()
@@ -222,6 +231,9 @@ class _Recovery:
             self._lost_since = None
         elif self._lost_since is None:
             self._lost_since = now
+        problem = fault_reason(state)
+        if problem and problem != NO_SCRIPT:
+            self._fault_seen = True
         if now < self._next_try:
             return False
         try:
@@ -232,9 +244,14 @@ class _Recovery:
                     return False
                 self._next_try = now + _RETRY_CONNECT
                 conn.reconnect()
-            elif fault_reason(state) == NO_SCRIPT:
+            elif problem == NO_SCRIPT and self._fault_seen:
+                # The operator cleared a stop (the script ends with it): upload it again. A
+                # script that ended on its own (stopped on the pendant, a script error) waits
+                # for the operator's clear() instead.
                 self._next_try = now + _RETRY_SCRIPT
                 conn.start_control()
+            elif not problem:
+                self._fault_seen = False
         except Exception as exc:  # the controller is not back yet: try again later
             _log.debug("UR recovery: %s", exc)
         return False
