@@ -234,6 +234,8 @@ class _Recovery:
         problem = fault_reason(state)
         if problem and problem != NO_SCRIPT:
             self._fault_seen = True
+        elif not problem:
+            self._fault_seen = False
         if now < self._next_try:
             return False
         try:
@@ -250,8 +252,6 @@ class _Recovery:
                 # for the operator's clear() instead.
                 self._next_try = now + _RETRY_SCRIPT
                 conn.start_control()
-            elif not problem:
-                self._fault_seen = False
         except Exception as exc:  # the controller is not back yet: try again later
             _log.debug("UR recovery: %s", exc)
         return False

@@ -11,11 +11,11 @@ from __future__ import annotations
 from typing import Any
 
 from PySide6.QtCore import QTimer, Signal
-from PySide6.QtWidgets import QLabel, QWidget
+from PySide6.QtWidgets import QLabel, QToolButton, QWidget
 
 from instructor_app.runtime.session import CellSession
 
-__all__ = ["RobotStatusLabel"]
+__all__ = ["RobotStatusLabel", "ScriptRestartButton"]
 
 _OK_STYLE = "QLabel { background: #d8f0d8; color: #104010; padding: 2px 6px; }"
 _FAULT_STYLE = "QLabel { background: #f6d0d0; color: #601010; padding: 2px 6px; }"
@@ -31,9 +31,11 @@ class RobotStatusLabel(QLabel):
     Signals:
         presence_changed(bool): the open cell has (or no longer has) a robot controller; a
             window shows or hides the label on it.
+        fault_changed(str): the problem shown changed ("" when the robot can move).
     """
 
     presence_changed = Signal(bool)
+    fault_changed = Signal(str)
 
     def __init__(
         self, session: CellSession, interval_ms: int = 100, parent: QWidget | None = None
@@ -57,7 +59,10 @@ class RobotStatusLabel(QLabel):
             return
         if (status is None) != (self._shown is None):
             self.presence_changed.emit(status is not None)
+        fault_before = self.fault
         self._shown = status
+        if self.fault != fault_before:
+            self.fault_changed.emit(self.fault)
         if status is None:
             self.setText("")
             return
@@ -84,3 +89,29 @@ class RobotStatusLabel(QLabel):
     def fault(self) -> str:
         """The problem shown now ("" when the robot can move or there is no robot)."""
         return str(getattr(self._shown, "problem", ""))
+
+
+class ScriptRestartButton(QToolButton):
+    """ "Restart control script": the operator's clear of a control script that ended on its
+    own (stopped on the pendant, a script error). Shown only while that is the robot's problem;
+    the cell uploads the script on its own thread, so the click returns at once."""
+
+    def __init__(
+        self, session: CellSession, status: RobotStatusLabel, parent: QWidget | None = None
+    ) -> None:
+        super().__init__(parent)
+        self.setObjectName("RestartScript")
+        self.setText("Restart control script")
+        self.setToolTip("Upload the robot's control script again; a held run then goes on")
+        self._session = session
+        self.setVisible(False)
+        status.fault_changed.connect(self._on_fault)
+        self.clicked.connect(self._restart)
+
+    def _on_fault(self, fault: str) -> None:
+        self.setVisible(fault.startswith("the control script is not running"))
+
+    def _restart(self) -> None:
+        clear = getattr(self._session.cell, "clear", None)
+        if callable(clear):
+            clear()

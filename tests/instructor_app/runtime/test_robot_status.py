@@ -8,6 +8,7 @@ from pathlib import Path
 
 import dashboard_client
 import pytest
+from PySide6.QtCore import Qt
 
 from capabilities.ur.emulator.process import EmulatorProcess
 from instructor_app.runtime.session import CellSession
@@ -62,6 +63,15 @@ def test_the_toolbar_shows_each_robot_state(qtbot, tmp_path: Path, emulator) -> 
         pendant.powerOn()
         pendant.brakeRelease()
         qtbot.waitUntil(lambda: not label.fault and "PLAYING" in text(), timeout=WAIT_MS)
+
+        emulator.kill_script()  # stopped on the pendant: the operator restarts it here
+        qtbot.waitUntil(lambda: "control script is not running" in label.fault, timeout=WAIT_MS)
+        assert "program STOPPED" in text()
+        restart = window.robot_restart
+        assert restart.isVisibleTo(window)
+        qtbot.mouseClick(restart, Qt.MouseButton.LeftButton)
+        qtbot.waitUntil(lambda: not label.fault and "PLAYING" in text(), timeout=WAIT_MS)
+        assert not restart.isVisibleTo(window)
 
         emulator.kill()
         qtbot.waitUntil(lambda: label.fault.startswith("connection lost"), timeout=WAIT_MS)
