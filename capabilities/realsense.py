@@ -70,7 +70,9 @@ class RealSenseCamera:
         try:
             profile = self._pipeline.start(config)
         except RuntimeError as exc:
-            raise RealSenseError(f"camera {name}: no RealSense {serial or ''} answers: {exc}") from exc
+            raise RealSenseError(
+                f"camera {name}: no RealSense {serial or ''} answers: {exc}"
+            ) from exc
         self._align = rs.align(rs.stream.color)
         self._scale = float(profile.get_device().first_depth_sensor().get_depth_scale())
         color = profile.get_stream(rs.stream.color).as_video_stream_profile()
