@@ -129,7 +129,11 @@ def _print_holds(out: TextIO) -> Callable[[Event], None]:
 
     def on_event(event: Event) -> None:
         if isinstance(event, RunHeld):
-            text = f"held: {event.reason}" if event.reason else "the cell is ready: resumed"
+            text = (
+                f"held: {event.reason} (the run goes on once the robot is ready; Ctrl-C stops it)"
+                if event.reason
+                else "the robot is ready: the run goes on"
+            )
             print(f"tick {event.tick:>5}  {text}", file=out, flush=True)
 
     return on_event
