@@ -332,3 +332,32 @@ def test_a_dead_control_script_holds_the_run_until_the_operator_clears_it(
         result = executor.wait(60)
         assert result is not None and result.status is SUCCESS, (result, executor.held)
     assert emulator.state()["q"] == pytest.approx(list(_joints(0.9)), abs=0.01)
+
+
+@pytest.mark.sim
+def test_costar_run_says_a_protective_stop_and_finishes_after_the_unlock(
+    tmp_path: Path, start_emulator
+) -> None:
+    import threading
+
+    cell_file = tmp_path / "emulated.cell.json"
+    emulator = start_emulator("5.12", write_cell=cell_file)
+    _, plan = _plan(tmp_path, (1.0,), speed=0.5)
+    out, err = io.StringIO(), io.StringIO()
+
+    def operator() -> None:  # another person at the cell: a stop, then the unlock
+        assert wait_for(lambda: emulator.state()["moving"], 30)
+        emulator.protective_stop()
+        assert wait_for(lambda: "held: protective stop" in out.getvalue(), 20)
+        pendant = dashboard_client.DashboardClient(emulator.host)
+        pendant.connect()
+        pendant.unlockProtectiveStop()
+
+    thread = threading.Thread(target=operator, daemon=True)
+    thread.start()
+    code = main(["run", plan, "--cell", str(cell_file), "--timeout", "60"], out, err)
+    thread.join(30)
+    text = out.getvalue()
+    assert code == 0, text + err.getvalue()
+    assert "held: protective stop" in text and "the run goes on" in text
+    assert emulator.state()["q"] == pytest.approx(list(_joints(1.0)), abs=0.01)
