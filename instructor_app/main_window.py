@@ -33,6 +33,7 @@ from instructor_app.panels.cell_views import CellViews
 from instructor_app.panels.operator import OperatorPanel
 from instructor_app.panels.start_page import StartPage, find_examples
 from instructor_app.runtime.controller import RunController
+from instructor_app.runtime.robot_status import RobotStatusLabel, ScriptRestartButton
 from instructor_app.runtime.run_view import (
     FailureButton,
     RunActions,
@@ -48,6 +49,8 @@ from instructor_app.settings import (
     is_shipped_example,
 )
 from instructor_app.views import Views, make_views
+
+OPEN_CELL_FILE = "Open cell file…"
 
 __all__ = ["APP_TITLE", "DISCARD", "Dialogs", "MainWindow", "Views", "make_views"]
 
@@ -145,11 +148,21 @@ class MainWindow(QMainWindow):
         self.cell_label = QLabel(" Cell: ")
         self.cell_combo = QComboBox(self)
         self.cell_combo.setObjectName("CellCombo")
-        self.cell_combo.setToolTip("The cell plans run on: the simulated cell, or none (no robot)")
-        self.cell_combo.addItems(list(self.session.cell_names()))
-        self.cell_combo.setCurrentText(self.session.name)
+        self.cell_combo.setToolTip(
+            "The cell plans run on: the simulated cell, none (no robot), or a cell file"
+        )
+        for name in self.session.cell_names():
+            self.cell_combo.addItem(name, name)
+        self.cell_combo.addItem(OPEN_CELL_FILE, "")  # data "": ask for a file
+        self._show_cell(self.session.name)
+        self.robot_status = RobotStatusLabel(self.session, parent=self)
         self.problems_label = QLabel("")
         # permanent: a temporary status message would hide a normal status-bar widget
+        self.robot_restart = ScriptRestartButton(self.session, self.robot_status, self)
+        self.statusBar().addPermanentWidget(self.robot_restart)
+        self.statusBar().addPermanentWidget(self.robot_status)
+        self.robot_status.setVisible(self.robot_status.present)
+        self.robot_status.presence_changed.connect(self.robot_status.setVisible)
         self.statusBar().addPermanentWidget(self.failure_button)
         self.statusBar().addPermanentWidget(self.problems_label)
 
@@ -267,7 +280,7 @@ class MainWindow(QMainWindow):
         self.session.cell_changed.connect(self._on_cell_changed)
         self.session.cell_failed.connect(lambda message: self.dialogs.error(self, "Cell", message))
         self.cell_combo.activated.connect(
-            lambda index: self.switch_cell(self.cell_combo.itemText(index))
+            lambda index: self.switch_cell(str(self.cell_combo.itemData(index) or ""))
         )
         document.dirty_changed.connect(lambda _: self._update_title())
         document.path_changed.connect(lambda _: self._update_title())
@@ -409,12 +422,27 @@ class MainWindow(QMainWindow):
         else:
             self.show_message("Stop the run before resetting the cell.")
 
+    def _show_cell(self, name: str) -> None:
+        """Select ``name`` in the cell chooser (a cell file gets an entry of its own)."""
+        index = self.cell_combo.findData(name)
+        if index < 0:
+            index = self.cell_combo.count() - 1  # before "Open cell file…"
+            self.cell_combo.insertItem(index, Path(name).name, name)
+            self.cell_combo.setItemData(index, name, Qt.ItemDataRole.ToolTipRole)
+        self.cell_combo.setCurrentIndex(index)
+
     def switch_cell(self, name: str) -> None:
-        """Open another cell (not while a plan runs)."""
+        """Open another cell: a name, a cell file, or "" to ask for one (not while running)."""
+        if not name:
+            folder = str(Path(self.session.name).parent) if Path(self.session.name).suffix else ""
+            name = self.dialogs.open_cell_path(self, folder)
+            if not name:
+                self._show_cell(self.session.name)
+                return
         if name == self.session.name:
             return
         if self.controller.is_running:
-            self.cell_combo.setCurrentText(self.session.name)
+            self._show_cell(self.session.name)
             self.show_message("Stop the run before switching the cell.")
             return
         self.show_message(f"Opening the {name} cell…")
@@ -424,7 +452,7 @@ class MainWindow(QMainWindow):
         self.views.set_registry(registry)
 
     def _on_cell_changed(self, name: str) -> None:
-        self.cell_combo.setCurrentText(name)
+        self._show_cell(name)
         self.show_message(f"Cell in use: {name}")
 
     # ------------------------------------------------------------------ files

@@ -20,6 +20,8 @@ from typing import Any
 
 import numpy as np
 
+from capabilities.camera_source import CameraSource
+from capabilities.camera_sources import open_source
 from capabilities.collaboration.console import OperatorConsole
 from capabilities.jobs import WorkerPool
 from capabilities.sim.cameras import (
@@ -144,14 +146,22 @@ class SimCellSession:
                 )
             )  # fmt: skip
             sizes = {"shoulder": shoulder_size, "wrist": wrist_size}
-            self.cameras = {
-                name: SimCameraDevice(self.sim, self._camera(name, settings, sizes.get(name)))
+            self.cameras: dict[str, CameraSource] = {
+                name: self._device(name, settings, sizes.get(name))
                 for name, settings in self.sim.config.cameras.items()
             }
             self.worker = install_scene_worker(self.sim, self.scene, path, seed)
         except BaseException:
             self.close()
             raise
+
+    def _device(
+        self, name: str, settings: CameraSettings, size: tuple[int, int] | None
+    ) -> CameraSource:
+        """A rendered camera, or the recorded or real source the cell file names."""
+        if settings.source == "sim":
+            return SimCameraDevice(self.sim, self._camera(name, settings, size))
+        return open_source(name, settings.source, settings.where, self.sim.config.folder())
 
     def _camera(
         self, name: str, settings: CameraSettings, size: tuple[int, int] | None

@@ -199,7 +199,10 @@ class RunController(QObject):
         for problem in problems:
             self.log_message.emit(str(problem), "warning")
         self._reset_run(plan)
-        self._executor = Executor(tree, self.rate_hz, [self._pump.put], plan_name=plan.name)
+        hold = getattr(self.session.cell, "hold_reason", None)  # a real robot's stops
+        self._executor = Executor(
+            tree, self.rate_hz, [self._pump.put], plan_name=plan.name, hold=hold
+        )
         self._executor.start(paused=paused)
         self._timer.start()
         self._set_state(ExecutorState.PAUSED if paused else ExecutorState.RUNNING)
@@ -243,6 +246,11 @@ class RunController(QObject):
             self._finish(batch.finished)
 
     def _emit_logs(self, batch: Batch) -> None:
+        for reason in batch.holds:
+            if reason:
+                self.log_message.emit(f"The robot stopped the run: {reason}", "error")
+            else:
+                self.log_message.emit("The robot is ready again: the run goes on", "info")
         for node_id, message in batch.logs:
             self.log_message.emit(f"{self._label(node_id)}: {message}", "info")
         for node_id, message in batch.failures:
