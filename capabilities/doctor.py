@@ -18,9 +18,9 @@ import os
 import subprocess
 import sys
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from typing import TextIO
 
+from capabilities.check_result import CheckResult
 from resources import example_plans, resource_path
 
 __all__ = ["CheckResult", "cell_checks", "checks", "cmd_doctor", "run_checks"]
@@ -28,15 +28,6 @@ __all__ = ["CheckResult", "cell_checks", "checks", "cmd_doctor", "run_checks"]
 MIN_PYTHON = (3, 11)
 PROBE_TIMEOUT = 60.0  # s; a first start of Qt or Mesa on a slow PC can take a while
 INSTALL_HINT = "run bash packaging/install.sh (it installs the system libraries Qt needs)"
-
-
-@dataclass(frozen=True)
-class CheckResult:
-    """What one check found: ``detail`` says what is there (ok) or how to fix it (not ok)."""
-
-    name: str
-    ok: bool
-    detail: str
 
 
 # A check returns one result, or several when one probe answers several questions (a robot

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from capabilities.doctor import CheckResult
+from capabilities.check_result import CheckResult
 from capabilities.errors import CapabilityError
 
 if TYPE_CHECKING:
