@@ -18,6 +18,7 @@ from PySide6.QtWidgets import (
     QDockWidget,
     QLabel,
     QMainWindow,
+    QScrollArea,
     QStackedWidget,
     QWidget,
 )
@@ -49,6 +50,14 @@ from instructor_app.settings import (
 from instructor_app.views import Views, make_views
 
 __all__ = ["APP_TITLE", "DISCARD", "Dialogs", "MainWindow", "Views", "make_views"]
+
+
+def _scrolled(widget: QWidget) -> QScrollArea:
+    """A tall panel in a scroll area, so that its tab does not squeeze the inspector."""
+    area = QScrollArea()
+    area.setWidgetResizable(True)
+    area.setWidget(widget)
+    return area
 
 
 class MainWindow(QMainWindow):
@@ -111,11 +120,15 @@ class MainWindow(QMainWindow):
         self._dock("palette", "Palette", self.views.palette, area.LeftDockWidgetArea)
         self._dock("inspector", "Inspector", self.views.inspector, area.RightDockWidgetArea)
         self._dock("plan", "Plan", self.views.plan_settings, area.RightDockWidgetArea)
-        self._dock("waypoints", "Waypoints", self.views.waypoints, area.RightDockWidgetArea)
+        self._dock(
+            "waypoints", "Waypoints", _scrolled(self.views.waypoints), area.RightDockWidgetArea
+        )
+        self._dock("move", "Move", _scrolled(self.views.move), area.RightDockWidgetArea)
         self._dock("operator", "Operator", self.operator_panel, area.RightDockWidgetArea)
         self.splitDockWidget(self.docks["inspector"], self.docks["plan"], Qt.Orientation.Vertical)
         self.tabifyDockWidget(self.docks["plan"], self.docks["waypoints"])
-        self.tabifyDockWidget(self.docks["waypoints"], self.docks["operator"])
+        self.tabifyDockWidget(self.docks["waypoints"], self.docks["move"])
+        self.tabifyDockWidget(self.docks["move"], self.docks["operator"])
         self.docks["plan"].raise_()  # the operator tab comes forward when the robot asks
         bottom = [
             ("validation", "Problems", self.views.validation),
@@ -225,6 +238,7 @@ class MainWindow(QMainWindow):
         views.canvas.selection_changed.connect(self._on_selection)
         views.canvas.message.connect(self.show_message)
         views.waypoints.message.connect(self.show_message)
+        views.teacher.message.connect(self.show_message)
         self.session.cell_changed.connect(lambda _name: self._attach_operator())
         self.operator_panel.prompt_shown.connect(lambda _text: self._raise_dock("operator"))
         self._attach_operator()
@@ -256,6 +270,11 @@ class MainWindow(QMainWindow):
         controller.running_nodes_changed.connect(self.running_panel.set_nodes)
         controller.failure_changed.connect(self.failure_button.show_failure)
         controller.run_state_changed.connect(self._on_run_state)
+        controller.run_state_changed.connect(
+            lambda state: views.teacher.set_run_active(
+                state not in (ExecutorState.READY, ExecutorState.FINISHED)
+            )
+        )
         self.run_presenter = RunPresenter(
             controller, views.canvas, views.blackboard, views.log, self.show_message, self
         )
@@ -503,6 +522,7 @@ class MainWindow(QMainWindow):
             event.ignore()
             return
         self.controller.shutdown()
+        self.views.teacher.shutdown()
         self.autosaver.stop()
         self.settings.save_window(self.saveGeometry(), self.saveState())
         event.accept()

@@ -34,10 +34,12 @@ class Views:
     log: Any
     plan_settings: Any
     waypoints: Any
+    teacher: Any = None  # RobotTeacher: jog, freedrive, move-here off the GUI thread
+    move: Any = None
 
     def set_registry(self, registry: Any) -> None:
         """Another cell: every view that shows operations rebuilds from its registry."""
-        for view in (self.palette, self.inspector, self.validation, self.waypoints):
+        for view in (self.teacher, self.palette, self.inspector, self.validation, self.waypoints):
             view.set_registry(registry)
         self.canvas.set_operation_kinds({m.id: m.kind for m in registry.manifests()})
         operations: dict[str, list[tuple[str, str]]] = {}
@@ -68,9 +70,12 @@ def make_views(document: PlanDocument, session: CellSession, parent: QWidget) ->
         ValidationPanel,
         WaypointsPanel,
     )
+    from instructor_app.panels.move import MovePanel
+    from instructor_app.runtime.teach import RobotTeacher
 
     registry = session.registry
     canvas = CanvasView(document, parent)
+    teacher = RobotTeacher(registry, parent=parent)
     canvas.set_node_factory(
         lambda kind, op: make_node(_item_for(kind, op), manifest_or_none(session.registry, op))
     )
@@ -84,7 +89,9 @@ def make_views(document: PlanDocument, session: CellSession, parent: QWidget) ->
         BlackboardPanel(parent),
         LogPanel(parent=parent),
         PlanSettingsPanel(document, parent),
-        WaypointsPanel(document, registry, parent),
+        WaypointsPanel(document, registry, parent, teacher=teacher),
+        teacher,
+        MovePanel(teacher, parent),
     )
     views.set_registry(registry)
     return views
