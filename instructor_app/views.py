@@ -93,5 +93,6 @@ def make_views(document: PlanDocument, session: CellSession, parent: QWidget) ->
         teacher,
         MovePanel(teacher, parent),
     )
+    views.inspector.set_teacher(teacher)
     views.set_registry(registry)
     return views

@@ -114,9 +114,12 @@ class PlanDocument(PlanModel):
     def set_plan_field(self, field: str, value: Any) -> None:
         self._push(SetPlanFieldCommand(self, field, value))
 
-    def replace_waypoint(self, old_name: str, new: Waypoint, text: str = "") -> None:
+    def replace_waypoint(
+        self, old_name: str, new: Waypoint, text: str = "", bind: tuple[str, str] | None = None
+    ) -> None:
         """Put ``new`` in place of the plan's waypoint ``old_name`` (appended when there is
-        none) and into every fixed binding that holds that waypoint: one undo step."""
+        none) and into every fixed binding that holds that waypoint, and bind it to the
+        port ``bind`` = (node id, port) if given: one undo step."""
         waypoints = list(self.plan.waypoints)
         names = [w.name for w in waypoints]
         if new.name != old_name and new.name in names:
@@ -132,7 +135,10 @@ class PlanDocument(PlanModel):
             if not binding.is_ref
             and isinstance(binding.value, Waypoint)
             and binding.value.name == old_name
+            and (node.id, port) != bind
         ]
+        if bind is not None:
+            bound.append((bind[0], bind[1], Binding.fixed(new, ParamType.WAYPOINT)))
         self.undo_stack.beginMacro(text or f"Change the waypoint {old_name!r}")
         try:
             self.set_plan_field("waypoints", waypoints)

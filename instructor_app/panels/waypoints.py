@@ -32,7 +32,7 @@ from capabilities.waypoints import WaypointFileError, WaypointLibrary
 from engine.types import Waypoint, WaypointFrame
 from instructor_app.document import DocumentError, PlanDocument
 from instructor_app.panels.waypoint_details import WaypointDetails
-from instructor_app.panels.waypoint_teach import TeachError, teach_like, teach_waypoint
+from instructor_app.runtime.waypoint_teach import TeachError, teach_like, teach_waypoint
 
 __all__ = ["WaypointsPanel", "WAYPOINT_FILTER", "PathAsker"]
 
@@ -94,6 +94,7 @@ class WaypointsPanel(QWidget):
         document.plan_reset.connect(self._refresh)
         if teacher is not None:
             teacher.availability_changed.connect(self._update_enabled)
+            teacher.preview_ready.connect(self._show_ghost)
         self.set_registry(registry)
         self._refresh()
 
@@ -164,8 +165,9 @@ class WaypointsPanel(QWidget):
         self._update_enabled()
 
     def set_scene(self, scene: Any) -> None:
-        """The 3D scene whose ghost arm previews the selected waypoint (None: none)."""
-        self.scene = scene
+        """The 3D scene whose ghost arm (``show_ghost(joints | None)``) previews the selected
+        waypoint; None or a scene without OpenGL: no preview."""
+        self.scene = scene if scene is not None and getattr(scene, "available", True) else None
         self._update_enabled()
 
     def waypoint_names(self) -> list[str]:
@@ -270,19 +272,18 @@ class WaypointsPanel(QWidget):
             self.teacher.release()
 
     def _preview(self) -> None:
-        waypoint = self.selected() if self.preview_button.isChecked() else None
+        """The ghost arm at the selected waypoint (worked out on the teacher's worker)."""
         if self.scene is None or self.teacher is None:
             return
+        waypoint = self.selected() if self.preview_button.isChecked() else None
         if waypoint is None:
-            self.scene.hide_ghost()
-            return
-        try:
-            resolved = self.teacher.resolver().resolve(waypoint, "", self.teacher.state.tcp)
-        except Exception as exc:  # not detected, no state: say why, show nothing
-            self.message.emit(f"Cannot preview {waypoint.name!r}: {exc}")
-            self.scene.hide_ghost()
-            return
-        self.scene.show_ghost(resolved, self.teacher.interface("arm"))
+            self.scene.show_ghost(None)
+        else:
+            self.teacher.preview(waypoint)
+
+    def _show_ghost(self, joints: object) -> None:
+        if self.scene is not None and self.preview_button.isChecked():
+            self.scene.show_ghost(joints)
 
     def _import_asked(self) -> None:
         path = self.ask_path(self)

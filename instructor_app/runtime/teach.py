@@ -33,6 +33,7 @@ __all__ = ["ArmState", "RobotTeacher", "MOVE_HERE_FRACTION"]
 
 MOVE_HERE_FRACTION = 0.25  # Move here runs at a quarter of the slider's speed, as PolyScope
 _POLL_MS = 100
+_DRAG_SETTLE_S = 5.0  # at most this long for the arm to reach a released drag
 
 
 @dataclass(frozen=True)
@@ -56,12 +57,14 @@ class RobotTeacher(QObject):
         availability_changed(): the cell changed, or a run started or ended.
         finished(str, str): a command ended: (what, problem; "" when it went well).
         message(str): words for the status bar.
+        preview_ready(object): the joints (rad) a previewed target puts the arm at, or None.
     """
 
     state_changed = Signal(object)
     availability_changed = Signal()
     finished = Signal(str, str)
     message = Signal(str)
+    preview_ready = Signal(object)
 
     def __init__(self, registry: Any = None, poll_ms: int = _POLL_MS, parent: Any = None) -> None:
         super().__init__(parent)
@@ -73,6 +76,8 @@ class RobotTeacher(QObject):
         self._drag_lock = threading.Lock()
         self._drag_pose: Pose | None = None
         self._drag_pending = False
+        self._drag_started_freedrive = False
+        self._drag_handle: Any = None
         self._run_active = False
         self._symmetries = SymmetryTable()
         self.speed_fraction = 0.25
@@ -229,6 +234,53 @@ class RobotTeacher(QObject):
             self._drag_pending = True
         return self._submit("drag", self._drag_newest)
 
+    def end_drag(self) -> bool:
+        """The drag is over: freedrive that the drag turned on is turned off again."""
+        drive = self._interfaces.get("freedrive")
+        if drive is None:
+            return False
+
+        def end() -> str:
+            handle, self._drag_handle = self._drag_handle, None
+            if handle is not None:  # let the arm reach where the hand let go
+                arrived = threading.Event()
+                handle.add_done_callback(lambda _h: arrived.set())
+                arrived.wait(_DRAG_SETTLE_S)
+            if self._drag_started_freedrive:
+                self._drag_started_freedrive = False
+                drive.set_freedrive(False)
+            return ""
+
+        return self._submit("drag end", end)
+
+    def preview(self, target: Any, reference: Any = "") -> bool:
+        """Work out (on the worker) the joints at a Pose or Waypoint: ``preview_ready``."""
+        arm = self._interfaces.get("arm")
+        if arm is None or target is None:
+            self.preview_ready.emit(None)
+            return False
+        resolver = self.resolver()
+
+        def work() -> str:
+            joints: tuple[float, ...] | None = None
+            try:
+                resolved = resolver.resolve(target, reference, arm.tcp_pose())
+            except OperationFailed as exc:
+                self.preview_ready.emit(None)
+                return f"cannot preview: {exc}"
+            if resolved.joints is not None:
+                joints = tuple(resolved.joints.positions)
+            for pose in resolved.poses:
+                joints = arm.inverse_kinematics(pose)
+                if joints is not None:
+                    break
+            self.preview_ready.emit(joints)
+            return (
+                "" if joints is not None else f"cannot preview: {resolved.describe} is unreachable"
+            )
+
+        return self._submit("preview", work)
+
     def shutdown(self) -> None:
         """Release, and let the worker finish (a stop already sent still reaches the arm)."""
         self._timer.stop()
@@ -288,7 +340,9 @@ class RobotTeacher(QObject):
         if drive is not None and hasattr(drive, "freedrive_drag_to"):
             if not drive.freedrive_active():
                 drive.set_freedrive(True)
-            drive.freedrive_drag_to(pose)  # a newer drag replaces it on the physics thread
+                self._drag_started_freedrive = True
+            # a newer drag replaces this one on the physics thread
+            self._drag_handle = drive.freedrive_drag_to(pose)
             return ""
         arm = self._interfaces["arm"]
         q = arm.inverse_kinematics(pose)
