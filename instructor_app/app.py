@@ -140,8 +140,7 @@ def _screenshot(args: argparse.Namespace) -> int:
             _grab(window, Path(args.screenshot))
             return code
         finally:
-            window.controller.shutdown()
-            window.autosaver.stop()
+            window.shutdown()
             window.hide()
             window.deleteLater()
             session.close()

@@ -90,7 +90,7 @@ class MainWindow(QMainWindow):
         self.document = PlanDocument(self)
         self.autosaver = Autosaver(self.document, recovery_folder, autosave_interval_ms, self)
         self.controller = RunController(self.document, session, rate_hz=rate_hz, parent=self)
-        self.views: Views = make_views(self.document, session, self)
+        self.views: Views = make_views(self.document, session, self, self.autosaver.folder.parent)
         self.run_actions = RunActions(self.controller, self)
         self.running_panel = RunningNodesPanel(self._node_path, self)
         self.operator_panel = OperatorPanel(self)
@@ -118,6 +118,9 @@ class MainWindow(QMainWindow):
         self.docks: dict[str, QDockWidget] = {}
         area = Qt.DockWidgetArea
         self._dock("palette", "Palette", self.views.palette, area.LeftDockWidgetArea)
+        self._dock("objects", "Objects", self.views.objects, area.LeftDockWidgetArea)
+        self.tabifyDockWidget(self.docks["palette"], self.docks["objects"])
+        self.docks["palette"].raise_()
         self._dock("inspector", "Inspector", self.views.inspector, area.RightDockWidgetArea)
         self._dock("plan", "Plan", self.views.plan_settings, area.RightDockWidgetArea)
         self._dock(
@@ -239,6 +242,7 @@ class MainWindow(QMainWindow):
         views.canvas.message.connect(self.show_message)
         views.waypoints.message.connect(self.show_message)
         views.teacher.message.connect(self.show_message)
+        views.objects.message.connect(self.show_message)
         self.session.cell_changed.connect(lambda _name: self._attach_operator())
         self.operator_panel.prompt_shown.connect(lambda _text: self._raise_dock("operator"))
         self._attach_operator()
@@ -517,12 +521,17 @@ class MainWindow(QMainWindow):
         if state is not None:
             self.restoreState(state)
 
+    def shutdown(self) -> None:
+        """Stop the run, the robot's teaching commands, background drawing and autosave."""
+        self.controller.shutdown()
+        self.views.teacher.shutdown()
+        self.views.objects.shutdown()
+        self.autosaver.stop()
+
     def closeEvent(self, event: QCloseEvent) -> None:
         if not self.maybe_save():
             event.ignore()
             return
-        self.controller.shutdown()
-        self.views.teacher.shutdown()
-        self.autosaver.stop()
+        self.shutdown()
         self.settings.save_window(self.saveGeometry(), self.saveState())
         event.accept()

@@ -15,6 +15,7 @@ It works on any cell whose interfaces follow the backend Protocols: ``arm``
 
 from __future__ import annotations
 
+import contextlib
 import threading
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
@@ -321,9 +322,10 @@ class RobotTeacher(QObject):
                 problem = str(exc)
             except Exception as exc:  # a backend error ends the command, never the GUI
                 problem = f"{type(exc).__name__}: {exc}"
-            self.finished.emit(what, problem or "")
-            if problem:
-                self.message.emit(f"{what.capitalize()}: {problem}")
+            with contextlib.suppress(RuntimeError):  # the window is gone: nobody to tell
+                self.finished.emit(what, problem or "")
+                if problem:
+                    self.message.emit(f"{what.capitalize()}: {problem}")
 
         try:
             self._pool.submit(run)

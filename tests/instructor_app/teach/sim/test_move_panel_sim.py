@@ -13,6 +13,7 @@ from instructor_app.panels.move import STEPS, MovePanel
 from instructor_app.runtime.session import CellSession
 from instructor_app.runtime.teach import RobotTeacher
 from tests.instructor_app.gui_driver import choose
+from tests.instructor_app.teach.held import hold_ready
 
 
 @pytest.fixture
@@ -82,6 +83,7 @@ def test_a_held_arrow_moves_until_let_go(
     choose(qtbot, panel.step_combo, "while held")
     start = arm.tcp_pose().position
     button = panel.jog_buttons["y+"]
+    hold_ready(qtbot, button)
     qtbot.mousePress(button, Qt.MouseButton.LeftButton)
     qtbot.waitUntil(lambda: arm.tcp_pose().position[1] - start[1] > 0.02, timeout=20_000)
     assert arm.is_moving()

@@ -24,6 +24,7 @@ from tests.instructor_app.gui_driver import (
     select,
     set_value,
 )
+from tests.instructor_app.teach.held import hold_ready
 
 LEFT = Qt.MouseButton.LeftButton
 
@@ -70,6 +71,7 @@ def test_waypoints_taught_by_freedrive_and_by_jogging_run_in_a_plan(
 ) -> None:
     arm, move = arm_of(fast_sim), window.views.move
     start = arm.tcp_pose().position
+    hold_ready(qtbot, move.freedrive_button)
     qtbot.mousePress(move.freedrive_button, LEFT)  # hold Freedrive, and push the tool by hand
     qtbot.waitUntil(arm.freedrive_active, timeout=5_000)
     qtbot.waitUntil(lambda: move.freedrive_button.text() == "Freedrive: ON")
@@ -171,6 +173,7 @@ def test_move_here_stops_when_the_button_is_let_go(
     q_before = arm.joint_positions()
     panel.select("start")
     assert panel.move_button.isEnabled()
+    hold_ready(qtbot, panel.move_button)
     qtbot.mousePress(panel.move_button, LEFT)
     qtbot.waitUntil(lambda: q_before[0] - arm.joint_positions()[0] > 0.05, timeout=20_000)
     assert arm.is_moving()
@@ -183,6 +186,7 @@ def test_move_here_stops_when_the_button_is_let_go(
     assert arm.joint_positions() == pytest.approx(stopped, abs=1e-4)  # it stays
     assert stopped[0] - far.joints.positions[0] > 0.2  # far from the waypoint: it stopped
     # Held to the end, it arrives.
+    hold_ready(qtbot, panel.move_button)
     with qtbot.waitSignal(window.views.teacher.finished, timeout=60_000) as blocker:
         qtbot.mousePress(panel.move_button, LEFT)
     assert blocker.args == ["move to start", ""]
