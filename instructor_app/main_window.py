@@ -118,20 +118,20 @@ class MainWindow(QMainWindow):
         self.docks: dict[str, QDockWidget] = {}
         area = Qt.DockWidgetArea
         self._dock("palette", "Palette", self.views.palette, area.LeftDockWidgetArea)
+        self._dock("move", "Move", _scrolled(self.views.move), area.LeftDockWidgetArea)
         self._dock("objects", "Objects", self.views.objects, area.LeftDockWidgetArea)
-        self.tabifyDockWidget(self.docks["palette"], self.docks["objects"])
+        self.tabifyDockWidget(self.docks["palette"], self.docks["move"])
+        self.tabifyDockWidget(self.docks["move"], self.docks["objects"])
         self.docks["palette"].raise_()
         self._dock("inspector", "Inspector", self.views.inspector, area.RightDockWidgetArea)
         self._dock("plan", "Plan", self.views.plan_settings, area.RightDockWidgetArea)
         self._dock(
             "waypoints", "Waypoints", _scrolled(self.views.waypoints), area.RightDockWidgetArea
         )
-        self._dock("move", "Move", _scrolled(self.views.move), area.RightDockWidgetArea)
         self._dock("operator", "Operator", self.operator_panel, area.RightDockWidgetArea)
         self.splitDockWidget(self.docks["inspector"], self.docks["plan"], Qt.Orientation.Vertical)
         self.tabifyDockWidget(self.docks["plan"], self.docks["waypoints"])
-        self.tabifyDockWidget(self.docks["waypoints"], self.docks["move"])
-        self.tabifyDockWidget(self.docks["move"], self.docks["operator"])
+        self.tabifyDockWidget(self.docks["waypoints"], self.docks["operator"])
         self.docks["plan"].raise_()  # the operator tab comes forward when the robot asks
         bottom = [
             ("validation", "Problems", self.views.validation),

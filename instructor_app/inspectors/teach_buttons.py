@@ -82,6 +82,7 @@ class TeachButtons(QWidget):
         teacher: the RobotTeacher (moves off the GUI thread).
         teach: called on Teach.
         target: gives (target, reference) for Move here, or None when there is none.
+        by_name: True while the port is bound to a parameter name (nothing to teach then).
     """
 
     def __init__(
@@ -89,15 +90,17 @@ class TeachButtons(QWidget):
         teacher: Any,
         teach: Callable[[], object],
         target: Callable[[], tuple[Any, Any] | None],
+        by_name: Callable[[], bool] = lambda: False,
         parent: QWidget | None = None,
     ) -> None:
         super().__init__(parent)
         self._teacher = teacher
         self._target = target
+        self._by_name = by_name
         self.teach_button = QPushButton("Teach")
         self.teach_button.setToolTip("Fill this parameter from where the robot is now")
         self.teach_button.clicked.connect(teach)
-        self.move_button = QPushButton("Move here (hold)")
+        self.move_button = QPushButton("Move here")
         self.move_button.setToolTip(
             "Hold down to drive the arm to this pose at reduced speed; let go and it stops"
         )
@@ -107,12 +110,19 @@ class TeachButtons(QWidget):
         layout.setContentsMargins(0, 0, 0, 0)
         layout.addWidget(self.teach_button)
         layout.addWidget(self.move_button)
+        layout.addStretch(1)  # the buttons keep their size at the left, in view
         teacher.availability_changed.connect(self.update_enabled)
         self.update_enabled()
 
     def update_enabled(self) -> None:
         reason = self._teacher.unavailable_reason("arm")
-        self.teach_button.setEnabled(self._teacher.interface("arm") is not None)
+        by_name = self._by_name()
+        self.teach_button.setEnabled(self._teacher.interface("arm") is not None and not by_name)
+        self.teach_button.setToolTip(
+            "Bound to a parameter: choose 'value' to teach it"
+            if by_name
+            else "Fill this parameter from where the robot is now"
+        )
         has_target = self._target() is not None
         self.move_button.setEnabled(not reason and has_target)
         if reason:

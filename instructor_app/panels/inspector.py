@@ -276,7 +276,12 @@ class InspectorPanel(QWidget):
             params = node.params if node is not None else {}
             return move_target(params.get(port.name), params.get("reference"))
 
-        buttons = TeachButtons(self._teacher, lambda: self.teach(port.name), target)
+        def by_name() -> bool:
+            node = self._find(self._node_id)
+            binding = node.params.get(port.name) if node is not None else None
+            return binding is not None and binding.is_ref
+
+        buttons = TeachButtons(self._teacher, lambda: self.teach(port.name), target, by_name)
         self.teach_buttons[port.name] = buttons
         self.form.addRow("", buttons)
 

@@ -66,6 +66,7 @@ class MovePanel(QWidget):
         layout.addWidget(self._build_joints())
         layout.addLayout(self._build_speed())
         self.freedrive_button = QPushButton("Freedrive (hold)")
+        self.freedrive_button.setMinimumWidth(80)
         self.freedrive_button.setObjectName("FreedriveButton")
         self.freedrive_button.setToolTip(
             "Hold down to guide the arm by hand; let go and the arm stays where it is"
@@ -90,6 +91,7 @@ class MovePanel(QWidget):
         box = QGroupBox("Tool (world frame)")
         grid = QGridLayout(box)
         self.pose_labels: list[QLabel] = []
+        grid.setHorizontalSpacing(6)
         for index, name in enumerate(_POSE_LABELS):
             value = QLabel("—")
             value.setAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
@@ -98,12 +100,14 @@ class MovePanel(QWidget):
             grid.addWidget(QLabel(name), row, column)
             grid.addWidget(value, row, column + 1)
             self.pose_labels.append(value)
+        grid.setColumnStretch(1, 1)
+        grid.setColumnStretch(3, 1)
         return box
 
     def _build_jog(self) -> QGroupBox:
         box = QGroupBox("Jog the tool")
         outer = QVBoxLayout(box)
-        options = QHBoxLayout()
+        options = QGridLayout()
         self.frame_combo = QComboBox()
         for text, frame in _FRAMES:
             self.frame_combo.addItem(text, frame)
@@ -114,10 +118,11 @@ class MovePanel(QWidget):
         self.step_combo = QComboBox()
         self.step_combo.addItems([label for label, _, _ in STEPS])
         self.step_combo.setToolTip("How far one click moves; 'while held' moves until let go")
-        options.addWidget(QLabel("Frame"))
-        options.addWidget(self.frame_combo)
-        options.addWidget(QLabel("Step"))
-        options.addWidget(self.step_combo, 1)
+        options.addWidget(QLabel("Frame"), 0, 0)
+        options.addWidget(self.frame_combo, 0, 1)
+        options.addWidget(QLabel("Step"), 1, 0)
+        options.addWidget(self.step_combo, 1, 1)
+        options.setColumnStretch(1, 1)
         outer.addLayout(options)
         grid = QGridLayout()
         for row, letter in enumerate("xyz"):
@@ -130,6 +135,7 @@ class MovePanel(QWidget):
     def _jog_button(self, axis: str, sign: int) -> QPushButton:
         text = f"{axis.upper() if len(axis) == 1 else 'R' + axis[1]}{_MINUS if sign < 0 else '+'}"
         button = QPushButton(text)
+        button.setMinimumWidth(40)
         button.setObjectName(f"jog_{axis}{'-' if sign < 0 else '+'}")
         button.setAutoRepeat(False)
         button.pressed.connect(lambda: self._jog_pressed(axis, sign))
@@ -196,9 +202,9 @@ class MovePanel(QWidget):
         for label, value, unit in zip(
             self.pose_labels, values, ("mm",) * 3 + ("°",) * 3, strict=True
         ):
-            label.setText(f"{value:8.1f} {unit}")
+            label.setText(f"{value:.1f} {unit}")
         for label, angle in zip(self.joint_labels, state.joints, strict=False):
-            label.setText(f"{math.degrees(angle):7.2f} °")
+            label.setText(f"{math.degrees(angle):.2f} °")
         self.freedrive_button.setText("Freedrive: ON" if state.freedrive else "Freedrive (hold)")
 
     def _update_enabled(self) -> None:

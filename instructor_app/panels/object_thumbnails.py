@@ -82,7 +82,7 @@ class ThumbnailCache:
         size: the thumbnails' side in pixels.
     """
 
-    def __init__(self, folder: Path | None, size: int = 96) -> None:
+    def __init__(self, folder: Path | None, size: int = 64) -> None:
         self.folder = folder
         self.size = size
         self.drawn = 0  # how many were drawn, not read from the cache (for tests)

@@ -122,7 +122,7 @@ class WaypointsPanel(QWidget):
         self.teach_button = _button("Teach", "Teach the selected waypoint again, here")
         self.teach_button.clicked.connect(self.teach_selected)
         self.move_button = _button(
-            "Move here (hold)",
+            "Move here",
             "Hold down to drive the arm to the selected waypoint at reduced speed; "
             "let go and it stops",
             "WaypointMoveHere",
@@ -138,11 +138,12 @@ class WaypointsPanel(QWidget):
         self.remove_button.clicked.connect(self.remove_selected)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(2, 2, 2, 2)
+        # What a worker uses most comes first: record, the list, drive there; then details.
+        layout.addLayout(self._row(self.name_field, self.record_button))
+        layout.addLayout(self._row(self.frame_combo, self.object_field))
         layout.addWidget(self.list, 1)
+        layout.addLayout(self._row(self.move_button, self.teach_button, self.preview_button))
         layout.addWidget(self.details)
-        layout.addLayout(self._row(self.teach_button, self.move_button, self.preview_button))
-        layout.addLayout(self._row(self.name_field))
-        layout.addLayout(self._row(self.frame_combo, self.object_field, self.record_button))
         layout.addLayout(self._row(self.import_button, self.remove_button))
 
     def _focus_name(self, _item: object) -> None:
