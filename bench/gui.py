@@ -11,6 +11,9 @@ Figures (all in one offscreen QApplication, view 1280 x 800):
   event loop runs the scene's update processing and the paint). The whole tree is in view
   (the worst case: every node is repainted, as boxes at that zoom). ``*_zoom100`` figures
   are the same at 100 % zoom (full detail, only the nodes on screen are painted).
+- ``camera_fps``, ``tick_rate_ratio``, ``scene3d_fps`` (and the figures behind them): the
+  camera panel and the 3D scene while a plan runs on the simulated cell, measured by
+  ``bench/cell_views.py`` in a process of its own (on the display's GL when there is one).
 - ``ngqt_create_node_1000_s``: the peer, NodeGraphQt's own ``NodeGraph.create_node`` with
   its defaults, 1000 times, in the same process (nodes with one input and one output port).
 
@@ -26,6 +29,7 @@ import json
 import os
 import random
 import statistics
+import subprocess
 import sys
 import tempfile
 import time
@@ -160,7 +164,7 @@ def _percentile(values: list[float], fraction: float) -> float:
     return ordered[min(len(ordered) - 1, round(fraction * (len(ordered) - 1)))]
 
 
-def run_bench(frames: int) -> dict[str, float]:
+def run_bench(frames: int) -> dict[str, Any]:
     app = QApplication.instance() or QApplication([])
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "bench.costar.json"
@@ -179,7 +183,25 @@ def run_bench(frames: int) -> dict[str, float]:
         "frame_ms_median_zoom100": round(statistics.median(zoom100), 2),
         "frame_ms_p99_zoom100": round(_percentile(zoom100, 0.99), 2),
         "ngqt_create_node_1000_s": round(measure_ngqt_create(1000), 3),
+        **measure_cell_views_in_a_process(),
     }
+
+
+def measure_cell_views_in_a_process() -> dict[str, Any]:
+    """bench/cell_views.py's figures; its own process, so that it gets the display's GL
+    (this one is offscreen) and a fresh simulated cell."""
+    env = dict(os.environ)
+    if env.get("DISPLAY"):
+        env["QT_QPA_PLATFORM"] = "xcb"
+    script = Path(__file__).with_name("cell_views.py")
+    done = subprocess.run(
+        [sys.executable, str(script), "--json"], capture_output=True, text=True, env=env,
+        timeout=300,
+    )  # fmt: skip
+    if done.returncode != 0:
+        raise RuntimeError(f"bench/cell_views.py failed:\n{done.stderr[-2000:]}")
+    result: dict[str, Any] = json.loads(done.stdout.strip().splitlines()[-1])
+    return result
 
 
 def main(argv: list[str] | None = None) -> int:

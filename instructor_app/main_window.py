@@ -30,7 +30,9 @@ from instructor_app.document.editing import PlanDocument
 from instructor_app.document.model import DocumentError
 from instructor_app.document.tree_ops import can_have_child
 from instructor_app.node_factory import make_node, manifest_or_none
+from instructor_app.panels.cell_views import CellViews
 from instructor_app.panels.operator import OperatorPanel
+from instructor_app.panels.scene_teach import SceneTeachLink
 from instructor_app.panels.start_page import StartPage, find_examples
 from instructor_app.runtime.controller import RunController
 from instructor_app.runtime.run_view import (
@@ -96,6 +98,7 @@ class MainWindow(QMainWindow):
         self.operator_panel = OperatorPanel(self)
         self.failure_button = FailureButton(self._node_label, self)
         self.selection: list[str] = []
+        self.cell_views = CellViews(self.document, session, self._selected_node, parent=self)
         self._build_layout()
         self.actions_by_name: dict[str, QAction] = {}
         self._build_menus()
@@ -124,6 +127,13 @@ class MainWindow(QMainWindow):
         self.tabifyDockWidget(self.docks["move"], self.docks["objects"])
         self.docks["palette"].raise_()
         self._dock("inspector", "Inspector", self.views.inspector, area.RightDockWidgetArea)
+        # The cell's views: a column right of the inspector, cameras above the 3D scene.
+        self._dock("cameras", "Cameras", self.cell_views.cameras, area.RightDockWidgetArea)
+        self._dock("scene3d", "3D scene", self.cell_views.scene3d, area.RightDockWidgetArea)
+        self.splitDockWidget(
+            self.docks["inspector"], self.docks["cameras"], Qt.Orientation.Horizontal
+        )
+        self.splitDockWidget(self.docks["cameras"], self.docks["scene3d"], Qt.Orientation.Vertical)
         self._dock("plan", "Plan", self.views.plan_settings, area.RightDockWidgetArea)
         self._dock(
             "waypoints", "Waypoints", _scrolled(self.views.waypoints), area.RightDockWidgetArea
@@ -133,6 +143,9 @@ class MainWindow(QMainWindow):
         self.tabifyDockWidget(self.docks["plan"], self.docks["waypoints"])
         self.tabifyDockWidget(self.docks["waypoints"], self.docks["operator"])
         self.docks["plan"].raise_()  # the operator tab comes forward when the robot asks
+        self.resizeDocks(
+            [self.docks["cameras"], self.docks["scene3d"]], [420, 480], Qt.Orientation.Vertical
+        )
         bottom = [
             ("validation", "Problems", self.views.validation),
             ("log", "Log", self.views.log),
@@ -151,7 +164,9 @@ class MainWindow(QMainWindow):
             [self.docks["inspector"], self.docks["plan"]], [700, 200], Qt.Orientation.Vertical
         )
         self.resizeDocks(
-            [self.docks["palette"], self.docks["inspector"]], [240, 320], Qt.Orientation.Horizontal
+            [self.docks[n] for n in ("palette", "inspector", "cameras")],
+            [240, 320, 560],
+            Qt.Orientation.Horizontal,
         )
         self.cell_label = QLabel(" Cell: ")
         self.cell_combo = QComboBox(self)
@@ -243,6 +258,11 @@ class MainWindow(QMainWindow):
         views.waypoints.message.connect(self.show_message)
         views.teacher.message.connect(self.show_message)
         views.objects.message.connect(self.show_message)
+        self.cell_views.message.connect(self.show_message)
+        # Drag the tool gizmo in the 3D scene, preview waypoints as a ghost arm there.
+        self.scene_link = SceneTeachLink(
+            self.cell_views.scene3d, views.teacher, views.waypoints, self
+        )
         self.session.cell_changed.connect(lambda _name: self._attach_operator())
         self.operator_panel.prompt_shown.connect(lambda _text: self._raise_dock("operator"))
         self._attach_operator()
@@ -290,6 +310,9 @@ class MainWindow(QMainWindow):
         """The operator panel answers the prompts of the cell in use (its "operator")."""
         cell = self.session.cell
         self.operator_panel.set_console(cell.interfaces().get("operator") if cell else None)
+
+    def _selected_node(self) -> str | None:
+        return self.selection[0] if len(self.selection) == 1 else None
 
     def _raise_dock(self, name: str) -> None:
         self.docks[name].show()
@@ -524,6 +547,7 @@ class MainWindow(QMainWindow):
     def shutdown(self) -> None:
         """Stop the run, the robot's teaching commands, background drawing and autosave."""
         self.controller.shutdown()
+        self.cell_views.stop()
         self.views.teacher.shutdown()
         self.views.objects.shutdown()
         self.autosaver.stop()

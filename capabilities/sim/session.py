@@ -55,6 +55,7 @@ class SimCameraDevice:
         self.name = camera.name
         mount = camera.mount
         self.on_wrist = isinstance(mount, LinkMount)
+        self._preview: SimCamera | None = None
         self._believed: Pose = (
             mount.T_link_camera if isinstance(mount, LinkMount) else mount.T_world_camera
         )
@@ -73,12 +74,25 @@ class SimCameraDevice:
         """Store a calibration: the world pose (fixed camera) or the flange pose (wrist)."""
         self._believed = pose
 
-    def capture(self) -> RGBDFrame:
+    def capture(self, size: tuple[int, int] | None = None) -> RGBDFrame:
+        """Render a frame; ``size`` (width, height) renders a smaller view of the same
+        camera (a live preview: the CPU renderer's cost grows with the pixels)."""
+        camera = self.camera if size is None else self._resized(size)
+
         def render(client: int) -> RGBDFrame:
-            frame = self.camera.capture(client, stamp=self._cell.time())
+            frame = camera.capture(client, stamp=self._cell.time())
             return dataclasses.replace(frame, T_world_camera=self.extrinsics())
 
         return self._cell.call(render)
+
+    def _resized(self, size: tuple[int, int]) -> SimCamera:
+        config = self.camera.config
+        if (config.width, config.height) == tuple(size):
+            return self.camera
+        if self._preview is None or self._preview.config.width != size[0]:
+            small = dataclasses.replace(config, width=int(size[0]), height=int(size[1]))
+            self._preview = SimCamera(self.camera.name, small, self.camera.mount)
+        return self._preview
 
     def displace_for_test(self, true_pose: Pose) -> None:
         """TEST ONLY: physically move a fixed camera (its believed pose stays as it was)."""
@@ -178,16 +192,27 @@ class SimCellSession:
 
     def scene_layout(self) -> dict[str, Any]:
         """What a worker configures about the cell (not ground truth of movable objects):
-        marker sizes, which object carries which marker, and the table markers' poses."""
+        marker sizes, which object carries which marker, the table markers' poses, and the
+        fixed furniture (table, holster) as boxes."""
         # Every marker the object library knows, not only those on objects present now: an
         # object handed in later must be recognised by its marker too.
         sizes = {m.marker_id: m.size for m in self.scene.fixed_markers.values()}
         library = self.scene.library
         for name in library.names():
             sizes.update({m.marker_id: m.size for m in library.get(name).markers})
+        table = self.sim.config.table
         return {
             "marker_sizes": sizes,
             "fixed_markers": {m.marker_id: m.pose for m in self.scene.fixed_markers.values()},
+            # The furniture, for views of the cell: boxes (name, centre pose, size x y z).
+            "fixtures": [
+                ("table", Pose((*table.center, table.top_z - table.size[2] / 2)), table.size),
+                (
+                    "holster",
+                    self.sim.config.holster_pose.compose(Pose((0.0, 0.0, 0.05))),
+                    (0.12, 0.12, 0.10),
+                ),
+            ],
         }
 
     def clock(self) -> float:

@@ -5,6 +5,10 @@ ghost arm at a waypoint. The scene here is a stand-in with the 3D panel's public
 
 from __future__ import annotations
 
+import json
+import os
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -94,3 +98,26 @@ def test_drag_the_tool_record_and_run(qtbot: Any, fast_sim: CellSession, tmp_pat
     set_value(qtbot, window, node_id, "target", dragged)
     assert run_to_end(qtbot, window, 60_000).status is Status.SUCCESS
     assert arm.tcp_pose().position == pytest.approx(path[-1].position, abs=1e-3)
+
+
+ROOT = Path(__file__).resolve().parents[4]
+
+
+@pytest.mark.skipif(
+    not os.environ.get("DISPLAY"), reason="needs an X display with GL (run under xvfb-run)"
+)
+def test_with_opengl_a_mouse_drag_of_the_gizmo_teaches_a_waypoint_a_plan_reaches() -> None:
+    """The real 3D scene (helper cams3d's) in the window, in its own process on Xvfb's GL."""
+    env = {**os.environ, "QT_QPA_PLATFORM": "xcb", "PYTHONPATH": str(ROOT)}
+    done = subprocess.run(
+        [sys.executable, str(Path(__file__).with_name("scene_drag_gl_check.py"))],
+        capture_output=True, text=True, timeout=180, env=env, cwd=ROOT,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr[-3000:]
+    out = json.loads(done.stdout.strip().splitlines()[-1])
+    assert out["available"] is True and out["gizmo_on_tcp"] is True
+    assert out["drag_ended"] is True and out["freedrive_off"] is True
+    assert out["moved_mm"] > 20  # the arm followed the hand...
+    assert out["arm_at_release_mm"] < 1.0  # ...to where it let go
+    assert out["ghost_shown"] is True
+    assert out["run"] == "SUCCESS" and out["after_run_mm"] < 1.0

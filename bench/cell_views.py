@@ -1,0 +1,132 @@
+"""The camera panel and the 3D scene while a plan runs on the simulated cell (real time).
+
+One main window on the simulated cell runs ``cup_to_bin_vision`` forever; the run alternates
+between phases with the camera and 3D docks hidden (nothing captured or drawn) and shown:
+
+- ``camera_fps``: pictures per second each camera shows in the camera panel (320x240) while
+  the plan runs (goal at least 15).
+- ``tick_rate_ratio``: engine ticks per second with the panels shown / with them hidden, in
+  the same run (goal at least 0.9).
+- ``scene3d_fps``: frames per second the 3D scene draws while the arm moves (null where no
+  OpenGL context can be made: run under xvfb-run).
+- ``sim_speed_on`` / ``sim_speed_off``: simulated seconds per wall second in each phase (the
+  CPU renderer runs on the physics thread, so camera frames cost the simulation time).
+
+Run it on its own or through ``bench/gui.py`` (which runs it in a process of its own with
+``QT_QPA_PLATFORM=xcb`` when there is a display)::
+
+    xvfb-run -a .venv/bin/python bench/cell_views.py --json
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+if __package__ in (None, ""):  # run as a script: make the repository importable
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+if not os.environ.get("DISPLAY"):
+    os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+
+from PySide6.QtCore import QEventLoop, QSettings, QTimer
+from PySide6.QtWidgets import QApplication
+
+from engine.tree import RunPolicy
+
+__all__ = ["measure_cell_views", "main"]
+
+PLAN = (
+    Path(__file__).resolve().parents[1] / "resources" / "examples" / "cup_to_bin_vision.costar.json"
+)
+
+
+def _wait(seconds: float) -> None:
+    loop = QEventLoop()
+    QTimer.singleShot(int(seconds * 1000), loop.quit)
+    loop.exec()
+
+
+def _phase(window: Any, shown: bool, seconds: float) -> dict[str, float]:
+    views = window.cell_views
+    for name in ("cameras", "scene3d"):
+        window.docks[name].setVisible(shown)
+    _wait(1.0)  # settle: the feed starts or stops, the docks lay out
+    executor = window.controller._executor  # the bench reads the engine's tick counter
+    cell = window.session.cell
+    ticks0, sim0, wall0 = executor.tree.ctx.tick_count, cell.sim.time(), time.perf_counter()
+    frames0, drawn0 = views.cameras.frames_shown, views.scene3d.frames_drawn
+    _wait(seconds)
+    wall = time.perf_counter() - wall0
+    cameras = max(len(views.cameras.shown), 1)
+    return {
+        "ticks_per_s": (executor.tree.ctx.tick_count - ticks0) / wall,
+        "camera_fps": (views.cameras.frames_shown - frames0) / wall / cameras,
+        "scene3d_fps": (views.scene3d.frames_drawn - drawn0) / wall,
+        "sim_speed": (cell.sim.time() - sim0) / wall,
+    }
+
+
+def measure_cell_views(seconds: float = 6.0) -> dict[str, Any]:
+    from instructor_app.app import HeadlessDialogs
+    from instructor_app.main_window import MainWindow
+    from instructor_app.runtime.session import CellSession
+    from instructor_app.settings import AppSettings
+
+    app = QApplication.instance() or QApplication([])
+    session = CellSession("sim", speed=1.0)
+    session.open()
+    with tempfile.TemporaryDirectory() as scratch:
+        settings = AppSettings(QSettings(str(Path(scratch, "s.ini")), QSettings.Format.IniFormat))
+        window = MainWindow(session, settings, HeadlessDialogs(), Path(scratch, "recovery"))
+        try:
+            window.resize(1920, 1080)
+            window.show()
+            window.document.open(PLAN)
+            window.document.set_plan_field("run_policy", RunPolicy.FOREVER)
+            assert window.controller.run(), "the plan did not start"
+            _wait(1.0)
+            off = _phase(window, False, seconds)
+            on = _phase(window, True, seconds)
+            app.processEvents()
+        finally:
+            window.controller.shutdown()
+            window.cell_views.stop()
+            window.autosaver.stop()
+            window.hide()
+            session.close()
+    gl = window.cell_views.scene3d.available
+    return {
+        "camera_fps": round(on["camera_fps"], 1),
+        "tick_rate_ratio": round(on["ticks_per_s"] / off["ticks_per_s"], 3),
+        "scene3d_fps": round(on["scene3d_fps"], 1) if gl else None,
+        "ticks_per_s_panels_on": round(on["ticks_per_s"], 1),
+        "ticks_per_s_panels_off": round(off["ticks_per_s"], 1),
+        "sim_speed_on": round(on["sim_speed"], 2),
+        "sim_speed_off": round(off["sim_speed"], 2),
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Print the figures (``--json``: one JSON object)."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.add_argument("--seconds", type=float, default=6.0, help="length of each phase")
+    args = parser.parse_args(argv)
+    results = measure_cell_views(args.seconds)
+    if args.json:
+        print(json.dumps(results))
+    else:
+        for key, value in results.items():
+            print(f"{key:26s} {value}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

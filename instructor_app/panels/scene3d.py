@@ -1,0 +1,396 @@
+"""The 3D scene: the robot in its current joints, the furniture, what the cell recognised,
+the latest point cloud, the plan's waypoints and regions, and the cameras' view pyramids.
+
+Drawn with pyqtgraph.opengl; where no OpenGL context can be made (``QT_QPA_PLATFORM=offscreen``,
+no GL driver) the panel shows why and everything else of the window works. Nothing here
+blocks the GUI thread: joints are a read of the arm's last measured state, recognised objects
+come from the world model, the point cloud from the camera panel's latest frame, and the
+simulation's ground truth (a labelled toggle, for checking perception by eye) is fetched on a
+worker thread.
+
+API for other panels (see /work/issues/COORD-scene3d.md): :meth:`Scene3DPanel.show_ghost`,
+:meth:`Scene3DPanel.set_gizmo` and the signals ``gizmo_dragged``, ``gizmo_released``,
+``point_picked`` and ``region_drawn``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Sequence
+from concurrent.futures import Future, ThreadPoolExecutor
+from typing import Any
+
+import numpy as np
+import pyqtgraph.opengl as gl
+from PySide6.QtCore import Qt, QTimer, Signal
+from PySide6.QtWidgets import QCheckBox, QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget
+
+from capabilities.geometry import pose_to_matrix
+from capabilities.motion.symmetry import SymmetryTable
+from capabilities.motion.targets import TargetResolver
+from capabilities.robot_body import robot_base_from_arm
+from engine.operations import OperationFailed
+from engine.types import Pose, Region, Waypoint, WaypointFrame
+from instructor_app.panels.scene3d_items import (
+    RobotItems,
+    axes_item,
+    box_item,
+    frustum_lines,
+    mesh_data,
+    set_pose,
+    sphere_item,
+)
+from instructor_app.panels.scene3d_pointing import PointingMixin
+from instructor_app.panels.scene3d_view import SceneView, opengl_problem
+
+__all__ = ["Scene3DPanel"]
+
+REFRESH_MS = 33
+REGION_RGBA = (1.0, 0.25, 0.8, 0.25)
+DETECTED_RGBA = (0.2, 0.9, 0.35, 1.0)
+TRUTH_RGBA = (1.0, 0.6, 0.1, 0.45)
+FrameSource = Callable[[str], Any]
+
+
+class Scene3DPanel(PointingMixin, QWidget):
+    """The cell in 3D (see the module doc).
+
+    Signals:
+        point_picked(object): (x, y, z) of a clicked surface (point cloud, table, furniture).
+        region_drawn(object): an ``engine.types.Region`` drawn in region mode.
+        gizmo_dragged(object): the target TCP ``Pose`` while the gizmo is dragged.
+        gizmo_released(object): the ``Pose`` where the gizmo's drag ended.
+        message(str): for the status bar.
+    """
+
+    point_picked = Signal(object)
+    region_drawn = Signal(object)
+    gizmo_dragged = Signal(object)
+    gizmo_released = Signal(object)
+    message = Signal(str)
+
+    def __init__(self, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("Scene3DPanel")
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(2, 2, 2, 2)
+        problem = opengl_problem()
+        self.available = problem is None
+        self.view: SceneView | None = None
+        self.problem_label = QLabel(f"The 3D scene needs OpenGL: {problem}." if problem else "")
+        if problem is not None:
+            self.problem_label.setWordWrap(True)
+            self.problem_label.setAlignment(Qt.AlignmentFlag.AlignCenter)
+            layout.addWidget(self.problem_label)
+            return
+        self._cell: Any = None
+        self._frames: FrameSource = lambda _name: None
+        self._regions: list[tuple[str, Region]] = []
+        self._waypoints: list[Waypoint] = []
+        self._gizmo: Pose | None = None
+        self._draft: tuple[np.ndarray, np.ndarray] | None = None  # region centre, view normal
+        self._workers = ThreadPoolExecutor(1, "scene3d-truth")
+        self._truth_job: Future[list[tuple[str, Pose]]] | None = None
+        self._tick = 0
+        self._build(layout)
+        self._timer = QTimer(self)
+        self._timer.setInterval(REFRESH_MS)
+        self._timer.timeout.connect(self._refresh)
+
+    def _build(self, layout: QVBoxLayout) -> None:
+        self.region_button = QPushButton("Draw region")
+        self.region_button.setCheckable(True)
+        self.region_button.setToolTip(
+            "Press on a surface at the region's centre and drag its radius"
+        )
+        self.cloud_box = QCheckBox("Point cloud")
+        self.cloud_box.setChecked(True)
+        self.truth_box = QCheckBox("Ground truth (simulation)")
+        self.truth_box.setToolTip(
+            "Where the simulator really has the objects (orange), to check perception"
+        )
+        bar = QHBoxLayout()
+        for widget in (self.region_button, self.cloud_box, self.truth_box):
+            bar.addWidget(widget)
+        bar.addStretch(1)
+        layout.addLayout(bar)
+        self.view = view = SceneView(self)
+        view.setBackgroundColor((32, 32, 36))
+        view.setMinimumHeight(260)
+        # From behind the robot's left, looking at the table (the robot base is at the origin).
+        view.setCameraPosition(
+            pos=pg_vector(0.35, 0.0, 0.1), distance=2.0, elevation=32, azimuth=200
+        )
+        view.gizmo_position = lambda: (
+            None if self._gizmo is None else np.array(self._gizmo.position)
+        )
+        view.clicked.connect(self._on_click)
+        view.pressed.connect(self._on_press)
+        view.dragged.connect(self._on_drag)
+        view.released.connect(self._on_release)
+        view.gizmo_moved.connect(self._on_gizmo_moved)
+        self.region_button.toggled.connect(lambda on: setattr(view, "capture_drags", on))
+        layout.addWidget(view, 1)
+        self._static: list[Any] = []
+
+    # ------------------------------------------------------------------ inputs
+
+    def set_cell(self, cell: Any) -> None:
+        """Draw another cell (None: only the grid)."""
+        if self.view is None:
+            return
+        view = self.view
+        for item in list(view.items):
+            view.removeItem(item)
+        self._cell = cell
+        self.robot = self.ghost = None
+        view.addItem(gl.GLGridItem(size=pg_vector(3, 3, 1), color=(255, 255, 255, 40)))
+        interfaces = cell.interfaces() if cell is not None else {}
+        self.table_z = 0.0  # picks fall on the table top when they miss the point cloud
+        for name, pose, size in (interfaces.get("scene_layout") or {}).get("fixtures", []):
+            box = box_item(size, (0.55, 0.45, 0.35, 1.0))
+            set_pose(box, pose_to_matrix(pose))
+            view.addItem(box)
+            if name == "table":
+                self.table_z = pose.position[2] + size[2] / 2
+        self.arm = interfaces.get("arm")
+        if self.arm is not None:
+            base = robot_base_from_arm(self.arm)
+            self.robot = RobotItems(view, base)
+            self.ghost = RobotItems(view, base, (0.4, 0.7, 1.0, 0.35))
+            self.ghost.set_visible(False)
+        self.cameras = {
+            k.split(":", 1)[1]: v for k, v in interfaces.items() if k.startswith("rgbd:")
+        }
+        self.frusta = {
+            name: gl.GLLinePlotItem(mode="lines", color=(1, 1, 0.3, 0.8)) for name in self.cameras
+        }
+        self.cloud = gl.GLScatterPlotItem(size=1.5, pxMode=True)
+        self.gizmo_items = (
+            axes_item(0.12, 3.0),
+            gl.GLMeshItem(
+                meshdata=gl.MeshData.sphere(rows=8, cols=12, radius=0.018),
+                color=(1, 1, 0, 1),
+                shader="shaded",
+            ),
+        )
+        for item in (*self.frusta.values(), self.cloud, *self.gizmo_items):
+            view.addItem(item)
+        self._dynamic: dict[str, list[Any]] = {
+            "objects": [],
+            "truth": [],
+            "regions": [],
+            "waypoints": [],
+            "draft": [],
+        }
+        self.set_gizmo(self._gizmo)
+        self._show_regions()
+        self._show_waypoints()
+        self._timer.start()
+
+    def set_frame_source(self, source: FrameSource) -> None:
+        """Where the point cloud comes from: camera name -> latest feed frame (or None)."""
+        self._frames = source
+
+    def set_regions(self, regions: Iterable[tuple[str, Region]]) -> None:
+        """The plan's regions (name, sphere), drawn as translucent spheres."""
+        self._regions = list(regions)
+        if self.view is not None and self._cell is not None:
+            self._show_regions()
+
+    def set_waypoints(self, waypoints: Iterable[Waypoint]) -> None:
+        """The plan's waypoints, drawn as small named axes where they are now."""
+        self._waypoints = list(waypoints)
+        if self.view is not None and self._cell is not None:
+            self._show_waypoints()
+
+    def stop(self) -> None:
+        """Stop refreshing (before the cell closes)."""
+        if self.view is not None:
+            self._timer.stop()
+            self._workers.shutdown(wait=False, cancel_futures=True)
+            self._workers = ThreadPoolExecutor(1, "scene3d-truth")
+
+    # ------------------------------------------------------------------ API for teaching
+
+    def show_ghost(self, joints: Sequence[float] | None) -> None:
+        """A translucent arm at these joints (rad), e.g. a waypoint's preview; None hides it."""
+        ghost = getattr(self, "ghost", None)
+        if ghost is None:
+            return
+        if joints is not None:
+            ghost.set_joints(joints)
+        ghost.set_visible(joints is not None)
+
+    def set_gizmo(self, pose: Pose | None) -> None:
+        """Show the draggable tool gizmo at a TCP pose (None hides it)."""
+        self._gizmo = pose
+        items = getattr(self, "gizmo_items", ())
+        for item in items:
+            item.setVisible(pose is not None)
+            if pose is not None:
+                set_pose(item, pose_to_matrix(pose))
+
+    def _on_gizmo_moved(self, position: Any, done: Any) -> None:
+        if self._gizmo is None:
+            return
+        x, y, z = (float(v) for v in position)
+        pose = Pose((x, y, z), self._gizmo.orientation)
+        self.set_gizmo(pose)
+        (self.gizmo_released if done else self.gizmo_dragged).emit(pose)
+
+    # ------------------------------------------------------------------ refresh
+
+    @property
+    def frames_drawn(self) -> int:
+        return self.view.frames_drawn if self.view is not None else 0
+
+    def _refresh(self) -> None:
+        if self.view is None or not self.isVisible():
+            return
+        self._tick += 1
+        changed = False
+        if self.robot is not None and self.arm is not None:
+            q = tuple(self.arm.joint_positions())
+            if q != self.robot.joints:
+                self.robot.set_joints(q)
+                changed = True
+        for name, camera in self.cameras.items():
+            if getattr(camera, "on_wrist", False) or self._tick == 1:
+                self._show_frustum(name, camera)
+        if self._tick % 10 == 1:
+            self._show_objects()
+            self._show_truth()
+            changed = True
+        if self._tick % 15 == 1:
+            self._show_cloud()
+            changed = True
+        if changed:
+            self.view.update()
+
+    def _show_frustum(self, name: str, camera: Any) -> None:
+        latest = self._frames(name)
+        K = camera.intrinsics
+        size = (
+            latest.frame.depth.shape[::-1]
+            if latest is not None
+            else (int(2 * K[0, 2]), int(2 * K[1, 2] + 2))
+        )
+        self.frusta[name].setData(pos=frustum_lines(K, size, camera.extrinsics()))
+
+    def _show_cloud(self) -> None:
+        latest = self._frames("shoulder")
+        if not self.cloud_box.isChecked() or latest is None:
+            self.cloud.setVisible(False)
+            return
+        frame = latest.frame
+        stride = max(1, frame.depth.shape[1] // 120)
+        # The floor around the table says nothing about the task: only what is on the table.
+        keep = frame.point_cloud(stride)[:, 2] > self.table_z - 0.02
+        points = frame.point_cloud(stride)[keep]
+        colours = frame.point_colors(stride)[keep].astype(np.float32) / 255.0
+        self.cloud.setData(
+            pos=points, color=np.column_stack((colours, np.full(len(colours), 0.8, np.float32)))
+        )
+        self.cloud.setVisible(True)
+        self._cloud_points = points
+
+    def _replace(self, group: str, items: list[Any]) -> None:
+        assert self.view is not None
+        for item in self._dynamic[group]:
+            self.view.removeItem(item)
+        for item in items:
+            self.view.addItem(item)
+        self._dynamic[group] = items
+
+    def _object_items(
+        self, name: str, pose: Pose, colour: tuple[float, ...], label: str
+    ) -> list[Any]:
+        library = (self._cell.interfaces() if self._cell else {}).get("objects")
+        try:
+            data = mesh_data(str(library.get(name).mesh_file))  # type: ignore[union-attr]
+        except Exception:  # no library or an unknown class: a ball marks where it was seen
+            data = gl.MeshData.sphere(rows=6, cols=8, radius=0.03)
+        mesh = gl.GLMeshItem(meshdata=data, color=colour, shader="shaded",
+                             glOptions="translucent" if colour[3] < 1 else "opaque")  # fmt: skip
+        set_pose(mesh, pose_to_matrix(pose))
+        text = gl.GLTextItem(
+            pos=np.add(pose.position, (0, 0, 0.12)), text=label, color=(230, 230, 230, 255)
+        )
+        return [mesh, text]
+
+    def _show_objects(self) -> None:
+        world = (self._cell.interfaces() if self._cell else {}).get("world")
+        items: list[Any] = []
+        for d in world.detections() if world is not None else []:
+            items += self._object_items(
+                d.object_class, d.pose, DETECTED_RGBA, f"{d.object_class} {d.confidence:.0%}"
+            )
+        self._replace("objects", items)
+
+    def _show_truth(self) -> None:
+        """Ground truth (simulation only): fetched on a worker, shown when it arrives."""
+        job, self._truth_job = self._truth_job, None
+        if (
+            job is not None
+            and job.done()
+            and job.exception() is None
+            and self.truth_box.isChecked()
+        ):
+            self._replace(
+                "truth",
+                [
+                    i
+                    for n, p in job.result()
+                    for i in self._object_items(n, p, TRUTH_RGBA, f"{n} (truth)")
+                ],
+            )
+        elif not self.truth_box.isChecked():
+            self._replace("truth", [])
+        cell = self._cell
+        if (
+            self.truth_box.isChecked()
+            and callable(getattr(cell, "truth_pose", None))
+            and hasattr(cell, "scene")
+        ):
+            names = list(cell.scene.objects)
+            self._truth_job = self._workers.submit(lambda: [(n, cell.truth_pose(n)) for n in names])
+
+    def _show_regions(self) -> None:
+        items: list[Any] = []
+        for name, region in self._regions:
+            sphere = sphere_item(region.radius, REGION_RGBA)
+            sphere.translate(*region.center)
+            items += [sphere, gl.GLTextItem(pos=np.add(region.center, (0, 0, region.radius + 0.02)),
+                                            text=name, color=(255, 120, 220, 255))]  # fmt: skip
+        self._replace("regions", items)
+
+    def _waypoint_pose(self, waypoint: Waypoint) -> Pose | None:
+        """Where a waypoint is now, resolved as motion.move_to resolves it (a relative one
+        against the object or marker last seen); None when that cannot be told."""
+        if waypoint.frame is WaypointFrame.JOINTS:
+            fk = getattr(self.arm, "forward_kinematics", None)
+            return fk(waypoint.joints.positions) if fk and waypoint.joints else None
+        world = (self._cell.interfaces() if self._cell else {}).get("world")
+        try:
+            resolved = TargetResolver(world, SymmetryTable()).resolve(waypoint, None, Pose())
+        except OperationFailed:
+            return None
+        return resolved.poses[0] if resolved.poses else None
+
+    def _show_waypoints(self) -> None:
+        items: list[Any] = []
+        for waypoint in self._waypoints:
+            pose = self._waypoint_pose(waypoint)
+            if pose is None:
+                continue
+            axes = axes_item()
+            set_pose(axes, pose_to_matrix(pose))
+            items += [axes, gl.GLTextItem(pos=np.add(pose.position, (0, 0, 0.03)), text=waypoint.name,
+                                          color=(200, 230, 255, 255))]  # fmt: skip
+        self._replace("waypoints", items)
+
+
+def pg_vector(x: float, y: float, z: float) -> Any:
+    from pyqtgraph import Vector
+
+    return Vector(x, y, z)
