@@ -47,6 +47,12 @@ _FRAMES = (("Base", "base"), ("Tool", "tool"))
 _MINUS = "\u2212"  # a real minus sign on the buttons
 
 
+def _number(value: float, decimals: int) -> str:
+    """``value`` rounded for display, without a "-0.0"."""
+    text = f"{value:.{decimals}f}"
+    return text[1:] if text.startswith("-") and float(text) == 0 else text
+
+
 class MovePanel(QWidget):
     """Live pose and joints, jog arrows, speed and Freedrive.
 
@@ -202,9 +208,9 @@ class MovePanel(QWidget):
         for label, value, unit in zip(
             self.pose_labels, values, ("mm",) * 3 + ("°",) * 3, strict=True
         ):
-            label.setText(f"{value:.1f} {unit}")
+            label.setText(f"{_number(value, 1)} {unit}")
         for label, angle in zip(self.joint_labels, state.joints, strict=False):
-            label.setText(f"{math.degrees(angle):.2f} °")
+            label.setText(f"{_number(math.degrees(angle), 2)} °")
         self.freedrive_button.setText("Freedrive: ON" if state.freedrive else "Freedrive (hold)")
 
     def _update_enabled(self) -> None:
