@@ -14,6 +14,11 @@ A model is a folder ``<library>/<name>/`` with ``model.json`` (format_version 1)
   ids, side in m (black border included), marker frame in the object frame (see
   markers_texture for the convention)
 - ``color`` (RGBA 0..1), ``friction`` (optional, default 0.6); other fields are kept in ``extra``.
+- ``grasps`` (optional): ``[{"name", "tool", "pose", "approach"}]``, taught once relative to
+  the object: ``pose`` is the tool's TCP in the object frame when it holds the object,
+  ``approach`` the TCP pose it comes from and lifts back to; ``tool`` is ``gripper`` (the
+  parallel gripper closes) or ``suction`` (the suction tool's cup takes it). The first grasp
+  is the default; the symmetry gives each grasp its equivalents.
 """
 
 from __future__ import annotations
@@ -28,8 +33,10 @@ from engine.json_reader import JsonFileError, JsonReader, read_json_file
 from engine.types import Pose
 
 __all__ = [
+    "GRASP_TOOLS",
     "BoxPart",
     "CollisionSpec",
+    "GraspSpec",
     "MarkerSpec",
     "ObjectLibrary",
     "ObjectLibraryError",
@@ -42,8 +49,10 @@ __all__ = [
 FORMAT_VERSION = 1
 _KNOWN_FIELDS = {
     "format_version", "name", "description", "mesh", "collision", "mass", "center_of_mass",
-    "dimensions", "symmetry", "markers", "color", "friction",
+    "dimensions", "symmetry", "markers", "color", "friction", "grasps",
 }  # fmt: skip
+GRASP_TOOLS = ("gripper", "suction")
+_MIN_APPROACH = 0.01  # m: an approach closer to the grasp than this is no approach
 
 
 class ObjectLibraryError(CapabilityError):
@@ -105,6 +114,23 @@ class Symmetry:
 
 
 @dataclass(frozen=True)
+class GraspSpec:
+    """A grasp taught once relative to the object (all poses in the object frame).
+
+    Attributes:
+        name: unique within the model ("top", "suction").
+        tool: ``gripper`` or ``suction``: what takes the object.
+        pose: the TCP pose that holds the object.
+        approach: the TCP pose the tool comes from, straight to ``pose``, and lifts back to.
+    """
+
+    name: str
+    tool: str
+    pose: Pose
+    approach: Pose
+
+
+@dataclass(frozen=True)
 class ObjectModelSpec:
     """A parsed ``model.json``: everything the cell and perception know about a model."""
 
@@ -121,6 +147,17 @@ class ObjectModelSpec:
     friction: float = 0.6
     description: str = ""
     extra: dict[str, Any] = field(default_factory=dict)
+    grasps: tuple[GraspSpec, ...] = ()
+
+    def grasp(self, name: str = "") -> GraspSpec:
+        """The grasp called ``name`` (empty: the first); ObjectLibraryError names the choices."""
+        if not self.grasps:
+            raise ObjectLibraryError(f"{self.directory / 'model.json'}: {self.name} has no grasps")
+        found = next((g for g in self.grasps if g.name == name), None) if name else self.grasps[0]
+        if found is None:
+            names = ", ".join(g.name for g in self.grasps)
+            raise ObjectLibraryError(f"{self.name} has no grasp {name!r} (it has {names})")
+        return found
 
     @property
     def footprint_radius(self) -> float:
@@ -168,6 +205,21 @@ def _parse_markers(f: JsonReader) -> tuple[MarkerSpec, ...]:
     )
 
 
+def _parse_grasps(f: JsonReader) -> tuple[GraspSpec, ...]:
+    grasps: list[GraspSpec] = []
+    for g in f.items("grasps", "grasps"):
+        name = g.text("name", nonempty=True)
+        if name in (known.name for known in grasps):
+            g.fail("a grasp name not used before in this model", key="name")
+        grasp = GraspSpec(name, g.choice("tool", GRASP_TOOLS), g.pose("pose"), g.pose("approach"))
+        if math.dist(grasp.pose.position, grasp.approach.position) < _MIN_APPROACH:
+            g.fail(
+                f"an approach {_MIN_APPROACH * 1000:.0f} mm or more from the pose", key="approach"
+            )
+        grasps.append(grasp)
+    return tuple(grasps)
+
+
 def _parse_model(f: JsonReader, directory: Path) -> ObjectModelSpec:
     f.as_object()
     f.check_version((FORMAT_VERSION,))
@@ -194,6 +246,7 @@ def _parse_model(f: JsonReader, directory: Path) -> ObjectModelSpec:
         friction=f.number("friction", 0.6, lo=0.0, above=True),
         description=f.text("description", ""),
         extra={k: v for k, v in f.as_object().items() if k not in _KNOWN_FIELDS},
+        grasps=_parse_grasps(f),
     )
 
 

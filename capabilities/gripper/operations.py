@@ -1,11 +1,16 @@
-"""Operations of the gripper capability: open, close, is_closed, is_holding."""
+"""Operations of the gripper capability: open, close, is_closed, is_holding, and grasp (an
+object at its pose with a grasp of its model, :mod:`capabilities.gripper.grasp`)."""
 
 from __future__ import annotations
 
-from capabilities.base import Capability, CapabilityEnv
+from capabilities.base import Capability, CapabilityEnv, CapabilityError
 from capabilities.gripper.backend import GRIPPER, GripperBackend
+from capabilities.gripper.grasp import Grasp, grasp_manifest
 from capabilities.jobs import job_from_handle
 from capabilities.kit import manifest
+from capabilities.motion.backend import ARM
+from capabilities.motion.symmetry import SymmetryTable
+from capabilities.tool.backend import SUCTION, SuctionBackend
 from engine.operations import Job, OperationCall, OperationKind
 
 __all__ = ["capability"]
@@ -68,9 +73,22 @@ class IsHolding:
         return Job.answer(self._gripper.is_holding())
 
 
-def capability() -> Capability:
-    """The gripper capability (requires ``gripper``)."""
-    cap = Capability(CAP, "Opens and closes the parallel gripper.", requires=(GRIPPER,))
+def _suction(env: CapabilityEnv) -> SuctionBackend | None:
+    try:
+        return env.interface(SUCTION)
+    except CapabilityError:
+        return None  # grasps made with the suction tool then say the cell has none
+
+
+def capability(symmetries: SymmetryTable | None = None) -> Capability:
+    """The gripper capability (requires ``gripper`` and ``arm``; grasp reads ``suction``
+    when the cell has one)."""
+    table = symmetries if symmetries is not None else SymmetryTable()
+    cap = Capability(
+        CAP,
+        "Opens and closes the parallel gripper; grasps objects with their models' grasps.",
+        requires=(GRIPPER, ARM),
+    )
 
     def gripper(env: CapabilityEnv) -> GripperBackend:
         return env.interface(GRIPPER)
@@ -79,4 +97,8 @@ def capability() -> Capability:
     cap.add(CLOSE, lambda env: Close(gripper(env)))
     cap.add(IS_CLOSED, lambda env: IsClosed(gripper(env)))
     cap.add(IS_HOLDING, lambda env: IsHolding(gripper(env)))
+    cap.add(
+        grasp_manifest(CAP, table.grasp_names()),
+        lambda env: Grasp(env.interface(ARM), gripper(env), _suction(env), table),
+    )
     return cap

@@ -131,19 +131,31 @@ class Jogger:
 
         return self._chain(issue, released, f"joint {joint + 1}")
 
-    def go_to(self, target: ResolvedTarget, fraction: float) -> CommandHandleLike:
-        """A joint move to a resolved target (the first reachable candidate pose).
+    def go_to(self, target: ResolvedTarget, fraction: float, released: threading.Event) -> str:
+        """Drive to a resolved target until there or ``released`` (blocks; as :meth:`follow`).
+
+        The first reachable candidate is used; a candidate with an approach (a grasp) is
+        reached as motion.move_to reaches it: a joint move to the approach, then a straight
+        line to the pose.
 
         Raises:
             JogFailed: no candidate pose is reachable.
         """
         speed, accel = self._joint(fraction)
         if target.joints is not None:
-            return self._arm.move_joints(target.joints.positions, speed, accel)
-        for pose in target.poses:
-            q = self._arm.inverse_kinematics(pose)
-            if q is not None:
-                return self._arm.move_joints(q, speed, accel)
+            return self.follow(
+                self._arm.move_joints(target.joints.positions, speed, accel), released
+            )
+        approaches = target.approaches or (None,) * len(target.poses)
+        for pose, approach in zip(target.poses, approaches, strict=True):
+            first = approach if approach is not None else pose
+            q = self._arm.inverse_kinematics(first)
+            if q is None or (approach is not None and self._arm.inverse_kinematics(pose) is None):
+                continue
+            problem = self.follow(self._arm.move_joints(q, speed, accel), released)
+            if problem or approach is None or released.is_set():
+                return problem
+            return self.follow(self._arm.move_linear(pose, *self._linear(fraction)), released)
         where = format_pose_mm(target.poses[0]) if target.poses else "no pose"
         raise JogFailed(f"unreachable: {target.describe}: tool pose {where}")
 

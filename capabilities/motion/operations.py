@@ -12,7 +12,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from capabilities.base import Capability, CapabilityEnv, CapabilityError
-from capabilities.jobs import job_from_handle
+from capabilities.jobs import chain_jobs, job_from_handle
 from capabilities.kit import manifest
 from capabilities.motion.backend import ARM, WORLD, ArmBackend, WorldBackend
 from capabilities.motion.geometry import format_pose_mm
@@ -72,9 +72,22 @@ def _linear_move(arm: ArmBackend, pose: Pose, call: OperationCall, describe: str
     return job_from_handle(handle, describe)
 
 
+def _via_approach(
+    arm: ArmBackend, q: Sequence[float], pose: Pose, call: OperationCall, describe: str
+) -> Job:
+    """A joint move to the approach joints ``q``, then a straight line to ``pose``."""
+    return chain_jobs(
+        [
+            ("approach", lambda: _joint_move(arm, q, call, describe)),
+            ("descend", lambda: _linear_move(arm, pose, call, describe)),
+        ]
+    )
+
+
 MOVE_TO = manifest(CAP, "move_to",
     OperationKind.ACTION,
-    "Moves the tool to a pose or waypoint (relative waypoints follow the detected object).",
+    "Moves the tool to a pose or waypoint (relative waypoints follow the detected object; "
+    "an object's pose with a grasp reference goes to that grasp through its approach).",
     PortSpec(
         "target", (ParamType.WAYPOINT, ParamType.POSE),
         doc="where the tool goes (world pose, or a waypoint in any frame)",
@@ -82,11 +95,14 @@ MOVE_TO = manifest(CAP, "move_to",
     PortSpec(
         "reference", (ParamType.POSE, ParamType.TEXT), default="",
         doc="for a relative waypoint: the object's (marker's) pose, or a class name / marker id "
-        "to look up; empty: the waypoint's own reference in the world model",
+        "to look up; empty: the waypoint's own reference in the world model. For a Pose "
+        "target that is an object's pose: a grasp reference, 'cup' (its model's first grasp) "
+        "or 'cup/rim'",
     ),
     PortSpec(
         "mode", (ParamType.TEXT,), default="joint", choices=("joint", "linear"),
-        doc="joint: fastest path in joint space; linear: a straight line of the tool",
+        doc="joint: fastest path in joint space; linear: a straight line of the tool (a grasp "
+        "reference: joint to the approach, then straight to the grasp)",
     ),
     SPEED,
     ACCEL,
@@ -109,12 +125,15 @@ class MoveTo:
                 self._arm, target.joints.positions, call, f"move to {target.describe}"
             )
         for index, pose in enumerate(target.poses):
-            q = self._arm.inverse_kinematics(pose)
-            if q is None:
+            approach = target.approaches[index] if target.approaches else None
+            q = self._arm.inverse_kinematics(approach or pose)
+            if q is None or (approach and self._arm.inverse_kinematics(pose, near=q) is None):
                 continue
             if index:
                 call.log(f"symmetric equivalent {index} of {target.describe} is used")
             describe = f"move to {target.describe}"
+            if approach is not None:
+                return _via_approach(self._arm, q, pose, call, describe)
             if mode == "linear":
                 return _linear_move(self._arm, pose, call, describe)
             return _joint_move(self._arm, q, call, describe)

@@ -1,8 +1,8 @@
-"""Object symmetries for smart waypoints, read from the object model library.
+"""Object symmetries and grasps for smart waypoints, read from the object model library.
 
 This is the one place motion reads the object library (``capabilities.object_library``,
-cell-neutral; models are read on first use). Only a model's ``symmetry`` block is read, never
-anything about a scene.
+cell-neutral; models are read on first use). Only a model's ``symmetry`` and ``grasps``
+blocks are read, never anything about a scene.
 """
 
 from __future__ import annotations
@@ -12,9 +12,14 @@ import threading
 from dataclasses import dataclass
 from pathlib import Path
 
-from capabilities.object_library import ObjectLibrary, ObjectLibraryError
+from capabilities.object_library import (
+    GraspSpec,
+    ObjectLibrary,
+    ObjectLibraryError,
+    Symmetry,
+)
 
-__all__ = ["ObjectSymmetry", "SymmetryTable", "NO_SYMMETRY"]
+__all__ = ["ObjectSymmetry", "SymmetryTable", "NO_SYMMETRY", "object_symmetry"]
 
 
 @dataclass(frozen=True)
@@ -57,20 +62,54 @@ class SymmetryTable:
                 self._cache[object_class] = self._load(object_class)
             return self._cache[object_class]
 
-    def _load(self, object_class: str) -> tuple[ObjectSymmetry, str]:
+    def grasp(self, object_class: str, name: str = "") -> GraspSpec:
+        """The model's grasp ``name`` (empty: its first).
+
+        Raises:
+            ObjectLibraryError: no such model or grasp; the message names the choices.
+        """
+        with self._lock:
+            return self._library_now().get(object_class).grasp(name)
+
+    def grasp_names(self) -> tuple[str, ...]:
+        """Every grasp name of the library's models, in first-seen order (a broken or
+        missing model is left out: using it says what is wrong)."""
+        names: dict[str, None] = {}
+        with self._lock:
+            library = self._library_now()
+            try:
+                models = library.names()
+            except OSError:
+                return ()
+            for model in models:
+                try:
+                    names.update(dict.fromkeys(g.name for g in library.get(model).grasps))
+                except (ObjectLibraryError, OSError):
+                    continue
+        return tuple(names)
+
+    def _library_now(self) -> ObjectLibrary:
         if self._library is None:
             self._library = ObjectLibrary(self._path)
+        return self._library
+
+    def _load(self, object_class: str) -> tuple[ObjectSymmetry, str]:
         try:
-            symmetry = self._library.get(object_class).symmetry
+            symmetry = self._library_now().get(object_class).symmetry
         except (ObjectLibraryError, OSError) as exc:
             return NO_SYMMETRY, f"no symmetry used for {object_class!r}: {exc}"
-        if symmetry.kind == "continuous":
-            return ObjectSymmetry(_unit(symmetry.axis), None), ""
-        if symmetry.kind == "discrete":
-            order = max(1, int(symmetry.order))
-            angles = tuple(2 * math.pi * k / order for k in range(order))
-            return ObjectSymmetry(_unit(symmetry.axis), angles), ""
-        return NO_SYMMETRY, ""
+        return object_symmetry(symmetry), ""
+
+
+def object_symmetry(symmetry: Symmetry) -> ObjectSymmetry:
+    """A model's symmetry block as the equivalent rotations motion turns a tool pose by."""
+    if symmetry.kind == "continuous":
+        return ObjectSymmetry(_unit(symmetry.axis), None)
+    if symmetry.kind == "discrete":
+        order = max(1, int(symmetry.order))
+        angles = tuple(2 * math.pi * k / order for k in range(order))
+        return ObjectSymmetry(_unit(symmetry.axis), angles)
+    return NO_SYMMETRY
 
 
 def _unit(axis: tuple[float, ...]) -> tuple[float, float, float]:

@@ -5,6 +5,10 @@ paper's smart waypoint). At run time it is composed with the object's pose: the 
 the operation, or the world model's best detection of the waypoint's class. Symmetric
 objects give several equivalent tool poses; they are ordered by how little the wrist has to
 turn from where the tool is now, and the first reachable one is used.
+
+A Pose target with a grasp reference (``"cup"`` or ``"cup/rim"``) is an object's pose, as
+Figure 3's "move to CUP_POSE": the tool goes to that grasp of the object's model, through
+the grasp's approach (:class:`capabilities.object_library.GraspSpec`).
 """
 
 from __future__ import annotations
@@ -16,27 +20,35 @@ from typing import Any
 from capabilities.motion.backend import WorldBackend
 from capabilities.motion.geometry import axis_rotation, format_pose_mm, rotation_between
 from capabilities.motion.symmetry import ObjectSymmetry, SymmetryTable
+from capabilities.object_library import ObjectLibraryError
 from engine.operations import OperationFailed
 from engine.types import JointConfig, Pose, Waypoint, WaypointFrame
 
-__all__ = ["ResolvedTarget", "TargetResolver", "symmetric_tool_poses"]
+__all__ = ["ResolvedTarget", "TargetResolver", "symmetric_rotations", "symmetric_tool_poses"]
 
 _CONTINUOUS_STEPS = 24  # fallbacks tried around a continuous symmetry, 15 deg apart
 
 
 @dataclass(frozen=True)
 class ResolvedTarget:
-    """Where to go: candidate tool poses (best first) or joints, and words for messages."""
+    """Where to go: candidate tool poses (best first) or joints, and words for messages.
+
+    ``approaches``, when given, has one pose per candidate: the tool gets there first (a
+    joint move) and goes on to the candidate in a straight line (a grasp's approach).
+    """
 
     describe: str
     poses: tuple[Pose, ...] = ()
     joints: JointConfig | None = None
+    approaches: tuple[Pose, ...] = ()
 
 
-def symmetric_tool_poses(
+def symmetric_rotations(
     object_pose: Pose, tool_in_object: Pose, symmetry: ObjectSymmetry, current: Pose
 ) -> list[Pose]:
-    """The tool poses equivalent under the object's symmetry, least wrist rotation first.
+    """The object's symmetry rotations (object frame) that bring ``tool_in_object`` nearest
+    the tool's ``current`` orientation first: turn any pose taught relative to the object by
+    one of them and the object looks the same to it.
 
     For a continuous symmetry the best angle is found in closed form: with
     m = q_obj^-1 * q_now * q_tool^-1, the rotation r(t) about axis a that maximises
@@ -50,11 +62,22 @@ def symmetric_tool_poses(
         angles = tuple(best + 2 * math.pi * k / _CONTINUOUS_STEPS for k in range(_CONTINUOUS_STEPS))
     else:
         angles = symmetry.angles or (0.0,)
-    poses = [
-        object_pose.compose(axis_rotation(symmetry.axis, angle)).compose(tool_in_object)
-        for angle in angles
+    rotations = [axis_rotation(symmetry.axis, angle) for angle in angles]
+
+    def turn(rotation: Pose) -> float:
+        return rotation_between(current, object_pose.compose(rotation).compose(tool_in_object))
+
+    return sorted(rotations, key=turn)
+
+
+def symmetric_tool_poses(
+    object_pose: Pose, tool_in_object: Pose, symmetry: ObjectSymmetry, current: Pose
+) -> list[Pose]:
+    """The tool poses equivalent under the object's symmetry, least wrist rotation first."""
+    return [
+        object_pose.compose(rotation).compose(tool_in_object)
+        for rotation in symmetric_rotations(object_pose, tool_in_object, symmetry, current)
     ]
-    return sorted(poses, key=lambda pose: rotation_between(current, pose))
 
 
 class TargetResolver:
@@ -71,6 +94,8 @@ class TargetResolver:
 
     def resolve(self, target: Any, reference: Any, current: Pose) -> ResolvedTarget:
         """Candidate poses for ``target``; raises OperationFailed saying what is missing."""
+        if isinstance(target, Pose) and isinstance(reference, str) and reference.strip():
+            return self._grasp(target, reference.strip(), current)
         if isinstance(target, Pose):
             return ResolvedTarget(f"pose {format_pose_mm(target)}", (target,))
         if not isinstance(target, Waypoint):
@@ -95,6 +120,24 @@ class TargetResolver:
         return ResolvedTarget(
             f"waypoint {target.name!r} relative to {object_class} at {format_pose_mm(object_pose)}",
             tuple(poses),
+        )
+
+    def _grasp(self, object_pose: Pose, reference: str, current: Pose) -> ResolvedTarget:
+        """A grasp reference ``model`` or ``model/grasp`` on the object at ``object_pose``."""
+        object_class, _, name = reference.partition("/")
+        try:
+            grasp = self._symmetries.grasp(object_class, name)
+        except (ObjectLibraryError, OSError) as exc:
+            raise OperationFailed(f"grasp reference {reference!r}: {exc}") from exc
+        symmetry, _note = self._symmetries.lookup(object_class)
+        turned = [
+            object_pose.compose(rotation)
+            for rotation in symmetric_rotations(object_pose, grasp.pose, symmetry, current)
+        ]
+        return ResolvedTarget(
+            f"grasp {grasp.name!r} of the {object_class} at {format_pose_mm(object_pose)}",
+            tuple(t.compose(grasp.pose) for t in turned),
+            approaches=tuple(t.compose(grasp.approach) for t in turned),
         )
 
     def _detected(self, object_class: str) -> Pose:

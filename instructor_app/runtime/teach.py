@@ -194,7 +194,7 @@ class RobotTeacher(QObject):
                 resolved = resolver.resolve(target, reference, current)
             except OperationFailed as exc:
                 raise JogFailed(str(exc)) from exc
-            return jogger.follow(jogger.go_to(resolved, fraction), released)
+            return jogger.go_to(resolved, fraction, released)
 
         return jogger is not None and self._hold(what, move)
 

@@ -2,10 +2,11 @@
 
 ``cup_to_bin.costar.json`` is the paper's Figure 3 on the simulated cell: the arm steps out of
 the shoulder camera's view, the camera finds the cup and the waste bin through their ArUco
-markers, the plan checks the cup was found, queries both poses, grasps the cup with
-waypoints taught relative to it and drops it over the bin; when the cup is not visible it
-waits and tries again (the root runs until success). Its waypoints are also written to
-``cup_to_bin.waypoints.json`` beside it. Usage: python resources/examples/make_cell_examples.py
+markers, the plan checks the cup was found, queries both poses, grasps the cup at its pose
+with the grasp its object model carries (``gripper.grasp``: approach, descend, close, lift)
+and drops it over the bin; when the cup is not visible it waits and tries again (the root
+runs until success). Its waypoints are also written to ``cup_to_bin.waypoints.json`` beside
+it. Usage: python resources/examples/make_cell_examples.py
 """
 
 from __future__ import annotations
@@ -27,20 +28,12 @@ _NAMESPACE = uuid.UUID("0b7f2a4e-3c1d-4f5e-8a9b-6c7d8e9f0a1b")
 DOWN = (1.0, 0.0, 0.0, 0.0)
 # A joint configuration taught by hand that keeps the arm out of the shoulder camera's view.
 OBSERVE_JOINTS = (1.2, -1.9, 2.0, -1.6, -1.57, 0.0)
-CUP_GRASP_Z = 0.06  # m above the cup's bottom: the fingers close around its middle
-CUP_ABOVE_Z = 0.22
 BIN_DROP_Z = 0.36  # m above the bin's bottom: 14 cm over its 22 cm rim
 
 
 def waypoints() -> list[Waypoint]:
     return [
         Waypoint("observe", WaypointFrame.JOINTS, joints=JointConfig(OBSERVE_JOINTS)),
-        Waypoint(
-            "above cup", WaypointFrame.OBJECT, Pose((0.0, 0.0, CUP_ABOVE_Z), DOWN), reference="cup"
-        ),
-        Waypoint(
-            "grasp cup", WaypointFrame.OBJECT, Pose((0.0, 0.0, CUP_GRASP_Z), DOWN), reference="cup"
-        ),
         Waypoint(
             "over bin",
             WaypointFrame.OBJECT,
@@ -72,14 +65,10 @@ class _Maker:
     def op(self, op: str, name: str, **params: Binding) -> NodeSpec:
         return NodeSpec(NodeKind.OPERATION, name, self._id(), op=op, params=params)
 
-    def move(
-        self, name: str, waypoint: str, reference: str | None = None, linear: bool = False
-    ) -> NodeSpec:
+    def move(self, name: str, waypoint: str, reference: str | None = None) -> NodeSpec:
         params = {"target": Binding.fixed(self.wps[waypoint], ParamType.WAYPOINT)}
         if reference:
             params["reference"] = Binding.reference(reference)
-        if linear:
-            params["mode"] = Binding.fixed("linear", ParamType.TEXT)
         return self.op("motion.move_to", name, **params)
 
     def obj(self, name: str) -> Binding:
@@ -95,12 +84,8 @@ def _figure3_tree(m: _Maker, finder: str, detect: str, title: str) -> NodeSpec:
         m.op(f"{finder}.object_pose", "pose of CUP", object=m.obj("cup"), pose=Binding.reference("CUP_POSE")),
         m.op(f"{finder}.object_pose", "pose of BIN", object=m.obj("waste_bin"),
              pose=Binding.reference("BIN_POSE")),
-        m.op("gripper.open", "open gripper"),
-        m.move("move above CUP_POSE", "above cup", "CUP_POSE"),
-        m.move("move to CUP_POSE", "grasp cup", "CUP_POSE", linear=True),
-        m.op("gripper.close", "grasp"),
-        m.op("gripper.is_holding", "holding the cup"),
-        m.move("lift", "above cup", "CUP_POSE", linear=True),
+        m.op("gripper.grasp", "grasp CUP at CUP_POSE", object=m.obj("cup"),
+             pose=Binding.reference("CUP_POSE")),
         m.move("move to BIN_POSE", "over bin", "BIN_POSE"),
         m.op("gripper.open", "release"),
     )  # fmt: skip
@@ -111,9 +96,8 @@ def _figure3_tree(m: _Maker, finder: str, detect: str, title: str) -> NodeSpec:
     return m.node(
         NodeKind.SEQUENCE, title,
         m.move("step out of view", "observe"),
-        m.op(f"{finder}.{detect}", "detect CUP and BIN", camera=Binding.fixed("shoulder", ParamType.TEXT)),
+        m.op(f"{finder}.{detect}", "detect CUP and BIN"),  # the shoulder camera, by default
         m.node(NodeKind.SELECTOR, "transfer or wait", transfer, wait),
-        m.move("back to observe", "observe"),
     )  # fmt: skip
 
 
@@ -122,11 +106,12 @@ def cup_to_bin() -> PlanSpec:
     return PlanSpec(
         tree, "Cup to bin (Figure 3, simulated cell)",
         "The paper's Figure 3 on the simulated cell: find the cup and the waste bin through their "
-        "markers, check the cup was found, query both poses, grasp the cup with waypoints taught "
-        "relative to it and drop it over the bin. When the cup is not visible the selector falls "
+        "markers, check the cup was found, query both poses, grasp the cup at its pose with the "
+        "grasp of its object model and drop it over the bin. When the cup is not visible the selector falls "
         "back to WAIT (forced to fail) and the root, which runs until success, looks again. "
         "Run it with: costar run cup_to_bin.costar.json --cell sim --seed N. Runs to SUCCESS.",
         RunPolicy.UNTIL_SUCCESS, waypoints=waypoints(), objects=["cup", "waste_bin"],
+        reset_cell=True,  # each run in the Instructor starts from the scene's seed
         id=uuid.uuid5(_NAMESPACE, "cup_to_bin").hex,
     )  # fmt: skip
 
@@ -139,10 +124,11 @@ def cup_to_bin_vision() -> PlanSpec:
         tree, "Cup to bin, by vision (Figure 3, simulated cell)",
         "The paper's Figure 3 with model-based recognition instead of markers: the shoulder "
         "camera's point cloud is matched to the cup and waste-bin models, the plan checks the "
-        "cup was found, queries both poses, grasps the cup with waypoints taught relative to "
-        "it and drops it over the bin; when the cup is not recognised it waits and looks "
+        "cup was found, queries both poses, grasps the cup at its pose with the grasp of its "
+        "object model and drops it over the bin; when the cup is not recognised it waits and looks "
         "again. Run it with: costar run cup_to_bin_vision.costar.json --cell sim --seed N.",
         RunPolicy.UNTIL_SUCCESS, waypoints=waypoints(), objects=["cup", "waste_bin"],
+        reset_cell=True,  # each run in the Instructor starts from the scene's seed
         id=uuid.uuid5(_NAMESPACE, "cup_to_bin_vision").hex,
     )  # fmt: skip
 

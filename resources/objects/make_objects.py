@@ -7,7 +7,8 @@ frame at the bottom centre, z up. The output is byte for byte reproducible; run
     python resources/objects/make_objects.py --check    # exit 1 if a file differs
 
 Needs numpy only. Objects: the paper's cup and waste bin (transport task) and the kitting
-task's metal plates with 3, 4 and 8 holes and the kit bin. Marker ids (DICT_4X4_50): cup 1-2,
+task's metal plates with 3, 4 and 8 holes and the kit bin. Grasps are taught here, once per
+model, relative to the object: the cup's for the gripper, the plates' for the suction tool. Marker ids (DICT_4X4_50): cup 1-2,
 waste bin 10-15, kit bin 20-25; scenes use 40-49 for fixed markers.
 """
 
@@ -218,6 +219,20 @@ def top_marker(marker_id: int, size: float, height: float, x: float = 0.0) -> di
     return {"id": marker_id, "size": size, "pose": pose}
 
 
+DOWN = [1.0, 0.0, 0.0, 0.0]  # the tool's z (its approach) pointing down, at the table
+
+
+def grasp(name: str, tool: str, z: float, approach_z: float) -> dict:
+    """A grasp from above: the TCP pointing down at height ``z`` of the object frame, reached
+    straight down from ``approach_z``. Symmetric objects get every equivalent at run time."""
+    return {
+        "name": name,
+        "tool": tool,
+        "pose": {"position": [0.0, 0.0, _r(z)], "orientation": DOWN},
+        "approach": {"position": [0.0, 0.0, _r(approach_z)], "orientation": DOWN},
+    }
+
+
 def _model(name: str, description: str, **fields: object) -> dict:
     return {
         "format_version": 1,
@@ -243,6 +258,9 @@ def make_cup() -> tuple[dict, Mesh]:
         symmetry={"kind": "continuous", "axis": [0.0, 0.0, 1.0]},
         markers=[top_marker(1, 0.04, h), wall_marker(2, 0.04, (1, 0, 0), (r, 0, h / 2))],
         color=[0.78, 0.16, 0.12, 1.0],
+        # The fingers close around the middle (top) or just under the lid (rim); both come
+        # from 22 cm up, clear of the lid with the fingers open.
+        grasps=[grasp("top", "gripper", 0.06, 0.22), grasp("rim", "gripper", 0.085, 0.22)],
     )
     return model, mesh
 
@@ -319,6 +337,8 @@ def make_plate(
         markers=[],
         color=[0.62, 0.64, 0.67, 1.0],
         holes=[{"position": h, "diameter": hole_d} for h in holes],
+        # The suction cup presses 0.5 mm into the solid centre, coming from 10 cm above.
+        grasps=[grasp("suction", "suction", t - 0.0005, t + 0.10)],
     )
     return model, mesh
 

@@ -45,6 +45,12 @@ def test_every_shipped_model_reads() -> None:
          "a finite number (JSON has no NaN"),
         (lambda d: json.dumps(d).replace('"mass": 0.15', '"mass": 0.1, "mass": 0.2'), "$",
          "each field at most once"),
+        (lambda d: d["grasps"][1].update(name="top"), "$.grasps[1].name", "not used before"),
+        (lambda d: d["grasps"][0].update(tool="magnet"), "$.grasps[0].tool",
+         "one of gripper, suction"),
+        (lambda d: d["grasps"][0].update(approach=d["grasps"][0]["pose"]), "$.grasps[0].approach",
+         "10 mm or more from the pose"),
+        (lambda d: d["grasps"][0].pop("pose"), "$.grasps[0].pose", "required"),
     ],
 )  # fmt: skip
 def test_a_bad_model_names_file_path_and_expectation(

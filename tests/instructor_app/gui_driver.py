@@ -5,6 +5,8 @@ For the window tests and the end-to-end test (build a plan from an empty documen
 reopen, run). Every helper goes through widgets: keys typed into fields, combo entries chosen
 with the keyboard, buttons clicked. Only editors without a typed path (pose, region, joints
 grids) get their value set and committed through the editor's own signal.
+
+Pass a :class:`CountingBot` in place of ``qtbot`` to count what the user did.
 """
 
 from __future__ import annotations
@@ -35,11 +37,13 @@ from instructor_app.runtime.session import CellSession
 from instructor_app.settings import AppSettings
 
 __all__ = [
+    "CountingBot",
     "ScriptedDialogs",
     "make_window",
     "palette_row",
     "add_from_palette",
     "search_insert",
+    "search_down_insert",
     "double_click_palette",
     "select",
     "click_node",
@@ -97,6 +101,60 @@ class ScriptedDialogs(Dialogs):
 
     def about(self, parent: QWidget, text: str) -> None:
         self.asked.append(("about", text))
+
+
+class CountingBot:
+    """``qtbot`` as a user's hands, counting the user's actions.
+
+    One action is: a click (a double click counts once: its first click), a key press, a
+    typed text (the keys of one word or phrase), opening a list, choosing a file in a file
+    dialog, and going to another field before typing into it (a click into it; a triple
+    click when its text is selected to be typed over). Everything else is ``qtbot``'s own.
+
+    Attributes:
+        actions: what was done, in order (``len(actions)`` is the count).
+    """
+
+    def __init__(self, qtbot: Any) -> None:
+        self._bot = qtbot
+        self._at: object = None  # the widget the user's hands are on
+        self.actions: list[str] = []
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._bot, name)
+
+    def count(self, what: str, at: object = None) -> None:
+        self.actions.append(what)
+        if at is not None:
+            self._at = at
+
+    def _go_to(self, widget: object) -> None:
+        if widget is not self._at:
+            self.count("click into the field", widget)
+
+    def mouseClick(self, widget: Any, *args: Any, **kwargs: Any) -> None:
+        self.count("click", widget)
+        self._bot.mouseClick(widget, *args, **kwargs)
+
+    def mouseDClick(self, *args: Any, **kwargs: Any) -> None:
+        self._bot.mouseDClick(*args, **kwargs)  # the click before it was counted
+
+    def keyClick(self, widget: Any, key: Any, *args: Any, **kwargs: Any) -> None:
+        self._go_to(widget)
+        self.count(f"key {Qt.Key(key).name}")
+        self._bot.keyClick(widget, key, *args, **kwargs)
+
+    def keyClicks(self, widget: Any, text: str, *args: Any, **kwargs: Any) -> None:
+        self._go_to(widget)
+        self.count(f"type {text!r}")
+        self._bot.keyClicks(widget, text, *args, **kwargs)
+
+
+def _count(qtbot: Any, what: str, at: object = None) -> None:
+    """Count an action done without qtbot (opening a list, a file dialog's choice);
+    ``at`` is where the user's hands are after it."""
+    if isinstance(qtbot, CountingBot):
+        qtbot.count(what, at)
 
 
 def make_window(
@@ -157,6 +215,24 @@ def search_insert(qtbot: Any, window: MainWindow, text: str, expect: str) -> str
     return added
 
 
+def search_down_insert(qtbot: Any, window: MainWindow, text: str, expect: str) -> str:
+    """Type ``text`` into the palette's search field, press Down until the current hit is
+    ``expect`` (an operation id or a kind), then Enter; the added node's id."""
+    before = _ids(window)
+    palette = window.views.palette
+    _replace_text(qtbot, palette.search_field, text)
+    for _ in range(palette.hits.count()):
+        hit = palette.current_hit()
+        if hit is not None and expect in (hit.op, hit.kind.value):
+            break
+        qtbot.keyClick(palette.search_field, Qt.Key.Key_Down)
+    qtbot.keyClick(palette.search_field, Qt.Key.Key_Return)
+    added = _one_added(window, before, text)
+    node = window.document.node(added)
+    assert expect in (node.op, node.kind.value), f"{text!r} inserted {node.op or node.kind}"
+    return added
+
+
 def double_click_palette(qtbot: Any, window: MainWindow, key: str) -> str:
     """Clear the search, double-click the palette row of ``key``; the added node's id."""
     before = _ids(window)
@@ -171,8 +247,11 @@ def double_click_palette(qtbot: Any, window: MainWindow, key: str) -> str:
     return _one_added(window, before, key)
 
 
-def select(window: MainWindow, node_id: str) -> None:
-    """Select a node on the canvas (as a click on it would)."""
+def select(window: MainWindow, node_id: str, qtbot: Any = None) -> None:
+    """Select a node on the canvas (as a click on it would; counted as one when ``qtbot``
+    counts and the node was not selected yet)."""
+    if window.views.canvas.selected_ids() != [node_id]:
+        _count(qtbot, "click a node")
     window.views.canvas.select(node_id)
     assert window.views.inspector.shown_node_id() == node_id
 
@@ -198,7 +277,7 @@ def click_node(qtbot: Any, window: MainWindow, node_id: str) -> None:
 
 
 def rename(qtbot: Any, window: MainWindow, node_id: str, name: str) -> None:
-    select(window, node_id)
+    select(window, node_id, qtbot)
     field = window.views.inspector.name_field
     _replace_text(qtbot, field, name)
     qtbot.keyClick(field, Qt.Key.Key_Return)
@@ -206,7 +285,7 @@ def rename(qtbot: Any, window: MainWindow, node_id: str, name: str) -> None:
 
 def bind_reference(qtbot: Any, window: MainWindow, node_id: str, port: str, name: str) -> None:
     """Bind a port to a named parameter (inputs: choose "parameter" first)."""
-    select(window, node_id)
+    select(window, node_id, qtbot)
     row: PortRow = window.views.inspector.port_row(port)
     if row.mode_combo.count():
         choose_index(qtbot, row.mode_combo, MODE_REFERENCE)
@@ -224,18 +303,19 @@ def set_value(
 ) -> None:
     """Give a port a fixed value: choose "value" (and the type), then enter the value in
     its editor as a user would (type it, or pick it from the combo)."""
-    select(window, node_id)
+    select(window, node_id, qtbot)
     row: PortRow = window.views.inspector.port_row(port)
     choose_index(qtbot, row.mode_combo, MODE_VALUE)
     if ptype is not None and ptype is not row.value_type:
         choose(qtbot, row.type_combo, ptype.value)
     assert row.editor is not None
-    _enter(qtbot, row.editor, value)
+    if row.editor.value() != value:  # a user leaves a value that is already right
+        _enter(qtbot, row.editor, value)
 
 
 def unset(qtbot: Any, window: MainWindow, node_id: str, port: str) -> None:
     """Choose "not set" / "default" for a port."""
-    select(window, node_id)
+    select(window, node_id, qtbot)
     choose_index(qtbot, window.views.inspector.port_row(port).mode_combo, MODE_UNSET)
 
 
@@ -273,6 +353,7 @@ def choose(qtbot: Any, combo: QComboBox, text: str) -> None:
 
 def choose_index(qtbot: Any, combo: QComboBox, index: int) -> None:
     """Open the combo's list, move to entry ``index`` with the arrow keys, press Enter."""
+    _count(qtbot, "open a list", combo.view())
     combo.showPopup()
     view = combo.view()
     qtbot.waitUntil(view.isVisible, timeout=2000)
@@ -329,6 +410,7 @@ def import_waypoints(qtbot: Any, window: MainWindow, path: Path) -> None:
     panel = plan_panels(window)[1]
     panel.ask_path = lambda parent: str(path)
     qtbot.mouseClick(panel.import_button, Qt.MouseButton.LeftButton)
+    _count(qtbot, "choose the file")
 
 
 # ---------------------------------------------------------------------- runs
@@ -367,6 +449,8 @@ def _one_added(window: MainWindow, before: Iterable[str], what: str) -> str:
 
 def _replace_text(qtbot: Any, field: Any, text: str) -> None:
     """Select all of a line edit and type over it (an empty ``text`` deletes it)."""
+    if field.text():
+        _count(qtbot, "select the text", field)
     field.selectAll()
     if text:
         qtbot.keyClicks(field, text)

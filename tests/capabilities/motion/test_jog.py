@@ -101,12 +101,20 @@ def test_a_jog_that_cannot_start_says_so_and_speeds_are_checked() -> None:
         Jogger(arm).step("base", "z", 0.01, 0.0)
 
 
-def test_go_to_takes_the_first_reachable_pose_or_the_joints() -> None:
+def test_go_to_takes_the_first_reachable_pose_through_its_approach() -> None:
     arm = FakeArm()
-    jogger = Jogger(arm)
-    target = ResolvedTarget("two", (Pose((0.1, 0.0, -0.1)), Pose((0.1, 0.0, 0.1))))
-    assert jogger.go_to(target, 0.5).ok and arm.sent[-1] == (1.0,) * 6
+    jogger, released = Jogger(arm), threading.Event()
+    below, above = Pose((0.1, 0.0, -0.1)), Pose((0.1, 0.0, 0.1))
+    assert jogger.go_to(ResolvedTarget("two", (below, above)), 0.5, released) == ""
+    assert arm.sent[-1] == (1.0,) * 6  # the joints of the reachable one
     joints = ResolvedTarget("joints", joints=JointConfig((0.5,) * 6))
-    assert jogger.go_to(joints, 0.5).ok and arm.sent[-1] == (0.5,) * 6
+    assert jogger.go_to(joints, 0.5, released) == "" and arm.sent[-1] == (0.5,) * 6
+    arm.sent.clear()
+    grasp = ResolvedTarget("grasp", (Pose((0.4, 0.0, 0.31)),), approaches=(Pose((0.4, 0.0, 0.4)),))
+    arm.move_linear = lambda pose, speed, accel: (  # type: ignore[method-assign]
+        arm.sent.append(pose.position) or CommandHandle.succeeded("move_linear")
+    )
+    assert jogger.go_to(grasp, 0.5, released) == ""
+    assert arm.sent == [(1.0,) * 6, (0.4, 0.0, 0.31)]  # to the approach, then down the line
     with pytest.raises(JogFailed, match="unreachable: none"):
-        jogger.go_to(ResolvedTarget("none", (Pose((0.0, 0.0, -1.0)),)), 0.5)
+        jogger.go_to(ResolvedTarget("none", (Pose((0.0, 0.0, -1.0)),)), 0.5, released)
