@@ -80,18 +80,11 @@ def _mm(position: Any) -> str:
 
 
 def _grasp_lines(spec: ObjectModelSpec) -> list[str]:
-    """The model's grasps, read tolerantly: parsed ones if the library has them, else the
-    raw ``grasps`` field of model.json, else none."""
-    parsed = getattr(spec, "grasps", None)
-    if parsed:
-        return [
-            f"{g.name} ({g.tool}): at {_mm(g.pose.position)}, from {_mm(g.approach.position)}"
-            for g in parsed
-        ]
-    raw = spec.extra.get("grasps") if isinstance(spec.extra, dict) else None
-    if isinstance(raw, list):
-        return [f"{g.get('name', '?')} ({g.get('tool', '?')})" for g in raw if isinstance(g, dict)]
-    return []
+    """The model's grasps: name, tool, the holding TCP and its approach (object frame)."""
+    return [
+        f"{g.name} ({g.tool}): at {_mm(g.pose.position)}, from {_mm(g.approach.position)}"
+        for g in spec.grasps
+    ]
 
 
 def describe_model(spec: ObjectModelSpec, user: bool = False) -> str:

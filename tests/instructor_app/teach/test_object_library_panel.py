@@ -95,9 +95,11 @@ def test_grasps_show_when_the_model_has_them(qtbot: Any, folders: tuple[Path, Pa
     panel = make_panel(qtbot, folders)
     panel.select("held_cup")
     assert "held_cup</b> (your library)" in panel.details.text()
-    assert "side (gripper)" in panel.details.text()
-    panel.select("cup")
-    assert "Grasps: none taught" in panel.details.text() or "Grasps: <br>" in panel.details.text()
+    assert "side (gripper): at (0, 0, 60) mm, from (0, 0, 160) mm" in panel.details.text()
+    panel.select("cup")  # the shipped cup's grasps, as the library parses them
+    assert "top (gripper): at (0, 0, 60) mm, from (0, 0, 220) mm" in panel.details.text()
+    panel.select("kit_bin")
+    assert "Grasps: none taught" in panel.details.text()
     panel.shutdown()
 
 
