@@ -113,12 +113,13 @@ class ObjectLibraryPanel(QWidget):
 
     Signals:
         message(str): what happened, or why not.
-        models_changed(): a model was added.
+        models_changed(): a model was added (it is selected).
     """
 
     message = Signal(str)
     models_changed = Signal()
     _drawn = Signal(str, object)  # from the drawing thread: (name, RGBA array or error text)
+    _added = Signal(object)  # from the same thread: the new model's spec, or why not
 
     def __init__(
         self,
@@ -151,6 +152,7 @@ class ObjectLibraryPanel(QWidget):
         layout.addWidget(self.details)
         layout.addWidget(self.add_button)
         self._drawn.connect(self._set_thumbnail)
+        self._added.connect(self._on_added)
         self.refresh()
 
     # ------------------------------------------------------------------ public
@@ -183,21 +185,36 @@ class ObjectLibraryPanel(QWidget):
         if chosen in self.names():
             self.select(chosen)
 
-    def add_from_mesh(self, mesh: str | Path, model: NewModel) -> ObjectModelSpec | None:
-        """Add a model to the user's library; None with a message when it cannot be."""
+    def add_from_mesh(self, mesh: str | Path, model: NewModel) -> bool:
+        """Add a model to the user's library off the GUI thread (reading and writing a mesh
+        takes a moment): ``models_changed`` when it is in, a message either way. False (and
+        a message) when it is refused at once."""
         if model.name in self.names():
             self.message.emit(f"Cannot add {model.name!r}: there is already a model of that name")
-            return None
+            return False
+        self.add_button.setEnabled(False)
+        self._pool.submit(self._import, Path(mesh), model)
+        return True
+
+    def _import(self, mesh: Path, model: NewModel) -> None:
         try:
-            spec = import_mesh_model(self.user_folder, mesh, model)
+            outcome: object = import_mesh_model(self.user_folder, mesh, model)
         except ObjectLibraryError as exc:
-            self.message.emit(f"Cannot add the model: {exc}")
-            return None
+            outcome = f"Cannot add the model: {exc}"
+        except Exception as exc:  # an unreadable mesh must not take the panel down
+            outcome = f"Cannot add the model: {type(exc).__name__}: {exc}"
+        with contextlib.suppress(RuntimeError):  # the panel is gone
+            self._added.emit(outcome)
+
+    def _on_added(self, outcome: object) -> None:
+        self.add_button.setEnabled(True)
+        if not isinstance(outcome, ObjectModelSpec):
+            self.message.emit(str(outcome))
+            return
         self.refresh()
-        self.select(spec.name)
-        self.message.emit(f"Added the model {spec.name!r} to {self.user_folder}")
+        self.select(outcome.name)
+        self.message.emit(f"Added the model {outcome.name!r} to {self.user_folder}")
         self.models_changed.emit()
-        return spec
 
     def has_thumbnail(self, name: str) -> bool:
         """True once the model's row shows its picture."""

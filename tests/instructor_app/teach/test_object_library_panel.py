@@ -162,13 +162,15 @@ def test_what_cannot_be_added_is_said_and_nothing_is_written(
     text.write_text("not a mesh")
     broken = tmp_path / "broken.obj"
     broken.write_text("v 0 0 0\nf 1 1 1\n")
-    assert panel.add_from_mesh(text, NewModel("notes")) is None
-    assert panel.add_from_mesh(broken, NewModel("broken")) is None
-    assert panel.add_from_mesh(broken, NewModel("Bad Name")) is None
-    assert panel.add_from_mesh(broken, NewModel("cup")) is None
+    tries = [(text, "notes"), (broken, "broken"), (broken, "Bad Name")]
+    for mesh, name in tries:  # each is read and refused on the panel's worker thread
+        with qtbot.waitSignal(panel.message, timeout=20_000):
+            assert panel.add_from_mesh(mesh, NewModel(name))
+    assert panel.add_from_mesh(broken, NewModel("cup")) is False  # refused at once
     assert "notes.txt: not a mesh file" in messages[0]
     assert "broken.obj: no usable triangle mesh" in messages[1]
     assert "'Bad Name' is not a model name" in messages[2]
     assert "already a model" in messages[3]
+    assert panel.add_button.isEnabled()
     assert not folders[0].exists() or not list(folders[0].iterdir())
     panel.shutdown()
