@@ -97,10 +97,21 @@ def test_waypoints_taught_by_freedrive_and_by_jogging_run_in_a_plan(
         abs=1e-3,
     )
 
-    plan_of_moves(qtbot, window, [by_hand, jogged])
+    nodes = plan_of_moves(qtbot, window, [by_hand, jogged])
     outcome = run_to_end(qtbot, window, 60_000)
     assert outcome.status is Status.SUCCESS, outcome
     assert arm.joint_positions() == pytest.approx(jogged.joints.positions, abs=2e-3)
+
+    # The pose node's own Move here (inspector), held until the arm is there.
+    select(window, nodes[0])
+    move_here = window.views.inspector.teach_buttons["target"].move_button
+    assert move_here.isEnabled()
+    hold_ready(qtbot, move_here)
+    with qtbot.waitSignal(window.views.teacher.finished, timeout=60_000) as blocker:
+        qtbot.mousePress(move_here, LEFT)
+    qtbot.mouseRelease(move_here, LEFT)
+    assert blocker.args == ["move here", ""]
+    assert arm.tcp_pose().position == pytest.approx(by_hand.pose.position, abs=1e-3)
 
 
 def _push_cup(client: int, cell: Any, dx: float, dy: float) -> None:
