@@ -98,8 +98,13 @@ def test_waypoints_taught_by_freedrive_and_by_jogging_run_in_a_plan(
     )
 
     nodes = plan_of_moves(qtbot, window, [by_hand, jogged])
+    jog_while: list[bool] = []  # the robot is the plan's while it runs
+    window.controller.run_state_changed.connect(
+        lambda _state: jog_while.append(move.jog_buttons["x+"].isEnabled())
+    )
     outcome = run_to_end(qtbot, window, 60_000)
     assert outcome.status is Status.SUCCESS, outcome
+    assert jog_while[0] is False and move.jog_buttons["x+"].isEnabled()
     assert arm.joint_positions() == pytest.approx(jogged.joints.positions, abs=2e-3)
 
     # The pose node's own Move here (inspector), held until the arm is there.
