@@ -90,15 +90,15 @@ def measure_cameras(cell: SimCell) -> dict[str, Any]:
 
 def measure_cup_to_bin(seed: int = 0) -> dict[str, Any]:
     """Real-time factor of the cup-to-bin plan run by the engine on a fresh simulated cell."""
-    from pathlib import Path
 
     from capabilities.base import CapabilityRegistry
     from capabilities.sim.session import SimCellSession
     from engine.build import build_tree
     from engine.executor import run_to_end
     from engine.files import load_plan
+    from resources import example_path
 
-    plan_path = Path(__file__).resolve().parents[1] / "resources/examples/cup_to_bin.costar.json"
+    plan_path = example_path("cup_to_bin")
     with SimCellSession("cup_to_bin", seed=seed) as session:
         registry = CapabilityRegistry(cell=session)
         tree = build_tree(load_plan(plan_path), registry, clock=session.clock)

@@ -1,4 +1,7 @@
-"""The ``costar`` command line: validate, run, list operations, show traces.
+"""The ``costar`` command line: validate, run, list operations and examples, show traces.
+
+Commands work on the simulated cell unless ``--cell none`` (no robot) is given; a plan is a
+file or ``example:NAME``, a plan shipped with the application (``costar examples``).
 
 Exit codes: 0 success (or valid), 1 the plan ran and failed, 2 invalid input (bad file,
 invalid plan, bad arguments), 3 stopped (Ctrl-C) or timed out.
@@ -19,20 +22,27 @@ from typing import Any, TextIO
 from capabilities.base import CapabilityError, CapabilityRegistry
 from capabilities.cells import CELL_NAMES, CellError, open_cell
 from capabilities.collaboration.answers import CONFIRM_MODES, PromptAnswerer
+from capabilities.doctor import cmd_doctor
+from capabilities.shipped_examples import cmd_examples
 from engine.build import BuildError, build_tree
 from engine.events import Event, LogMessage, RunFinished, StatusChanged
 from engine.executor import Executor
 from engine.files import PlanFileError, load_plan
 from engine.operations import OperationManifest
+from engine.run_report import FailureLog
 from engine.spec import PlanSpec
 from engine.status import Status
 from engine.trace import TraceError, TraceRecorder, format_timeline, read_trace
 from engine.types import encode_value
+from engine.units import format_value
 from engine.validation import Problem, has_errors, validate_plan
+from resources import plan_argument
 
 __all__ = ["main"]
 
 EXIT_SUCCESS, EXIT_FAILURE, EXIT_INVALID, EXIT_STOPPED = 0, 1, 2, 3
+CELL_HELP = "the cell: sim, the simulated cell (default), or none, no robot"
+PLAN_HELP = "a plan file, or example:NAME for a shipped plan (costar examples lists them)"
 
 
 def _print_problems(file: str, problems: Sequence[Problem], out: TextIO) -> None:
@@ -73,7 +83,11 @@ def _cmd_validate(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         count = sum(p.severity == "error" for p in problems)
         print(f"{args.plan}: invalid ({count} error{'' if count == 1 else 's'})", file=out)
         if args.cell == "none" and any("cannot run on this cell" in p.message for p in problems):
-            print("hint: some operations need a robot cell; try --cell sim", file=out)
+            print(
+                "hint: some operations need a robot; leave out --cell none to use the "
+                "simulated cell",
+                file=out,
+            )
         return EXIT_INVALID
     print(f"{args.plan}: valid", file=out)
     return EXIT_SUCCESS
@@ -136,7 +150,8 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         except BuildError as exc:
             print(f"error: {exc}", file=err)
             return EXIT_INVALID
-        listeners: list[Callable[[Event], None]] = []
+        failures = FailureLog(plan)
+        listeners: list[Callable[[Event], None]] = [failures]
         if args.verbose:
             listeners.append(_VerbosePrinter(plan, out))
         if args.trace:
@@ -152,7 +167,9 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             restore()
             if answerer is not None:
                 answerer.detach()
-        return _report(result, plan, tree.blackboard.snapshot(), out, args.verbose)
+        code = _report(result, plan, tree.blackboard.snapshot(), out, args.verbose)
+        _report_caught(failures, out)
+        return code
 
 
 def _wait(executor: Executor, timeout: float | None) -> RunFinished:
@@ -175,7 +192,7 @@ def _report(
 ) -> int:
     if verbose and board:
         for key, value in sorted(board.items()):
-            print(f"  {key} = {json.dumps(encode_value(value))}", file=out)
+            print(f"  {key} = {format_value(value)}", file=out)
     name = plan.name or "plan"
     if result.reason in ("stopped", "timeout"):
         print(f"{name}: {result.reason} after {result.tick} ticks", file=out)
@@ -186,6 +203,15 @@ def _report(
     note = f" ({result.message})" if result.message else ""
     print(f"{name}: {result.status.value} after {result.tick} ticks{note}", file=out)
     return EXIT_SUCCESS if result.status is Status.SUCCESS else EXIT_FAILURE
+
+
+def _report_caught(failures: FailureLog, out: TextIO) -> None:
+    """The failures the plan carried on past (a fallback, a retry), one line each."""
+    caught = failures.caught()
+    if caught:
+        print("  on the way:", file=out)
+        for failure in caught:
+            print(f"  - {failure.describe()}", file=out)
 
 
 def _manifest_json(manifest: OperationManifest, available: bool, reason: str) -> dict[str, Any]:
@@ -264,24 +290,19 @@ def _parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     def add_cell(p: argparse.ArgumentParser) -> None:
-        p.add_argument(
-            "--cell",
-            choices=CELL_NAMES,
-            default="none",
-            help="the cell to run on (default: none, only cell-free capabilities)",
-        )
+        p.add_argument("--cell", choices=CELL_NAMES, default="sim", help=CELL_HELP)
         p.add_argument("--seed", type=int, default=0, help="scene seed of the simulated cell")
         p.add_argument(
             "--scene", help="scene of the simulated cell (name or path; default cup_to_bin)"
         )
 
     validate = sub.add_parser("validate", help="check a plan; exit 0 valid, 2 invalid")
-    validate.add_argument("plan")
+    validate.add_argument("plan", help=PLAN_HELP)
     add_cell(validate)
     validate.set_defaults(func=_cmd_validate)
 
     run = sub.add_parser("run", help="run a plan until it finishes")
-    run.add_argument("plan")
+    run.add_argument("plan", help=PLAN_HELP)
     run.add_argument("--rate", type=float, default=20.0, help="ticks per second (default 20)")
     run.add_argument("--trace", help="write a trace (JSON lines) to this file")
     run.add_argument("--timeout", type=float, help="stop after this many seconds (exit 3)")
@@ -298,8 +319,14 @@ def _parser() -> argparse.ArgumentParser:
 
     ops = sub.add_parser("ops", help="list every operation with its parameters")
     ops.add_argument("--json", action="store_true")
-    ops.add_argument("--cell", choices=CELL_NAMES, default="none")
+    ops.add_argument("--cell", choices=CELL_NAMES, default="sim", help=CELL_HELP)
     ops.set_defaults(func=_cmd_ops)
+
+    examples = sub.add_parser("examples", help="list the plans shipped with the application")
+    examples.set_defaults(func=cmd_examples)
+
+    doctor = sub.add_parser("doctor", help="check this computer can run the Instructor")
+    doctor.set_defaults(func=cmd_doctor)
 
     trace = sub.add_parser("trace", help="traces of runs")
     trace_sub = trace.add_subparsers(dest="trace_command", required=True)
@@ -327,9 +354,15 @@ def main(
     if args.command == "run" and args.rate <= 0:
         print("error: --rate must be above 0", file=err)
         return EXIT_INVALID
-    if getattr(args, "plan", None) and not Path(args.plan).exists():
-        print(f"error: {args.plan}: no such file", file=err)
-        return EXIT_INVALID
+    if getattr(args, "plan", None):
+        try:
+            args.plan = plan_argument(args.plan)
+        except FileNotFoundError as exc:
+            print(f"error: {exc}", file=err)
+            return EXIT_INVALID
+        if not Path(args.plan).exists():
+            print(f"error: {args.plan}: no such file", file=err)
+            return EXIT_INVALID
     try:
         return int(args.func(args, out, err))
     except CapabilityError as exc:

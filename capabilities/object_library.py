@@ -31,6 +31,7 @@ from typing import Any
 from capabilities.errors import CapabilityError
 from engine.json_reader import JsonFileError, JsonReader, read_json_file
 from engine.types import Pose
+from resources import resource_path
 
 __all__ = [
     "GRASP_TOOLS",
@@ -64,8 +65,8 @@ class ObjectLibraryError(CapabilityError):
 
 
 def default_library_path() -> Path:
-    """``resources/objects`` of this checkout."""
-    return Path(__file__).resolve().parents[1] / "resources" / "objects"
+    """The shipped object library (``objects``)."""
+    return resource_path("objects")
 
 
 @dataclass(frozen=True)

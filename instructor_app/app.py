@@ -1,6 +1,7 @@
 """``costar-instructor``: the desktop application.
 
-``costar-instructor [PLAN] [--cell sim|none] [--seed N] [--run] [--screenshot PNG] [--size WxH]``
+``costar-instructor [PLAN | example:NAME] [--cell sim|none] [--seed N] [--run]
+[--screenshot PNG] [--size WxH]``
 
 Without ``--screenshot`` it opens the window and runs the event loop. With it, it renders the
 main window to a PNG and exits, after the run finished when ``--run`` is given, so that a
@@ -25,6 +26,7 @@ from typing import Any
 os.environ.setdefault("QT_LOGGING_RULES", "qt.multimedia*=false")
 
 from PySide6.QtCore import QEventLoop, QSettings, QTimer
+from PySide6.QtGui import QIcon
 from PySide6.QtWidgets import QApplication, QWidget
 
 from engine.status import Status
@@ -33,6 +35,7 @@ from instructor_app.main_window import Dialogs, MainWindow
 from instructor_app.runtime.controller import RunOutcome
 from instructor_app.runtime.session import CellSession
 from instructor_app.settings import APPLICATION, ORGANIZATION, AppSettings
+from resources import plan_argument, resource_path
 
 __all__ = [
     "main",
@@ -51,7 +54,9 @@ def _parser() -> argparse.ArgumentParser:
         prog="costar-instructor",
         description="Teach a robot a task by composing a behavior tree.",
     )
-    parser.add_argument("plan", nargs="?", help="a plan file (*.costar.json) to open")
+    parser.add_argument(
+        "plan", nargs="?", help="a plan file (*.costar.json) or example:NAME (costar examples)"
+    )
     parser.add_argument("--cell", choices=("sim", "none"), default="sim",
                         help="the cell to work with (default: sim, the simulated cell)")  # fmt: skip
     parser.add_argument("--seed", type=int, default=0, help="scene seed of the simulated cell")
@@ -84,6 +89,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         args = _parser().parse_args(argv)
     except SystemExit as exc:  # argparse exits on --help (0) and on bad arguments (2)
         return int(exc.code or 0)
+    if args.plan:
+        try:
+            args.plan = plan_argument(args.plan)
+        except FileNotFoundError as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            return EXIT_BAD_INPUT
     if args.screenshot and not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
         os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
     app = QApplication.instance() or QApplication(
@@ -91,6 +102,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     app.setOrganizationName(ORGANIZATION)
     app.setApplicationName(APPLICATION)
+    app.setWindowIcon(QIcon(str(resource_path("icons", "costar-instructor.svg"))))
     if args.screenshot:
         return _screenshot(args)
     return _interactive(args)

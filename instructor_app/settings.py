@@ -14,6 +14,8 @@ from PySide6.QtCore import QByteArray, QSettings
 from PySide6.QtGui import QAction
 from PySide6.QtWidgets import QMenu, QWidget
 
+from resources import resource_path
+
 __all__ = [
     "AppSettings",
     "RecentFilesMenu",
@@ -30,7 +32,7 @@ APPLICATION = "Instructor"
 MAX_RECENT = 10
 
 # The plans shipped with the application (the start page lists them).
-EXAMPLES_DIR = Path(__file__).resolve().parents[1] / "resources" / "examples"
+EXAMPLES_DIR = resource_path("examples")
 DISTRIBUTION = "costar-instructor"
 
 _RECENT = "files/recent"
@@ -50,7 +52,7 @@ def app_version() -> str:
 def is_shipped_example(path: Path) -> bool:
     """Whether ``path`` is in the shipped examples folder (those files stay as shipped)."""
     try:
-        return path.resolve().is_relative_to(EXAMPLES_DIR)
+        return path.resolve().is_relative_to(EXAMPLES_DIR.resolve())
     except OSError:
         return False
 

@@ -15,6 +15,7 @@ from capabilities.sim.cameras import SHOULDER_EYE, SHOULDER_TARGET, WRIST_MOUNT,
 from capabilities.sim.errors import SimError
 from engine.json_reader import JsonFileError, JsonReader, read_json_file
 from engine.types import ParamType, Pose
+from resources import resource_path
 
 __all__ = [
     "CameraSettings",
@@ -26,9 +27,7 @@ __all__ = [
 ]
 
 FORMAT_VERSION = 1
-DEFAULT_CONFIG_PATH = (
-    Path(__file__).resolve().parents[2] / "resources" / "cells" / "sim_default.json"
-)
+DEFAULT_CONFIG_PATH = resource_path("cells", "sim_default.json")
 
 
 class CellConfigError(SimError):

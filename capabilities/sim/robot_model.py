@@ -17,10 +17,11 @@ from importlib import metadata
 from pathlib import Path
 
 from capabilities.sim.errors import SimError
+from resources import resource_path
 
 __all__ = ["ROBOTS_DIR", "find_ur5_urdf", "robot_urdf_path"]
 
-ROBOTS_DIR = Path(__file__).resolve().parents[2] / "resources" / "robots"
+ROBOTS_DIR = resource_path("robots")
 _UR5_SUFFIX = "example-robot-data/robots/ur_description/urdf/ur5_robot.urdf"
 _PACKAGE_PREFIX = "package://example-robot-data/"
 

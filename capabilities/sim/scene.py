@@ -31,6 +31,7 @@ from capabilities.sim.objects import (
 from capabilities.sim.placement import Placement, sample_placements
 from capabilities.sim.scene_spec import SceneSpec, read_scene
 from engine.types import Pose
+from resources import resource_path
 
 __all__ = [
     "FixedMarker",
@@ -46,8 +47,8 @@ MARKER_LIFT = 0.0005  # fixed markers float 0.5 mm above the table so they never
 
 
 def default_scene_path(name: str) -> Path:
-    """``resources/scenes/<name>.json`` of this checkout."""
-    return Path(__file__).resolve().parents[2] / "resources" / "scenes" / f"{name}.json"
+    """The shipped scene ``scenes/<name>.json``."""
+    return resource_path("scenes", f"{name}.json")
 
 
 def yaw_pose(x: float, y: float, z: float, yaw: float) -> Pose:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from engine.units import format_value
 from instructor_app.inspectors.base import EditorContext, InspectorError, ParamEditor
 from instructor_app.inspectors.factory import (
     EDITOR_TYPES,
@@ -9,7 +10,6 @@ from instructor_app.inspectors.factory import (
     default_value,
     editor_for,
 )
-from instructor_app.inspectors.units import format_value
 
 __all__ = [
     "EDITOR_TYPES",

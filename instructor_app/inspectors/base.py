@@ -17,8 +17,8 @@ from PySide6.QtWidgets import QDoubleSpinBox, QHBoxLayout, QWidget
 
 from engine.operations import PortSpec
 from engine.types import ParamType, Waypoint
+from engine.units import DisplayUnit
 from instructor_app.errors import InstructorError
-from instructor_app.inspectors.units import DisplayUnit
 
 __all__ = ["EditorContext", "ParamEditor", "UnitSpinBox", "InspectorError"]
 

@@ -8,8 +8,8 @@ from PySide6.QtWidgets import QCheckBox, QComboBox, QLineEdit, QWidget
 
 from engine.operations import PortSpec
 from engine.types import ObjectModel, ParamType, Waypoint
+from engine.units import DisplayUnit, display_unit
 from instructor_app.inspectors.base import EditorContext, ParamEditor, UnitSpinBox
-from instructor_app.inspectors.units import DisplayUnit, display_unit
 
 __all__ = [
     "NumberEditor",

@@ -14,8 +14,8 @@ from PySide6.QtWidgets import QGridLayout, QLabel, QWidget
 
 from engine.operations import PortSpec
 from engine.types import JointConfig, ParamType, Pose, Region
+from engine.units import display_unit, quaternion_to_rpy, rpy_to_quaternion
 from instructor_app.inspectors.base import ParamEditor, UnitSpinBox
-from instructor_app.inspectors.units import display_unit, quaternion_to_rpy, rpy_to_quaternion
 
 __all__ = ["PoseEditor", "RegionEditor", "JointConfigEditor"]
 

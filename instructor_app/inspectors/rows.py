@@ -24,9 +24,9 @@ from PySide6.QtWidgets import (
 from engine.operations import Direction, PortSpec
 from engine.spec import Binding
 from engine.types import ParamType
+from engine.units import format_value
 from instructor_app.inspectors.base import EditorContext, ParamEditor
 from instructor_app.inspectors.factory import concrete_types, editor_for
-from instructor_app.inspectors.units import format_value
 
 __all__ = ["PortRow", "MODE_UNSET", "MODE_VALUE", "MODE_REFERENCE"]
 

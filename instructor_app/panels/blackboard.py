@@ -14,7 +14,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from instructor_app.inspectors.units import format_value
+from engine.units import format_value
 
 __all__ = ["BlackboardPanel"]
 

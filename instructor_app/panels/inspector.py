@@ -25,6 +25,7 @@ from PySide6.QtWidgets import (
 from engine.kinds import KIND_DOC, KIND_PORTS
 from engine.operations import Direction, OperationSource, PortSpec
 from engine.spec import Binding, NodeKind, NodeSpec
+from engine.units import display_unit
 from engine.validation import ERROR, Problem
 from instructor_app.document import DocumentError, PlanDocument
 from instructor_app.inspectors.base import EditorContext
@@ -36,7 +37,6 @@ from instructor_app.inspectors.teach_buttons import (
     move_target,
     taught_value,
 )
-from instructor_app.inspectors.units import display_unit
 from instructor_app.node_factory import manifest_or_none, readable
 from instructor_app.runtime.waypoint_teach import TeachError
 

@@ -26,7 +26,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from instructor_app.inspectors.units import quaternion_to_rpy
+from engine.units import quaternion_to_rpy
 from instructor_app.runtime.teach import ArmState, RobotTeacher
 
 __all__ = ["MovePanel", "STEPS", "HOLD", "JOINT_NAMES"]

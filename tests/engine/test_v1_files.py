@@ -15,6 +15,9 @@ from engine.validation import has_errors, validate_plan
 
 V1 = Path(__file__).resolve().parent / "data" / "v1"
 V1_PLANS = sorted(V1.rglob("*.costar.json"))
+# The format-2 files of examples that changed since (cup to bin now grasps with the object's
+# grasp): what the version-1 file must still mean.
+V2_AT_MIGRATION = Path(__file__).resolve().parent / "data" / "v2"
 
 
 def test_every_v1_example_was_kept() -> None:
@@ -55,7 +58,9 @@ class _InterfacesOnly:
 @pytest.mark.parametrize("path", V1_PLANS, ids=lambda p: p.relative_to(V1).as_posix())
 def test_v1_file_means_what_the_shipped_v2_file_means(path: Path) -> None:
     """The reader turns "config" and timing.wait into the ports and Wait node of format 2."""
-    shipped = Path(__file__).resolve().parents[2] / "resources" / "examples" / path.relative_to(V1)
+    shipped = V2_AT_MIGRATION / path.relative_to(V1)
+    if not shipped.exists():
+        shipped = Path(__file__).resolve().parents[2] / "resources" / "examples" / path.relative_to(V1)
     assert '"format_version": 1' in path.read_text(encoding="utf-8")
     assert '"format_version": 2' in shipped.read_text(encoding="utf-8")
     assert load_plan(path) == load_plan(shipped)

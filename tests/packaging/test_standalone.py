@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
+PYTEST = [sys.executable, "-m", "pytest", "-q", "-p", "no:xdist", "-p", "no:cacheprovider"]
 
 
 def _committed_clone(destination: Path) -> Path:
@@ -35,8 +36,7 @@ def test_a_clone_in_an_empty_folder_passes_the_bench_tests(tmp_path: Path) -> No
     assert sorted(p.name for p in tmp_path.iterdir()) == ["repo"]  # no ../shared beside it
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTEST_XDIST_WORKER")}
     result = subprocess.run(
-        [sys.executable, "-m", "pytest", "-q", "-p", "no:xdist", "-p", "no:cacheprovider"]
-        + ["tests/bench"],
+        [*PYTEST, "tests/bench"],
         cwd=clone,
         env=env,
         capture_output=True,

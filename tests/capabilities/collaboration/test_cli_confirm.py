@@ -26,7 +26,7 @@ def confirm_plan(folder: Path, questions: int = 1) -> str:
 
 def run(*argv: str, stdin: str = "") -> tuple[int, str]:
     out, err = io.StringIO(), io.StringIO()
-    code = main(["run", *argv, "--timeout", "60"], out, err, io.StringIO(stdin))
+    code = main(["run", "--cell", "none", *argv, "--timeout", "60"], out, err, io.StringIO(stdin))
     return code, out.getvalue() + err.getvalue()
 
 

@@ -11,9 +11,9 @@ from pytestqt.qtbot import QtBot
 
 from engine.operations import PortSpec
 from engine.types import JointConfig, ObjectModel, ParamType, Pose, Region, Waypoint
+from engine.units import rpy_to_quaternion
 from instructor_app.inspectors import EDITOR_TYPES, EditorContext, concrete_types, editor_for
 from instructor_app.inspectors.editors import ChoiceEditor, NumberEditor
-from instructor_app.inspectors.units import rpy_to_quaternion
 
 WAYPOINTS = (Waypoint("above", pose=Pose((0.1, 0, 0.3))), Waypoint("home", pose=Pose()))
 CONTEXT = EditorContext(("cup", "waste_bin"), WAYPOINTS)

@@ -7,7 +7,7 @@ import math
 from pytestqt.qtbot import QtBot
 
 from engine.types import Pose
-from instructor_app.inspectors.units import rpy_to_quaternion
+from engine.units import rpy_to_quaternion
 from instructor_app.panels.blackboard import BlackboardPanel
 from instructor_app.panels.log import LogPanel
 

@@ -1,8 +1,9 @@
-"""What the UI shows versus what the plan stores: mm and degrees on screen, m and rad inside.
+"""What people read versus what the plan stores: mm and degrees shown, m and rad inside.
 
-Pure functions (no Qt), so the conversions are tested on their own. Orientation is shown
-as roll, pitch, yaw about the fixed world axes x, y, z (R = Rz(yaw) Ry(pitch) Rx(roll)), the
-convention of ROS and of the UR teach pendant's RPY view.
+The Instructor's editors and panels and ``costar run`` show values through these pure
+functions, so the command line reads like the GUI. Orientation is shown as roll, pitch, yaw
+about the fixed world axes x, y, z (R = Rz(yaw) Ry(pitch) Rx(roll)), the convention of ROS
+and of the UR teach pendant's RPY view.
 """
 
 from __future__ import annotations
@@ -94,18 +95,24 @@ def pose_from_display(values: tuple[float, ...]) -> Pose:
     return Pose((x / 1000.0, y / 1000.0, z / 1000.0), q)
 
 
+def _one_decimal(value: float) -> str:
+    """``value`` with one decimal, never "-0.0" (a pose a hair under the table reads 0.0)."""
+    text = f"{value:.1f}"
+    return "0.0" if text == "-0.0" else text
+
+
 def _mm(values: tuple[float, ...]) -> str:
-    return ", ".join(f"{v * 1000.0:.1f}" for v in values)
+    return ", ".join(_one_decimal(v * 1000.0) for v in values)
 
 
 def format_value(value: Any) -> str:
     """A value as a person reads it: poses and regions in mm and degrees, joints in degrees."""
     if isinstance(value, Pose):
         shown = pose_to_display(value)
-        angles = ", ".join(f"{a:.1f}" for a in shown[3:])
+        angles = ", ".join(_one_decimal(a) for a in shown[3:])
         return f"({_mm(value.position)}) mm, rpy ({angles})°"
     if isinstance(value, JointConfig):
-        return "(" + ", ".join(f"{p * _DEG:.1f}" for p in value.positions) + ")°"
+        return "(" + ", ".join(_one_decimal(p * _DEG) for p in value.positions) + ")°"
     if isinstance(value, Region):
         return f"centre ({_mm(value.center)}) mm, radius {value.radius * 1000.0:.1f} mm"
     if isinstance(value, ObjectModel):

@@ -7,7 +7,7 @@ import math
 import pytest
 
 from engine.types import JointConfig, ObjectModel, Pose, Region, Waypoint
-from instructor_app.inspectors.units import (
+from engine.units import (
     display_unit,
     format_value,
     pose_from_display,
@@ -62,3 +62,9 @@ def test_format_value_uses_mm_and_degrees() -> None:
     assert format_value(ObjectModel("cup")) == "cup"
     assert format_value(Waypoint("home", pose=Pose())) == "home (world)"
     assert format_value(0.5) == "0.5" and format_value(True) == "True"
+
+
+def test_a_value_that_rounds_to_zero_reads_0_not_minus_0() -> None:
+    pose = Pose((0.4210, 0.2802, -1.02e-05), (-5.6e-05, 4.1e-05, 0.0, 1.0))
+    assert format_value(pose) == "(421.0, 280.2, 0.0) mm, rpy (0.0, 0.0, 0.0)°"
+    assert format_value(JointConfig((-1e-9, 0.0))) == "(0.0, 0.0)°"
