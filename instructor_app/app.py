@@ -147,6 +147,7 @@ def _screenshot(args: argparse.Namespace) -> int:
                     print(f"error: {exc}", file=sys.stderr)
                     return EXIT_BAD_INPUT
             window.resize(*args.size)
+            window.arrange_cell_views()  # the picture's size may give them a column
             window.show()
             code = _run_for_picture(window, args.timeout) if args.run else EXIT_OK
             _grab(window, Path(args.screenshot))

@@ -127,13 +127,9 @@ class MainWindow(QMainWindow):
         self.tabifyDockWidget(self.docks["move"], self.docks["objects"])
         self.docks["palette"].raise_()
         self._dock("inspector", "Inspector", self.views.inspector, area.RightDockWidgetArea)
-        # The cell's views: a column right of the inspector, cameras above the 3D scene.
+        # The cell's views; where they go depends on the window's width (arrange_cell_views).
         self._dock("cameras", "Cameras", self.cell_views.cameras, area.RightDockWidgetArea)
         self._dock("scene3d", "3D scene", self.cell_views.scene3d, area.RightDockWidgetArea)
-        self.splitDockWidget(
-            self.docks["inspector"], self.docks["cameras"], Qt.Orientation.Horizontal
-        )
-        self.splitDockWidget(self.docks["cameras"], self.docks["scene3d"], Qt.Orientation.Vertical)
         self._dock("plan", "Plan", self.views.plan_settings, area.RightDockWidgetArea)
         self._dock(
             "waypoints", "Waypoints", _scrolled(self.views.waypoints), area.RightDockWidgetArea
@@ -143,9 +139,6 @@ class MainWindow(QMainWindow):
         self.tabifyDockWidget(self.docks["plan"], self.docks["waypoints"])
         self.tabifyDockWidget(self.docks["waypoints"], self.docks["operator"])
         self.docks["plan"].raise_()  # the operator tab comes forward when the robot asks
-        self.resizeDocks(
-            [self.docks["cameras"], self.docks["scene3d"]], [420, 480], Qt.Orientation.Vertical
-        )
         bottom = [
             ("validation", "Problems", self.views.validation),
             ("log", "Log", self.views.log),
@@ -164,9 +157,7 @@ class MainWindow(QMainWindow):
             [self.docks["inspector"], self.docks["plan"]], [700, 200], Qt.Orientation.Vertical
         )
         self.resizeDocks(
-            [self.docks[n] for n in ("palette", "inspector", "cameras")],
-            [240, 320, 560],
-            Qt.Orientation.Horizontal,
+            [self.docks["palette"], self.docks["inspector"]], [240, 320], Qt.Orientation.Horizontal
         )
         self.cell_label = QLabel(" Cell: ")
         self.cell_combo = QComboBox(self)
@@ -178,6 +169,27 @@ class MainWindow(QMainWindow):
         # permanent: a temporary status message would hide a normal status-bar widget
         self.statusBar().addPermanentWidget(self.failure_button)
         self.statusBar().addPermanentWidget(self.problems_label)
+
+    def arrange_cell_views(self) -> None:
+        """Cameras above the 3D scene in a column of their own right of the inspector when
+        the window is wide enough for it (1700 px); tabs beside Plan, Waypoints and Operator
+        otherwise (the canvas and the inspector keep their room). Called when no saved layout is restored, and after a resize
+        for a picture."""
+        docks = self.docks
+        if self.width() >= 1700:
+            right, across = Qt.DockWidgetArea.RightDockWidgetArea, Qt.Orientation.Horizontal
+            self.addDockWidget(right, docks["cameras"], across)  # a full-height column
+            self.splitDockWidget(docks["cameras"], docks["scene3d"], Qt.Orientation.Vertical)
+            self.resizeDocks(
+                [docks["cameras"], docks["scene3d"]], [420, 480], Qt.Orientation.Vertical
+            )
+            self.resizeDocks(
+                [docks["palette"], docks["cameras"]], [240, 560], Qt.Orientation.Horizontal
+            )
+        else:
+            self.tabifyDockWidget(docks["operator"], docks["cameras"])
+            self.tabifyDockWidget(docks["cameras"], docks["scene3d"])
+            docks["plan"].raise_()
 
     def _dock(self, name: str, title: str, widget: QWidget, area: Qt.DockWidgetArea) -> None:
         dock = QDockWidget(title, self)
@@ -543,6 +555,8 @@ class MainWindow(QMainWindow):
             self.resize(1400, 900)
         if state is not None:
             self.restoreState(state)
+        else:
+            self.arrange_cell_views()
 
     def shutdown(self) -> None:
         """Stop the run, the robot's teaching commands, background drawing and autosave."""

@@ -27,9 +27,9 @@ from PySide6.QtWidgets import (
     QCheckBox,
     QFileDialog,
     QGraphicsEllipseItem,
-    QHBoxLayout,
     QLabel,
     QPushButton,
+    QToolBar,
     QVBoxLayout,
     QWidget,
 )
@@ -133,17 +133,15 @@ class CameraPanel(QWidget):
         self.overlay_box.setChecked(True)
         self.overlay_box.toggled.connect(self._set_overlays)
         self.rate_label = QLabel("")
-        bar = QHBoxLayout()
+        bar = QToolBar()  # a narrow dock folds its buttons into the toolbar's menu
         for widget in (self.pause_button, self.snapshot_button, self.draw_button, self.overlay_box):
             bar.addWidget(widget)
-        bar.addStretch(1)
         bar.addWidget(self.rate_label)
         self.view = pg.GraphicsLayoutWidget()
         self.view.setBackground("#202020")
-        self.view.setMinimumSize(320, 240)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(2, 2, 2, 2)
-        layout.addLayout(bar)
+        layout.addWidget(bar)
         layout.addWidget(self.view, 1)
         self._draft_item = QGraphicsEllipseItem()
         self._draft_item.setPen(pg.mkPen((255, 60, 200), width=2))
@@ -181,6 +179,8 @@ class CameraPanel(QWidget):
                 pictures.append(picture)
             self._pictures[name] = (pictures[0], pictures[1])
         self.feed = CameraFeed(cameras, self.painter, self.fps)
+        feed = self.feed  # a panel deleted without stop() still ends its thread
+        self.destroyed.connect(lambda *_: feed.stop(0.5))
         if not cameras:
             self.rate_label.setText("this cell has no cameras")
         self._update_active()

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 import pyqtgraph.opengl as gl
 from PySide6.QtCore import Qt, QTimer, Signal
-from PySide6.QtWidgets import QCheckBox, QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget
+from PySide6.QtWidgets import QCheckBox, QLabel, QPushButton, QToolBar, QVBoxLayout, QWidget
 
 from capabilities.geometry import pose_to_matrix
 from capabilities.motion.symmetry import SymmetryTable
@@ -108,14 +108,12 @@ class Scene3DPanel(PointingMixin, QWidget):
         self.truth_box.setToolTip(
             "Where the simulator really has the objects (orange), to check perception"
         )
-        bar = QHBoxLayout()
+        bar = QToolBar()  # a narrow dock folds its buttons into the toolbar's menu
         for widget in (self.region_button, self.cloud_box, self.truth_box):
             bar.addWidget(widget)
-        bar.addStretch(1)
-        layout.addLayout(bar)
+        layout.addWidget(bar)
         self.view = view = SceneView(self)
         view.setBackgroundColor((32, 32, 36))
-        view.setMinimumHeight(260)
         # From behind the robot's left, looking at the table (the robot base is at the origin).
         view.setCameraPosition(
             pos=pg_vector(0.35, 0.0, 0.1), distance=2.0, elevation=32, azimuth=200
@@ -143,7 +141,8 @@ class Scene3DPanel(PointingMixin, QWidget):
             view.removeItem(item)
         self._cell = cell
         self.robot = self.ghost = None
-        view.addItem(gl.GLGridItem(size=pg_vector(3, 3, 1), color=(255, 255, 255, 40)))
+        grid = gl.GLGridItem(size=pg_vector(3, 3, 1), color=(255, 255, 255, 40))
+        view.addItem(grid)
         interfaces = cell.interfaces() if cell is not None else {}
         self.table_z = 0.0  # picks fall on the table top when they miss the point cloud
         for name, pose, size in (interfaces.get("scene_layout") or {}).get("fixtures", []):
@@ -152,6 +151,7 @@ class Scene3DPanel(PointingMixin, QWidget):
             view.addItem(box)
             if name == "table":
                 self.table_z = pose.position[2] + size[2] / 2
+                grid.translate(0.0, 0.0, pose.position[2] - size[2] / 2)  # the floor
         self.arm = interfaces.get("arm")
         if self.arm is not None:
             base = robot_base_from_arm(self.arm)
