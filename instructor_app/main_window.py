@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtCore import Qt
+from PySide6.QtCore import QSize, Qt
 from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
 from PySide6.QtWidgets import (
     QComboBox,
@@ -54,9 +54,17 @@ from instructor_app.views import Views, make_views
 __all__ = ["APP_TITLE", "DISCARD", "Dialogs", "MainWindow", "Views", "make_views"]
 
 
+class _Scrolled(QScrollArea):
+    """A tall panel in a scroll area that asks for no more than a side column's width, so
+    that its tab squeezes neither the inspector nor the palette."""
+
+    def sizeHint(self) -> QSize:
+        hint = super().sizeHint()
+        return QSize(min(hint.width(), 260), hint.height())
+
+
 def _scrolled(widget: QWidget) -> QScrollArea:
-    """A tall panel in a scroll area, so that its tab does not squeeze the inspector."""
-    area = QScrollArea()
+    area = _Scrolled()
     area.setWidgetResizable(True)
     area.setWidget(widget)
     return area
