@@ -24,7 +24,7 @@ from typing import Any
 
 from PySide6.QtCore import QObject, QTimer, Signal
 
-from capabilities.motion.jog import JogFailed, Jogger
+from capabilities.motion.jog import JogFailed, Jogger, JogSpeeds
 from capabilities.motion.symmetry import SymmetryTable
 from capabilities.motion.targets import TargetResolver
 from engine.operations import OperationFailed
@@ -350,5 +350,6 @@ class RobotTeacher(QObject):
         q = arm.inverse_kinematics(pose)
         if q is None:
             return "the arm cannot reach that pose"
-        arm.move_joints(q, Jogger(arm).speeds.joint, Jogger(arm).speeds.joint_accel)
+        speeds = JogSpeeds()
+        arm.move_joints(q, speeds.joint, speeds.joint_accel)  # a newer target preempts it
         return ""
