@@ -27,7 +27,7 @@ from PySide6.QtWidgets import QCheckBox, QLabel, QPushButton, QToolBar, QVBoxLay
 from capabilities.geometry import pose_to_matrix
 from capabilities.motion.symmetry import SymmetryTable
 from capabilities.motion.targets import TargetResolver
-from capabilities.robot_body import robot_base_from_arm
+from capabilities.robot_body import RobotBodyError, robot_base_from_arm
 from engine.operations import OperationFailed
 from engine.types import Pose, Region, Waypoint, WaypointFrame
 from instructor_app.panels.scene3d_items import (
@@ -153,8 +153,12 @@ class Scene3DPanel(PointingMixin, QWidget):
                 self.table_z = pose.position[2] + size[2] / 2
                 grid.translate(0.0, 0.0, pose.position[2] - size[2] / 2)  # the floor
         self.arm = interfaces.get("arm")
-        if self.arm is not None:
-            base = robot_base_from_arm(self.arm)
+        try:
+            base = robot_base_from_arm(self.arm) if self.arm is not None else None
+        except RobotBodyError as exc:  # the 3D scene shows the rest, and says why not the arm
+            self.message.emit(f"The 3D scene cannot draw the robot: {exc}")
+            self.arm, base = None, None
+        if base is not None:
             self.robot = RobotItems(view, base)
             self.ghost = RobotItems(view, base, (0.4, 0.7, 1.0, 0.35))
             self.ghost.set_visible(False)
