@@ -153,9 +153,7 @@ def _screenshot(args: argparse.Namespace) -> int:
             _grab(window, Path(args.screenshot))
             return code
         finally:
-            window.controller.shutdown()
-            window.cell_views.stop()
-            window.autosaver.stop()
+            window.shutdown()
             window.hide()
             window.deleteLater()
             session.close()

@@ -11,13 +11,14 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtCore import Qt
+from PySide6.QtCore import QSize, Qt
 from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
 from PySide6.QtWidgets import (
     QComboBox,
     QDockWidget,
     QLabel,
     QMainWindow,
+    QScrollArea,
     QStackedWidget,
     QWidget,
 )
@@ -31,6 +32,7 @@ from instructor_app.document.tree_ops import can_have_child
 from instructor_app.node_factory import make_node, manifest_or_none
 from instructor_app.panels.cell_views import CellViews
 from instructor_app.panels.operator import OperatorPanel
+from instructor_app.panels.scene_teach import SceneTeachLink
 from instructor_app.panels.start_page import StartPage, find_examples
 from instructor_app.runtime.controller import RunController
 from instructor_app.runtime.robot_status import RobotStatusLabel, ScriptRestartButton
@@ -53,6 +55,22 @@ from instructor_app.views import Views, make_views
 OPEN_CELL_FILE = "Open cell file…"
 
 __all__ = ["APP_TITLE", "DISCARD", "Dialogs", "MainWindow", "Views", "make_views"]
+
+
+class _Scrolled(QScrollArea):
+    """A tall panel in a scroll area that asks for no more than a side column's width, so
+    that its tab squeezes neither the inspector nor the palette."""
+
+    def sizeHint(self) -> QSize:
+        hint = super().sizeHint()
+        return QSize(min(hint.width(), 260), hint.height())
+
+
+def _scrolled(widget: QWidget) -> QScrollArea:
+    area = _Scrolled()
+    area.setWidgetResizable(True)
+    area.setWidget(widget)
+    return area
 
 
 class MainWindow(QMainWindow):
@@ -85,7 +103,7 @@ class MainWindow(QMainWindow):
         self.document = PlanDocument(self)
         self.autosaver = Autosaver(self.document, recovery_folder, autosave_interval_ms, self)
         self.controller = RunController(self.document, session, rate_hz=rate_hz, parent=self)
-        self.views: Views = make_views(self.document, session, self)
+        self.views: Views = make_views(self.document, session, self, self.autosaver.folder.parent)
         self.run_actions = RunActions(self.controller, self)
         self.running_panel = RunningNodesPanel(self._node_path, self)
         self.operator_panel = OperatorPanel(self)
@@ -114,12 +132,19 @@ class MainWindow(QMainWindow):
         self.docks: dict[str, QDockWidget] = {}
         area = Qt.DockWidgetArea
         self._dock("palette", "Palette", self.views.palette, area.LeftDockWidgetArea)
+        self._dock("move", "Move", _scrolled(self.views.move), area.LeftDockWidgetArea)
+        self._dock("objects", "Objects", self.views.objects, area.LeftDockWidgetArea)
+        self.tabifyDockWidget(self.docks["palette"], self.docks["move"])
+        self.tabifyDockWidget(self.docks["move"], self.docks["objects"])
+        self.docks["palette"].raise_()
         self._dock("inspector", "Inspector", self.views.inspector, area.RightDockWidgetArea)
         # The cell's views; where they go depends on the window's width (arrange_cell_views).
         self._dock("cameras", "Cameras", self.cell_views.cameras, area.RightDockWidgetArea)
         self._dock("scene3d", "3D scene", self.cell_views.scene3d, area.RightDockWidgetArea)
         self._dock("plan", "Plan", self.views.plan_settings, area.RightDockWidgetArea)
-        self._dock("waypoints", "Waypoints", self.views.waypoints, area.RightDockWidgetArea)
+        self._dock(
+            "waypoints", "Waypoints", _scrolled(self.views.waypoints), area.RightDockWidgetArea
+        )
         self._dock("operator", "Operator", self.operator_panel, area.RightDockWidgetArea)
         self.splitDockWidget(self.docks["inspector"], self.docks["plan"], Qt.Orientation.Vertical)
         self.tabifyDockWidget(self.docks["plan"], self.docks["waypoints"])
@@ -264,7 +289,13 @@ class MainWindow(QMainWindow):
         views.canvas.selection_changed.connect(self._on_selection)
         views.canvas.message.connect(self.show_message)
         views.waypoints.message.connect(self.show_message)
+        views.teacher.message.connect(self.show_message)
+        views.objects.message.connect(self.show_message)
         self.cell_views.message.connect(self.show_message)
+        # Drag the tool gizmo in the 3D scene, preview waypoints as a ghost arm there.
+        self.scene_link = SceneTeachLink(
+            self.cell_views.scene3d, views.teacher, views.waypoints, self
+        )
         self.session.cell_changed.connect(lambda _name: self._attach_operator())
         self.operator_panel.prompt_shown.connect(lambda _text: self._raise_dock("operator"))
         self._attach_operator()
@@ -296,6 +327,11 @@ class MainWindow(QMainWindow):
         controller.running_nodes_changed.connect(self.running_panel.set_nodes)
         controller.failure_changed.connect(self.failure_button.show_failure)
         controller.run_state_changed.connect(self._on_run_state)
+        controller.run_state_changed.connect(
+            lambda state: views.teacher.set_run_active(
+                state not in (ExecutorState.READY, ExecutorState.FINISHED)
+            )
+        )
         self.run_presenter = RunPresenter(
             controller, views.canvas, views.blackboard, views.log, self.show_message, self
         )
@@ -558,12 +594,18 @@ class MainWindow(QMainWindow):
         else:
             self.arrange_cell_views()
 
+    def shutdown(self) -> None:
+        """Stop the run, the robot's teaching commands, background drawing and autosave."""
+        self.controller.shutdown()
+        self.cell_views.stop()
+        self.views.teacher.shutdown()
+        self.views.objects.shutdown()
+        self.autosaver.stop()
+
     def closeEvent(self, event: QCloseEvent) -> None:
         if not self.maybe_save():
             event.ignore()
             return
-        self.controller.shutdown()
-        self.cell_views.stop()
-        self.autosaver.stop()
+        self.shutdown()
         self.settings.save_window(self.saveGeometry(), self.saveState())
         event.accept()
