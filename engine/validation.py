@@ -16,9 +16,9 @@ written before everything.
 from __future__ import annotations
 
 import difflib
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, Literal, Protocol
 
 from engine.kinds import KIND_PORTS, check_setting, kind_port
 from engine.operations import (
@@ -29,10 +29,27 @@ from engine.operations import (
     OperationSource,
     PortSpec,
 )
-from engine.spec import KIND_CATEGORY, Binding, Category, NodeKind, NodeSpec, PlanSpec
+from engine.spec import (
+    KIND_CATEGORY,
+    Binding,
+    Category,
+    NodeKind,
+    NodeSpec,
+    PlanSpec,
+    SubtreeRef,
+    SubtreeSpec,
+)
 from engine.types import ParamType, check_value
 
-__all__ = ["ERROR", "WARNING", "Severity", "Problem", "validate_plan", "has_errors"]
+__all__ = [
+    "ERROR",
+    "WARNING",
+    "Severity",
+    "Problem",
+    "SubtreeSource",
+    "validate_plan",
+    "has_errors",
+]
 
 Severity = Literal["error", "warning"]
 ERROR: Severity = "error"
@@ -45,6 +62,14 @@ _PASS_CHILD = (
     NodeKind.RETRY,
     NodeKind.TIMEOUT,
 )
+
+
+class SubtreeSource(Protocol):
+    """What validation asks a subtree library (engine.library.Library implements it)."""
+
+    def latest(self, subtree_id: str) -> SubtreeSpec | None:
+        """The newest version of a subtree, or None when the library has none."""
+        ...
 
 
 @dataclass(frozen=True)
@@ -83,6 +108,7 @@ class _Writer:
     label: str
     types: tuple[ParamType, ...]
     node: NodeSpec | None = None
+    crossing: bool = False  # written inside a subtree instance, under a shared name
 
 
 @dataclass
@@ -95,6 +121,8 @@ class _Check:
     manifests: dict[int, OperationManifest] = field(default_factory=dict)  # id(node) -> manifest
     writers: dict[str, list[_Writer]] = field(default_factory=dict)
     found: list[tuple[int, int, Problem]] = field(default_factory=list)
+    # id(instance) -> the shared names its inside reads without writing them first
+    crossing_reads: dict[int, tuple[str, ...]] = field(default_factory=dict)
 
     def add(
         self,
@@ -109,20 +137,36 @@ class _Check:
         self.found.append((order, len(self.found), problem))
 
 
-def validate_plan(plan: PlanSpec, source: OperationSource) -> list[Problem]:
+def validate_plan(
+    plan: PlanSpec,
+    source: OperationSource,
+    library: SubtreeSource | None = None,
+    *,
+    given: Mapping[str, tuple[ParamType, ...]] | None = None,
+    stack: tuple[SubtreeRef, ...] = (),
+) -> list[Problem]:
     """Every problem of a plan, errors and warnings, sorted in tree order.
 
     Args:
         plan: the plan to check.
         source: the operations of the cell (manifests and availability).
+        library: the subtree library, to say when it has a newer version of a subtree the
+            plan's instances run (None: not checked).
+        given: names set before the tree starts, with their types (a subtree's inputs and
+            shared names, when the inside of a subtree is checked).
+        stack: the subtrees being checked around this one (a subtree may not hold itself).
 
     Returns:
         The problems; empty when the plan is fine. Plan-wide problems come first.
     """
+    from engine import subtree_check  # it builds on this module's checks
+
     check = _Check(plan, source)
     if plan.tree is None:
         check.add(ERROR, None, "The plan is empty: add a node to start from.")
     _check_parameters(check)
+    for name, types in (given or {}).items():
+        check.writers.setdefault(name, []).append(_Writer(f"the input {name}", types))
     ids: dict[str, str] = {}
     for order, (path, node) in enumerate(plan.walk()):
         check.paths[id(node)] = (order, path)
@@ -137,9 +181,12 @@ def validate_plan(plan: PlanSpec, source: OperationSource) -> list[Problem]:
         _check_structure(check, node)
         if node.kind is NodeKind.OPERATION:
             _check_operation(check, node)
+        elif node.kind is NodeKind.SUBTREE:
+            subtree_check.check_instance(check, node, library, stack)
+    subtree_check.check_crossings(check)
     _check_writer_types(check)
     if plan.tree is not None:
-        initial = {p.name for p in plan.parameters if p.value is not None}
+        initial = {p.name for p in plan.parameters if p.value is not None} | set(given or {})
         _check_reads(check, plan.tree, frozenset(initial))
     return [problem for _, _, problem in sorted(check.found, key=lambda f: (f[0], f[1]))]
 
@@ -177,7 +224,7 @@ def _check_structure(check: _Check, node: NodeSpec) -> None:
         check.add(ERROR, node, f"{label!r} has no nodes below it: add some or remove it.")
     elif category is Category.LEAF and count:
         check.add(ERROR, node, f"{label!r} cannot have nodes below it; it has {count}.")
-    if node.kind is not NodeKind.OPERATION:
+    if node.kind not in (NodeKind.OPERATION, NodeKind.SUBTREE):
         _check_kind_ports(check, node)
     if node.kind is NodeKind.PARALLEL and count:
         _check_parallel_policy(check, node)
@@ -415,6 +462,10 @@ def _check_writer_types(check: _Check) -> None:
 def _check_reads(check: _Check, node: NodeSpec, available: frozenset[str]) -> frozenset[str]:
     """Check the references this subtree reads; return what it guarantees after SUCCESS."""
     if node.kind is NodeKind.OPERATION:
+        return _operation_reads(check, node, available)
+    if node.kind is NodeKind.SUBTREE:
+        for name in check.crossing_reads.get(id(node), ()):
+            _check_reference(check, node, name, name, (ParamType.ANY,), available)
         return _operation_reads(check, node, available)
     children = node.children
     if node.kind in (NodeKind.SEQUENCE, NodeKind.REACTIVE_SEQUENCE):
