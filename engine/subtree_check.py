@@ -9,28 +9,36 @@ by another instance or by the plan is a collision: reported, since each overwrit
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from engine.instances import instance_manifest
 from engine.operations import Direction
 from engine.spec import NodeKind, NodeSpec, PlanSpec, SubtreeRef, SubtreeSpec
 from engine.types import ParamType
-from engine.validation import (
+from engine.validation_ports import (
     ERROR,
     WARNING,
+    Check,
     Problem,
     SubtreeSource,
-    _Check,
-    _check_bound_ports,
-    _check_unbound_ports,
-    _stated,
-    _Writer,
-    validate_plan,
+    Writer,
+    check_bound_ports,
+    check_unbound_ports,
+    stated,
 )
+
+# validate_plan, passed in by engine.validation (which imports this module)
+Validate = Callable[..., list[Problem]]
 
 __all__ = ["check_instance", "check_crossings", "inner_writes"]
 
 
 def check_instance(
-    check: _Check, node: NodeSpec, library: SubtreeSource | None, stack: tuple[SubtreeRef, ...]
+    check: Check,
+    node: NodeSpec,
+    library: SubtreeSource | None,
+    stack: tuple[SubtreeRef, ...],
+    validate: Validate,
 ) -> None:
     """The subtree an instance runs, its bindings, its inside, and the library's version."""
     if node.subtree is None:
@@ -65,15 +73,15 @@ def check_instance(
         return
     manifest = instance_manifest(subtree)
     check.manifests[id(node)] = manifest
-    params = _stated(node.params)
-    _check_bound_ports(check, node, manifest, params)
-    _check_unbound_ports(check, node, manifest, params)
+    params = stated(node.params)
+    check_bound_ports(check, node, manifest, params)
+    check_unbound_ports(check, node, manifest, params)
     _check_definition(check, node, subtree)
-    _check_inside(check, node, subtree, library, (*stack, ref))
+    _check_inside(check, node, subtree, library, (*stack, ref), validate)
     _add_crossings(check, node, subtree)
 
 
-def _check_definition(check: _Check, node: NodeSpec, subtree: SubtreeSpec) -> None:
+def _check_definition(check: Check, node: NodeSpec, subtree: SubtreeSpec) -> None:
     declared = {p.name for p in [*subtree.inputs, *subtree.outputs]}
     for name in subtree.shared:
         if name in declared:
@@ -87,18 +95,19 @@ def _check_definition(check: _Check, node: NodeSpec, subtree: SubtreeSpec) -> No
 
 
 def _check_inside(
-    check: _Check,
+    check: Check,
     node: NodeSpec,
     subtree: SubtreeSpec,
     library: SubtreeSource | None,
     stack: tuple[SubtreeRef, ...],
+    validate: Validate,
 ) -> None:
     """The inside, checked as a tree of its own, its problems reported at the instance."""
     given: dict[str, tuple[ParamType, ...]] = {p.name: (ParamType(p.type),) for p in subtree.inputs}
     for name in subtree.shared:
         given.setdefault(name, (ParamType.ANY,))
     inner = PlanSpec(tree=subtree.tree, name=subtree.name, subtrees=check.plan.subtrees)
-    problems = validate_plan(inner, check.source, library, given=given, stack=stack)
+    problems = validate(inner, check.source, library, given=given, stack=stack)
     order, path = check.paths[id(node)]
     for problem in problems:
         inside = Problem(
@@ -116,7 +125,7 @@ def _check_inside(
             )
 
 
-def inner_writes(subtree: SubtreeSpec, check: _Check) -> dict[str, tuple[ParamType, ...]]:
+def inner_writes(subtree: SubtreeSpec, check: Check) -> dict[str, tuple[ParamType, ...]]:
     """Names the inside writes (operation results and nested instances' outputs), with types."""
     written: dict[str, tuple[ParamType, ...]] = {}
     for _, inner in subtree.tree.walk():
@@ -139,18 +148,18 @@ def inner_writes(subtree: SubtreeSpec, check: _Check) -> dict[str, tuple[ParamTy
     return written
 
 
-def _add_crossings(check: _Check, node: NodeSpec, subtree: SubtreeSpec) -> None:
+def _add_crossings(check: Check, node: NodeSpec, subtree: SubtreeSpec) -> None:
     """Shared names: writes inside count in this scope; reads inside need a writer here."""
     written = inner_writes(subtree, check)
     for name in subtree.shared:
         if name in written:
-            writer = _Writer(repr(node.label), written[name], node, crossing=True)
+            writer = Writer(repr(node.label), written[name], node, crossing=True)
             check.writers.setdefault(name, []).append(writer)
     reads = [name for name in subtree.shared if name not in written]
     check.crossing_reads[id(node)] = tuple(reads)
 
 
-def check_crossings(check: _Check) -> None:
+def check_crossings(check: Check) -> None:
     """A shared name written inside an instance and by anything else in this scope collides."""
     for name, writers in check.writers.items():
         crossing = [w for w in writers if w.crossing]
