@@ -207,6 +207,7 @@ def transfer() -> SubtreeSpec:
         m.node(NodeKind.INVERTER, "not in the bin yet",
                m.op("predicates.touching", "OBJECT in the bin", object_a="OBJECT",
                     object_b=_obj("kit_bin"))),
+        m.op("motion.go_home", "clear of the table"),  # from the camera pose, over the bin
         m.move("above OBJECT", "PICK", "PART_POSE"),
         m.vertical("down to OBJECT", -HOVER),
         m.op("tool.suction_on", "suck"),
