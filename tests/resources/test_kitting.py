@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import importlib.util
 import io
 from pathlib import Path
@@ -11,11 +12,17 @@ import pytest
 
 from capabilities.base import CapabilityRegistry
 from capabilities.cli import main as costar
+from capabilities.sim.session import SimCellSession
+from engine.build import build_tree
+from engine.executor import run_to_end
 from engine.files import dump_plan, load_plan
 from engine.library import SHIPPED_LIBRARY, Library, dump_subtree
-from engine.spec import NodeKind
+from engine.spec import NodeKind, PlanSpec
+from engine.status import Status
+from engine.types import ObjectModel
 from engine.validation import has_errors, validate_plan
 from tests.resources.test_examples import _InterfacesOnly
+
 
 class _SimInterfaces(_InterfacesOnly):
     """The simulated cell's interfaces with its operator console (validation only)."""
@@ -75,3 +82,37 @@ def test_costar_run_kitting_succeeds(seed: int) -> None:
     code = costar([*args, "--timeout", "600"], out, err)
     assert code == 0, out.getvalue() + err.getvalue()
     assert "SUCCESS" in out.getvalue()
+
+
+def _reparameterized_transfer_plan() -> PlanSpec:
+    """Handoff, Unholster, the 8-hole plate's Transfer rebound to the 4-hole plate (Figure 6:
+    a new object, a new pick waypoint relative to it, a new place waypoint relative to the
+    bin), Holster."""
+    plan = load_plan(KITTING)
+    assert plan.tree is not None
+    by_name = {n.name: n for _, n in plan.walk()}
+    transfer = copy.deepcopy(by_name["Transfer 8-hole plate"])
+    four = by_name["Transfer 4-hole plate"]
+    assert transfer.params["OBJECT"].value == ObjectModel("plate_8_holes")
+    for port in ("OBJECT", "PICK", "PLACE"):  # what the worker teaches anew
+        transfer.params[port] = four.params[port]
+    transfer.name = "Transfer (reparameterized)"
+    plan.tree.children = [by_name["Handoff"], by_name["Unholster"], transfer, by_name["Holster"]]
+    return plan
+
+
+def test_transfer_reparameterized_from_the_8_to_the_4_hole_plate_runs() -> None:
+    plan = _reparameterized_transfer_plan()
+    with SimCellSession("kitting_handoff", 0) as session:
+        registry = CapabilityRegistry(cell=session)
+        assert not has_errors(validate_plan(plan, registry))
+        result = run_to_end(build_tree(plan, registry, clock=session.clock), 20.0, timeout=600)
+        assert result.status is Status.SUCCESS, result.message
+        session.sim.wait_sim(0.5)
+        bin_pose = session.truth_pose("kit_bin")
+        x, y, z = bin_pose.inverse().compose(session.truth_pose("plate_4_holes")).position
+        assert abs(x) < 0.175 and abs(y) < 0.1275 and 0 < z < 0.03  # in the bin (ground truth)
+        eight = session.truth_pose("plate_8_holes")
+        assert eight.position[2] < 0.01  # still on the table: the 8-hole plate was not moved
+        inside = bin_pose.inverse().compose(eight).position
+        assert abs(inside[0]) > 0.175 or abs(inside[1]) > 0.1275
