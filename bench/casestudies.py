@@ -16,7 +16,7 @@ what is wrong. Run from the repository root::
     .venv/bin/python bench/casestudies.py [--runs 100] [--only kitting] [--json]
 
 JSON: ``{"kitting": {"runs": 100, "succeeded": 99, "failures": {"seed": "why", ...},
-"wall_s_per_run": 17.2}}``.
+"wall_s_per_run": 17.2}}`` (wall seconds per run, divided by ``--jobs`` in effect).
 """
 
 from __future__ import annotations
@@ -24,6 +24,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import multiprocessing
 import sys
 import time
 from collections.abc import Callable
@@ -102,15 +103,26 @@ def run_case(case: CaseStudy, seed: int) -> str:
         return case.score(session)
 
 
-def measure(name: str, runs: int, first_seed: int = 0) -> dict[str, Any]:
-    case = CASES[name]
-    failures: dict[str, str] = {}
+def _run_seed(job: tuple[str, int]) -> tuple[int, str]:
+    name, seed = job
+    try:
+        why = run_case(CASES[name], seed)
+    except Exception as exc:  # a crash of one run is a failed run, not the end of the bench
+        why = f"error: {type(exc).__name__}: {exc}"
+    print(f"{name} seed {seed}: {why or 'ok'}", file=sys.stderr, flush=True)
+    return seed, why
+
+
+def measure(name: str, runs: int, first_seed: int = 0, jobs: int = 1) -> dict[str, Any]:
+    """Run ``runs`` seeds of a case study, ``jobs`` cells at a time (each its own process)."""
+    seeds = [(name, seed) for seed in range(first_seed, first_seed + runs)]
     start = time.perf_counter()
-    for seed in range(first_seed, first_seed + runs):
-        why = run_case(case, seed)
-        if why:
-            failures[str(seed)] = why
-        print(f"{name} seed {seed}: {why or 'ok'}", file=sys.stderr, flush=True)
+    if jobs > 1:
+        with multiprocessing.get_context("spawn").Pool(jobs) as pool:
+            results = pool.map(_run_seed, seeds, chunksize=1)
+    else:
+        results = [_run_seed(job) for job in seeds]
+    failures = {str(seed): why for seed, why in results if why}
     wall = (time.perf_counter() - start) / max(runs, 1)
     return {
         "runs": runs,
@@ -126,9 +138,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--runs", type=int, default=100, help="seeds per case study")
     parser.add_argument("--first-seed", type=int, default=0)
     parser.add_argument("--only", choices=sorted(CASES), action="append")
+    parser.add_argument("--jobs", type=int, default=1, help="cells run at once (processes)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     args = parser.parse_args(argv)
-    figures = {name: measure(name, args.runs, args.first_seed) for name in args.only or CASES}
+    figures = {
+        name: measure(name, args.runs, args.first_seed, args.jobs) for name in args.only or CASES
+    }
     if args.json:
         print(json.dumps(figures))
     else:
