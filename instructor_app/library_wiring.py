@@ -84,6 +84,7 @@ class LibraryController(QObject):
         panel.usages_requested.connect(lambda entry: self.find_usages(entry))
         panel.reload_requested.connect(self.reload)
         views.canvas.instance_inserter = self._insert_under
+        views.canvas.selection_changed.connect(self._show_inside)
         self.actions = self._make_actions()
         self.reload()
 
@@ -162,6 +163,13 @@ class LibraryController(QObject):
         self.last_usages = usages
         self.views.library.show_usages(entry.subtree.name, usages, problems)
         return usages
+
+    def _show_inside(self, node_ids: list[str]) -> None:
+        """Open the selected instance in the Inside panel (statuses of runs shown live)."""
+        plan = self.document.plan
+        node = plan.find(node_ids[0]) if len(node_ids) == 1 else None
+        if node is not None and node.kind is NodeKind.SUBTREE:
+            self.views.inside.show_instance(plan, node)
 
     # ------------------------------------------------------------------ menu
 

@@ -122,6 +122,8 @@ class MainWindow(QMainWindow):
         self._dock("waypoints", "Waypoints", self.views.waypoints, area.RightDockWidgetArea)
         self._dock("operator", "Operator", self.operator_panel, area.RightDockWidgetArea)
         self._dock("library", "Library", self.views.library, area.LeftDockWidgetArea)
+        self._dock("inside", "Inside", self.views.inside, area.RightDockWidgetArea)
+        self.tabifyDockWidget(self.docks["operator"], self.docks["inside"])
         self.tabifyDockWidget(self.docks["palette"], self.docks["library"])
         self.docks["palette"].raise_()
         self.splitDockWidget(self.docks["inspector"], self.docks["plan"], Qt.Orientation.Vertical)
@@ -263,6 +265,7 @@ class MainWindow(QMainWindow):
     def _wire_run(self) -> None:
         controller, views = self.controller, self.views
         controller.statuses_changed.connect(views.canvas.set_statuses)
+        controller.inner_statuses_changed.connect(views.inside.set_statuses)
         controller.blackboard_written.connect(views.blackboard.set_value)
         controller.log_message.connect(views.log.append)
         controller.running_nodes_changed.connect(self.running_panel.set_nodes)

@@ -35,6 +35,7 @@ class Views:
     plan_settings: Any
     waypoints: Any
     library: Any
+    inside: Any
 
     def set_registry(self, registry: Any) -> None:
         """Another cell: every view that shows operations rebuilds from its registry."""
@@ -63,6 +64,7 @@ def make_views(document: PlanDocument, session: CellSession, parent: QWidget) ->
     from instructor_app.panels import (
         BlackboardPanel,
         InspectorPanel,
+        InstanceInsidePanel,
         LibraryPanel,
         LogPanel,
         PalettePanel,
@@ -88,6 +90,7 @@ def make_views(document: PlanDocument, session: CellSession, parent: QWidget) ->
         PlanSettingsPanel(document, parent),
         WaypointsPanel(document, registry, parent),
         LibraryPanel(parent),
+        InstanceInsidePanel(parent),
     )
     views.set_registry(registry)
     return views

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from instructor_app.panels.blackboard import BlackboardPanel
 from instructor_app.panels.inspector import InspectorPanel
+from instructor_app.panels.instance_inside import InstanceInsidePanel
 from instructor_app.panels.library import LibraryPanel
 from instructor_app.panels.log import LogPanel
 from instructor_app.panels.palette import PalettePanel
@@ -15,6 +16,7 @@ from instructor_app.panels.waypoints import WaypointsPanel
 __all__ = [
     "BlackboardPanel",
     "InspectorPanel",
+    "InstanceInsidePanel",
     "LibraryPanel",
     "LogPanel",
     "PalettePanel",

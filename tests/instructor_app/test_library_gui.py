@@ -191,3 +191,20 @@ def test_a_newer_library_version_is_shown_and_the_instance_updates(
     qtbot.waitUntil(
         lambda: not any("newer version" in p.message for p in window.views.validation.problems())
     )
+
+
+def test_the_inside_of_a_selected_instance_shows_the_run_live(
+    qtbot: Any, window: MainWindow, tmp_path: Path
+) -> None:
+    _open(window, tmp_path, _plan())
+    instance_id = _save_part_with_open_message(qtbot, window)
+    select(window, instance_id)
+    inside = window.views.inside
+    assert inside.title.text().startswith("Inside part")
+    assert set(inside.status_texts()) == {
+        "part (sequence)",
+        "say (debug.log)",
+        "keep (debug.set_param)",
+    }
+    assert run_to_end(qtbot, window).status is Status.SUCCESS
+    qtbot.waitUntil(lambda: set(inside.status_texts().values()) == {"SUCCESS"})
