@@ -122,8 +122,6 @@ class MainWindow(QMainWindow):
         self._dock("waypoints", "Waypoints", self.views.waypoints, area.RightDockWidgetArea)
         self._dock("operator", "Operator", self.operator_panel, area.RightDockWidgetArea)
         self._dock("library", "Library", self.views.library, area.LeftDockWidgetArea)
-        self._dock("inside", "Inside", self.views.inside, area.RightDockWidgetArea)
-        self.tabifyDockWidget(self.docks["operator"], self.docks["inside"])
         self.tabifyDockWidget(self.docks["palette"], self.docks["library"])
         self.docks["palette"].raise_()
         self.splitDockWidget(self.docks["inspector"], self.docks["plan"], Qt.Orientation.Vertical)
@@ -135,6 +133,7 @@ class MainWindow(QMainWindow):
             ("log", "Log", self.views.log),
             ("blackboard", "Blackboard", self.views.blackboard),
             ("running", "Running nodes", self.running_panel),
+            ("inside", "Inside instance", self.views.inside),
         ]
         for name, title, widget in bottom:
             self._dock(name, title, widget, area.BottomDockWidgetArea)

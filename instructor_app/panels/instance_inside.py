@@ -44,6 +44,7 @@ class InstanceInsidePanel(QWidget):
         self.title.setText(f"Inside {instance.label} ({subtree.name}, version {subtree.version})")
         self._add(plan, subtree.tree, f"{instance.id}/", None, (subtree.ref,))
         self.tree.expandAll()
+        self.tree.resizeColumnToContents(0)
         for runtime_id, status in self._statuses.items():
             self._colour(runtime_id, status)
 
