@@ -12,7 +12,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from PySide6.QtCore import Qt
+from PySide6.QtCore import QPointF, Qt
+from PySide6.QtGui import QDropEvent
 from PySide6.QtWidgets import QDialog
 
 from engine.files import dump_plan
@@ -208,3 +209,24 @@ def test_the_inside_of_a_selected_instance_shows_the_run_live(
     }
     assert run_to_end(qtbot, window).status is Status.SUCCESS
     qtbot.waitUntil(lambda: set(inside.status_texts().values()) == {"SUCCESS"})
+
+
+def test_a_subtree_dragged_from_the_library_onto_a_node_becomes_its_child(
+    qtbot: Any, window: MainWindow, tmp_path: Path
+) -> None:
+    _open(window, tmp_path, _plan())
+    panel = window.views.library
+    panel.select("Unholster")
+    row = panel.tree.currentItem()
+    mime = panel.tree.mimeData([row])  # what the tree hands to a drag
+    canvas = window.views.canvas
+    main = canvas.item(_node(window, "main").id)
+    pos = canvas.viewer.mapFromScene(main.mapToScene(main.shape_rect().center()))
+    event = QDropEvent(
+        QPointF(pos), Qt.DropAction.CopyAction, mime, Qt.MouseButton.LeftButton,
+        Qt.KeyboardModifier.NoModifier,
+    )  # fmt: skip
+    canvas.viewer.dropEvent(event)
+    added = window.document.plan.tree.children[-1]  # type: ignore[union-attr]
+    assert added.kind is NodeKind.SUBTREE and added.name == "Unholster"
+    assert [s.name for s in window.document.plan.subtrees] == ["Unholster"]
