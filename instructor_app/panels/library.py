@@ -21,6 +21,7 @@ from PySide6.QtWidgets import (
     QLabel,
     QLineEdit,
     QPushButton,
+    QSizePolicy,
     QTextBrowser,
     QTreeWidget,
     QTreeWidgetItem,
@@ -145,6 +146,8 @@ class LibraryPanel(QWidget):
         self.reload_button.clicked.connect(self.reload_requested.emit)
         buttons = QHBoxLayout()
         for button in (self.insert_button, self.usages_button, self.reload_button):
+            # they may narrow with the dock: the panel must not widen the window
+            button.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Fixed)
             buttons.addWidget(button)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(2, 2, 2, 2)
