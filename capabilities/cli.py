@@ -23,6 +23,7 @@ from engine.build import BuildError, build_tree
 from engine.events import Event, LogMessage, RunFinished, StatusChanged
 from engine.executor import Executor
 from engine.files import PlanFileError, load_plan
+from engine.instances import runtime_paths
 from engine.library import Library, library_folder
 from engine.operations import OperationManifest
 from engine.spec import PlanSpec
@@ -92,7 +93,7 @@ class _VerbosePrinter:
     """Prints one line per status change (on the dispatcher thread)."""
 
     def __init__(self, plan: PlanSpec, out: TextIO) -> None:
-        self._paths = dict((node.id, path) for path, node in plan.walk())
+        self._paths = runtime_paths(plan)  # instances' insides too
         self._out = out
 
     def __call__(self, event: Event) -> None:

@@ -21,11 +21,11 @@ from typing import Any
 from engine.context import TreeContext
 from engine.decorators import Decorator
 from engine.operations import Direction, OperationKind, OperationManifest, PortSpec
-from engine.spec import NodeSpec, SubtreeRef, SubtreeSpec
+from engine.spec import NodeKind, NodeSpec, PlanSpec, SubtreeRef, SubtreeSpec
 from engine.status import RUNNING, SUCCESS, Status
 from engine.types import ParamType
 
-__all__ = ["Scope", "SubtreeInstance", "instance_manifest", "ROOT_SCOPE"]
+__all__ = ["Scope", "SubtreeInstance", "instance_manifest", "runtime_paths", "ROOT_SCOPE"]
 
 
 def instance_manifest(subtree: SubtreeSpec) -> OperationManifest:
@@ -47,6 +47,36 @@ def instance_manifest(subtree: SubtreeSpec) -> OperationManifest:
         capability="library",
         ports=tuple(ports),
     )
+
+
+def runtime_paths(plan: PlanSpec) -> dict[str, str]:
+    """Runtime node id -> path, the insides of instances included (``Kitting/Handoff[0]/...``).
+
+    Status events name runtime ids; this tells a reader where each one is.
+    """
+    paths: dict[str, str] = {}
+    stack: list[tuple[NodeSpec, str, str, tuple[SubtreeRef, ...]]] = []
+    if plan.tree is not None:
+        stack.append((plan.tree, "", "", ()))
+    while stack:
+        top, prefix, base, seen = stack.pop()
+        for path, node in top.walk(base):
+            paths[f"{prefix}{node.id}"] = path
+            inner = (
+                plan.subtree(node.subtree)
+                if node.kind is NodeKind.SUBTREE and node.subtree
+                else None
+            )
+            if inner is not None and inner.ref not in seen:
+                stack.append(
+                    (
+                        inner.tree,
+                        f"{prefix}{node.id}/",
+                        f"{path}/{inner.tree.label}",
+                        (*seen, inner.ref),
+                    )
+                )
+    return paths
 
 
 @dataclass(frozen=True)

@@ -8,6 +8,7 @@ from bt_fakes import logic, op, plan
 from capabilities.base import CapabilityRegistry
 from engine.build import BuildError, build_tree
 from engine.files import dump_plan, loads_plan
+from engine.instances import runtime_paths
 from engine.spec import (
     Binding,
     NodeKind,
@@ -196,3 +197,13 @@ def test_failure_inside_fails_the_instance_with_its_message(registry: Capability
     assert built.tick_until_done(1000) is FAILURE
     node = next(n for n in built.iterate() if n.name == "Pick A")
     assert node.status is FAILURE and "oops" in node.message
+
+
+def test_runtime_paths_name_the_insides_of_instances(registry: CapabilityRegistry) -> None:
+    spec = two_instances()
+    paths = runtime_paths(spec)
+    first = spec.tree.children[1]  # type: ignore[union-attr]
+    find = spec.subtrees[0].tree.children[0]
+    assert paths[f"{first.id}/{find.id}"] == "sequence/Pick A[1]/Pick/find[0]"
+    built = {node.id for node in build_tree(spec, registry).iterate()} - {"root"}
+    assert built <= set(paths)  # every runtime node has a path
