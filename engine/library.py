@@ -217,7 +217,7 @@ class Library:
                 raise LibraryConflict(
                     f"{target}: another subtree called {current.name!r} is already there"
                 )
-            on_disk = current.version if current is not None else None
+            on_disk = current.version if current is not None else self._shipped_version(subtree.id)
             if on_disk != base_version:
                 raise LibraryConflict(_conflict_text(target, subtree, on_disk, base_version))
             saved = dataclasses.replace(subtree, version=(on_disk or 0) + 1, date=_now())
@@ -227,12 +227,22 @@ class Library:
                 raise LibraryError(str(exc)) from exc
         return saved
 
+    def _shipped_version(self, subtree_id: str) -> int | None:
+        """A shipped subtree's version: a changed copy goes to the writable folder, one up."""
+        found = [
+            e.subtree.version for e in self.entries if e.shipped and e.subtree.id == subtree_id
+        ]
+        return max(found) if found else None
+
     def _target(self, subtree: SubtreeSpec, folder: str) -> Path:
         existing = next(
             (e for e in self.entries if e.subtree.id == subtree.id and not e.shipped), None
         )
         if existing is not None:
             return existing.path
+        shipped = next((e for e in self.entries if e.subtree.id == subtree.id), None)
+        if shipped is not None and not folder:
+            folder = shipped.folder  # a changed shipped subtree keeps its folder
         parts = [p for p in Path(folder).parts if p not in ("", ".", "..")]
         place = self.root.joinpath(*parts)
         try:

@@ -113,3 +113,16 @@ def test_two_processes_writing_at_once_lose_nothing(tmp_path: Path) -> None:
     updates = set(final.description.rstrip(";").split(";"))
     assert updates == {f"{who}{i}" for who in "ab" for i in range(count)}
     assert not list(tmp_path.rglob(".*.lock")) and not list(tmp_path.rglob(".*.tmp"))
+
+
+def test_a_changed_shipped_subtree_is_saved_to_the_writable_folder(tmp_path: Path) -> None:
+    shipped = tmp_path / "shipped"
+    Library(shipped, shipped=()).scan().save(pick_subtree(), "kitting")
+    library = Library(tmp_path / "mine", shipped=(shipped,)).scan()
+    original = library.latest("test.pick")
+    assert original is not None and library.entry("test.pick").shipped  # type: ignore[union-attr]
+    original.description = "mine now"
+    saved = library.save(original, base_version=original.version)
+    assert saved.version == 2 and (tmp_path / "mine" / "kitting" / "Pick.subtree.json").exists()
+    library.scan()
+    assert library.latest("test.pick") == saved and not library.entry("test.pick").shipped  # type: ignore[union-attr]
