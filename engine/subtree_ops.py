@@ -146,8 +146,10 @@ def make_subtree(
         fixed = old is not None and not old.is_ref and old.type is not None
         default = old.value if fixed and old is not None else None
         ptype = ParamType(old.type) if fixed and old is not None and old.type else _one_type(port)
-        inputs.append(SubtreePort(spec.name, ptype, spec.doc or port.doc, default))
         node.params[spec.port] = Binding.reference(spec.name)
+        if any(p.name == spec.name for p in inputs):
+            continue  # one input may feed several parameters (OBJECT: found and its pose)
+        inputs.append(SubtreePort(spec.name, ptype, spec.doc or port.doc, default))
     reads, writes = _reads_and_writes(tree, ports_of)
     declared = {p.name for p in inputs}
     for ref, ptype in sorted(reads.items()):

@@ -78,6 +78,9 @@ class SaveSubtreeDialog(QDialog):
         self.outputs_table.setHorizontalHeaderLabels(["Written name (output)", "Description"])
         self._params: list[tuple[NodeSpec, PortSpec]] = []
         self._fill(root, ports_of)
+        for table in (self.params_table, self.outputs_table):
+            table.resizeColumnsToContents()
+            table.horizontalHeader().setStretchLastSection(True)
         form = QFormLayout()
         form.addRow("Name", self.name_field)
         form.addRow("Folder", self.folder_field)

@@ -134,3 +134,14 @@ def test_find_usages_in_a_folder_names_broken_files(tmp_path: Path) -> None:
         ("a.costar.json", "sequence/Pick B[2]", 1),
     ]
     assert len(problems) == 1 and "broken.costar.json" in problems[0]
+
+
+def test_one_input_may_feed_several_parameters(registry: CapabilityRegistry) -> None:
+    spec = _selection_plan()
+    part = spec.tree.children[1]  # type: ignore[union-attr]
+    find, check = part.children[0], part.children[1]
+    opened = [OpenPort(find.id, "value", "OBJECT"), OpenPort(check.id, "expected", "OBJECT")]
+    made = make_subtree(part, "Find", ports_of(spec, registry), opened)
+    assert [p.name for p in made.inputs] == ["OBJECT"]
+    inner = made.tree.children
+    assert inner[0].params["value"] == inner[1].params["expected"] == Binding.reference("OBJECT")
