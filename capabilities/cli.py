@@ -28,6 +28,8 @@ from engine.build import BuildError, build_tree
 from engine.events import Event, LogMessage, RunFinished, RunHeld, StatusChanged
 from engine.executor import Executor
 from engine.files import PlanFileError, load_plan
+from engine.instances import runtime_paths
+from engine.library import Library, library_folder
 from engine.operations import OperationManifest
 from engine.run_report import FailureLog
 from engine.spec import PlanSpec
@@ -68,6 +70,14 @@ def _open(args: argparse.Namespace, err: TextIO, start: bool) -> Any:
         return None
 
 
+def _library(args: argparse.Namespace, err: TextIO) -> Library:
+    """The subtree library (to tell of newer versions); its broken files are named, skipped."""
+    library = Library(library_folder(args.library)).scan()
+    for problem in library.problems:
+        print(f"warning: library file skipped: {problem}", file=err)
+    return library
+
+
 def _cmd_validate(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     cell = _open(args, err, start=False)
     if cell is None:
@@ -77,7 +87,7 @@ def _cmd_validate(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         plan = _load(args.plan, registry, err)
         if plan is None:
             return EXIT_INVALID
-        problems = validate_plan(plan, registry)
+        problems = validate_plan(plan, registry, _library(args, err))
     _print_problems(args.plan, problems, out)
     if has_errors(problems):
         count = sum(p.severity == "error" for p in problems)
@@ -97,7 +107,7 @@ class _VerbosePrinter:
     """Prints one line per status change (on the dispatcher thread)."""
 
     def __init__(self, plan: PlanSpec, out: TextIO) -> None:
-        self._paths = dict((node.id, path) for path, node in plan.walk())
+        self._paths = runtime_paths(plan)  # instances' insides too
         self._out = out
 
     def __call__(self, event: Event) -> None:
@@ -162,7 +172,7 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         plan = _load(args.plan, registry, err)
         if plan is None:
             return EXIT_INVALID
-        problems = validate_plan(plan, registry)
+        problems = validate_plan(plan, registry, _library(args, err))
         if has_errors(problems):
             _print_problems(args.plan, problems, err)
             print(f"{args.plan}: invalid, not started", file=err)
@@ -327,6 +337,10 @@ def _parser() -> argparse.ArgumentParser:
         p.add_argument("--seed", type=int, default=0, help="scene seed of the simulated cell")
         p.add_argument(
             "--scene", help="scene of the simulated cell (name or path; default cup_to_bin)"
+        )
+        p.add_argument(
+            "--library",
+            help="the subtree library folder (default: $COSTAR_LIBRARY, else the user's)",
         )
 
     validate = sub.add_parser("validate", help="check a plan; exit 0 valid, 2 invalid")

@@ -24,11 +24,14 @@ from PySide6.QtWidgets import (
 )
 
 from engine.executor import ExecutorState
+from engine.library import library_folder
+from engine.spec import NodeKind
 from instructor_app.dialogs import APP_TITLE, DISCARD, SAVE, Dialogs
 from instructor_app.document.autosave import DEFAULT_INTERVAL_MS, Autosaver, offer_recoveries
 from instructor_app.document.editing import PlanDocument
 from instructor_app.document.model import DocumentError
 from instructor_app.document.tree_ops import can_have_child
+from instructor_app.library_wiring import LibraryController
 from instructor_app.node_factory import make_node, manifest_or_none
 from instructor_app.panels.cell_views import CellViews
 from instructor_app.panels.operator import OperatorPanel
@@ -110,6 +113,11 @@ class MainWindow(QMainWindow):
         self.failure_button = FailureButton(self._node_label, self)
         self.selection: list[str] = []
         self.cell_views = CellViews(self.document, session, self._selected_node, parent=self)
+        self.library = LibraryController(
+            self.document, self.views, lambda: self.session.registry, self._insertion_point,
+            library_folder(setting=self.settings.library_folder()), self,
+        )  # fmt: skip
+        self.library.message.connect(self.show_message)
         self._build_layout()
         self.actions_by_name: dict[str, QAction] = {}
         self._build_menus()
@@ -146,6 +154,9 @@ class MainWindow(QMainWindow):
             "waypoints", "Waypoints", _scrolled(self.views.waypoints), area.RightDockWidgetArea
         )
         self._dock("operator", "Operator", self.operator_panel, area.RightDockWidgetArea)
+        self._dock("library", "Library", self.views.library, area.LeftDockWidgetArea)
+        self.tabifyDockWidget(self.docks["palette"], self.docks["library"])
+        self.docks["palette"].raise_()
         self.splitDockWidget(self.docks["inspector"], self.docks["plan"], Qt.Orientation.Vertical)
         self.tabifyDockWidget(self.docks["plan"], self.docks["waypoints"])
         self.tabifyDockWidget(self.docks["waypoints"], self.docks["operator"])
@@ -155,6 +166,7 @@ class MainWindow(QMainWindow):
             ("log", "Log", self.views.log),
             ("blackboard", "Blackboard", self.views.blackboard),
             ("running", "Running nodes", self.running_panel),
+            ("inside", "Inside instance", self.views.inside),
         ]
         for name, title, widget in bottom:
             self._dock(name, title, widget, area.BottomDockWidgetArea)
@@ -248,6 +260,7 @@ class MainWindow(QMainWindow):
         run_menu.addActions(self.run_actions.all())
         run_menu.addSeparator()
         run_menu.addAction(reset)
+        self.library.fill_menu(bar.addMenu("&Library"))
         help_menu = bar.addMenu("&Help")
         help_menu.addAction(self._action("about", f"&About {APP_TITLE}", self._about))
         toolbar = self.addToolBar("Run")
@@ -322,6 +335,7 @@ class MainWindow(QMainWindow):
     def _wire_run(self) -> None:
         controller, views = self.controller, self.views
         controller.statuses_changed.connect(views.canvas.set_statuses)
+        controller.inner_statuses_changed.connect(views.inside.set_statuses)
         controller.blackboard_written.connect(views.blackboard.set_value)
         controller.log_message.connect(views.log.append)
         controller.running_nodes_changed.connect(self.running_panel.set_nodes)
@@ -373,6 +387,8 @@ class MainWindow(QMainWindow):
         if not item.available:
             self.show_message(f"{item.label} cannot be used on this cell: {item.reason}")
             return None
+        if item.kind is NodeKind.SUBTREE:  # a library subtree: an instance, its subtree embedded
+            return self.library.insert(item.op)
         node = make_node(item, manifest_or_none(self.session.registry, item.op))
         try:
             parent_id, index = self._insertion_point()

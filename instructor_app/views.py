@@ -35,6 +35,8 @@ class Views:
     log: Any
     plan_settings: Any
     waypoints: Any
+    library: Any
+    inside: Any
     teacher: Any = None  # RobotTeacher: jog, freedrive, move-here off the GUI thread
     move: Any = None
     objects: Any = None
@@ -70,6 +72,8 @@ def make_views(
     from instructor_app.panels import (
         BlackboardPanel,
         InspectorPanel,
+        InstanceInsidePanel,
+        LibraryPanel,
         LogPanel,
         PalettePanel,
         PlanSettingsPanel,
@@ -98,6 +102,8 @@ def make_views(
         LogPanel(parent=parent),
         PlanSettingsPanel(document, parent),
         WaypointsPanel(document, registry, parent, teacher=teacher),
+        LibraryPanel(parent),
+        InstanceInsidePanel(parent),
         teacher,
         MovePanel(teacher, parent),
         ObjectLibraryPanel(

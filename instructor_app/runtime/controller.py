@@ -66,6 +66,8 @@ class RunController(QObject):
         run_finished(object): a :class:`RunOutcome`.
         run_refused(list): the validation problems (or a build error) that kept it from starting.
         failure_changed(str, str): the deepest failing node and its message ("" "": none).
+        inner_statuses_changed(object): runtime id ("instance/inner") -> Status inside subtree
+            instances; None when a new run starts.
     """
 
     # object, not dict: a dict signal goes through QVariantMap and turns Status into str.
@@ -76,6 +78,8 @@ class RunController(QObject):
     running_nodes_changed = Signal(list)
     run_finished = Signal(object)
     run_refused = Signal(list)
+    # runtime id ("instance/inner") -> Status of nodes inside subtree instances; None: a new run
+    inner_statuses_changed = Signal(object)
     failure_changed = Signal(str, str)
 
     def __init__(
@@ -220,6 +224,7 @@ class RunController(QObject):
         self._stopping = False
         self._set_failure("", "")
         self._statuses.update({node_id: Status.IDLE for node_id in self._order})
+        self.inner_statuses_changed.emit(None)
 
     # ------------------------------------------------------------------ GUI thread
 
@@ -233,6 +238,9 @@ class RunController(QObject):
             if k in self._order and not (self._stopping and v is Status.IDLE)
         }
         self._statuses.update(changed)
+        inside = {k: v for k, v in batch.statuses.items() if "/" in k}  # inside instances
+        if inside:
+            self.inner_statuses_changed.emit(inside)
         self._messages.update({k: v for k, v in batch.messages.items() if k in self._order})
         if changed:
             self.statuses_changed.emit(changed)
