@@ -11,6 +11,7 @@ from engine.btcpp.errors import XmlFileError, XmlProblem
 from engine.btcpp.logic import LOGIC_BY_MODEL, LogicModel
 from engine.btcpp.names import decode_id, decode_port
 from engine.btcpp.values import param_type_of_model, parse_value
+from engine.btcpp.writer import UNUSED_OUTPUT
 from engine.btcpp.xmltree import Element, XmlSyntaxError, parse
 from engine.kinds import setting as kind_setting
 from engine.operations import OperationManifest
@@ -49,7 +50,7 @@ def _models(element: Element | None) -> dict[str, _Model]:
     for item in element.children if element is not None else []:
         model = models.setdefault(item.attrs.get("ID", ""), _Model(item.tag))
         for port in item.children:
-            doc = port.attrs.get("description", "") or ""
+            doc = port.attrs.get("description") or port.text.strip()
             ptype = param_type_of_model(port.attrs.get("type"))
             entry = (port.tag, ptype, port.attrs.get("default"), doc)
             try:
@@ -66,6 +67,7 @@ class _Reader:
         self.models: dict[str, _Model] = {}
         self.subtrees: dict[str, SubtreeSpec] = {}  # BehaviorTree ID -> definition
         self.ids: set[str] = set()
+        self.foreign = False  # True: not written by us (no CostarPlan element)
 
     def problem(self, line: int, expected: str, got: str) -> None:
         self.problems.append(XmlProblem(line, expected, got))
@@ -85,44 +87,43 @@ class _Reader:
             self.problem(extra.line, "one <TreeNodesModel>", "a second one")
         self.models = _models(next(iter(groups.get("TreeNodesModel", [])), None))
         data = next(iter(groups.get("CostarPlan", [])), None)
-        trees = {
-            t.attrs.get("ID", f"BehaviorTree_{i}"): t
-            for i, t in enumerate(groups.get("BehaviorTree", []))
-        }
+        self.foreign = data is None
+        trees: dict[str, Element] = {}
+        for index, tree in enumerate(groups.get("BehaviorTree", [])):
+            # BehaviorTree.CPP writes a loaded tree with one BehaviorTree per instance.
+            trees.setdefault(tree.attrs.get("ID", f"BehaviorTree_{index}"), tree)
         main_id = self._main_id(root, data, trees)
         plan = PlanSpec(name=main_id or "")
         for tree_id, element in trees.items():
             if tree_id != main_id:
                 self.subtrees[tree_id] = self._subtree(tree_id, element)
         for tree_id, element in trees.items():  # instances are read once all trees are known
-            if tree_id != main_id and element.children:
-                self.ids = set()
+            if tree_id != main_id:
                 sub = self.subtrees[tree_id]
-                sub.tree = self._node(element.children[0], sub.layout) or sub.tree
-        self.ids = set()
+                sub.tree = self._root_node(element, sub.layout) or sub.tree
         if main_id is not None:
-            element = trees[main_id]
-            if len(element.children) != 1:
-                self.problem(
-                    element.line, "one root node in the BehaviorTree", f"{len(element.children)}"
-                )
-            if element.children:
-                plan.tree = self._node(element.children[0], plan.layout)
+            plan.tree = self._root_node(trees[main_id], plan.layout)
         plan.subtrees = list(self.subtrees.values())
         if data is not None:
             self._plan_data(data, plan)
         return plan
 
+    def _root_node(self, tree: Element, layout: dict[str, NodeLayout]) -> NodeSpec | None:
+        """The one node under a BehaviorTree; node ids are a namespace per tree."""
+        self.ids = set()
+        if len(tree.children) != 1:
+            self.problem(tree.line, "one root node in the BehaviorTree", f"{len(tree.children)}")
+        return self._node(tree.children[0], layout) if tree.children else None
+
     def _main_id(
         self, root: Element, data: Element | None, trees: dict[str, Element]
     ) -> str | None:
-        wanted = (data.attrs.get("tree") if data is not None else None) or root.attrs.get(
-            "main_tree_to_execute"
-        )
-        if wanted is None and len(trees) == 1:
-            wanted = next(iter(trees))
+        wanted = data.attrs.get("tree") if data is not None else None
+        wanted = wanted or root.attrs.get("main_tree_to_execute")
+        if wanted is None and trees:
+            wanted = next(iter(trees))  # as BehaviorTree.CPP: the first when none is named
         if wanted is None or wanted not in trees:
-            got = f"{wanted!r}" if wanted else f"{len(trees)} trees and no main_tree_to_execute"
+            got = repr(wanted) if wanted else "no BehaviorTree"
             self.problem(root.line, "the main tree named and present", got)
             return None
         return wanted
@@ -234,6 +235,8 @@ class _Reader:
         if node is None:
             return None
         node.name = element.attrs.get("name", "")
+        if self.foreign and node.name == (element.attrs.get("ID") or element.tag):
+            node.name = ""  # BehaviorTree.CPP names an unnamed node after its type
         node.id = element.attrs.get("_uid") or new_id()
         if node.id in self.ids:
             self.problem(element.line, "a _uid no other node has", repr(node.id))
@@ -354,6 +357,8 @@ class _Reader:
         for port, text in self._ports(element).items():
             spec = sub.port(port)
             if spec is None and port in sub.shared and text == "{" + port + "}":
+                continue
+            if text == UNUSED_OUTPUT and spec in sub.outputs:
                 continue
             if spec is None:
                 names = ", ".join(p.name for p in [*sub.inputs, *sub.outputs]) or "none"

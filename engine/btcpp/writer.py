@@ -17,9 +17,12 @@ from engine.operations import Direction, OperationKind, OperationManifest
 from engine.spec import Binding, NodeKind, NodeLayout, NodeSpec, PlanSpec, SubtreeSpec
 from engine.types import ParamType, check_value, type_of_value
 
-__all__ = ["FORMAT_VERSION", "export_xml"]
+__all__ = ["FORMAT_VERSION", "UNUSED_OUTPUT", "export_xml"]
 
 FORMAT_VERSION = 1  # of the CostarPlan element: what BehaviorTree.CPP does not hold
+# An output an instance does not copy out: BehaviorTree.CPP needs every declared port of a
+# SubTree remapped, so it goes to this private (``_``) entry, which nothing reads.
+UNUSED_OUTPUT = "{_}"
 
 
 @dataclass
@@ -241,6 +244,8 @@ class _Writer:
         if tree_id not in self.models:
             self._subtree_tree(sub)  # declares its model
         self._bindings(node, self.models[tree_id], attrs, path)
+        for port in sub.outputs:  # BehaviorTree.CPP wants every port remapped: a sink
+            attrs.setdefault(encode_port(port.name), UNUSED_OUTPUT)
         for name in sub.shared:  # crosses the scope on purpose: remapped to itself
             attrs.setdefault(name, "{" + name + "}")
         return "SubTree"

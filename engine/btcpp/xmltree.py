@@ -30,6 +30,7 @@ class Element:
     attrs: dict[str, str]
     line: int
     children: list[Element] = field(default_factory=list)
+    text: str = ""  # the character data directly inside (a port's description)
 
 
 def parse(text: str) -> Element:
@@ -53,11 +54,16 @@ def parse(text: str) -> Element:
     def end(tag: str) -> None:
         stack.pop()
 
+    def data(text: str) -> None:
+        if stack:
+            stack[-1].text += text
+
     def doctype(*args: object) -> None:
         raise XmlSyntaxError(parser.CurrentLineNumber, "no document type declaration")
 
     parser.StartElementHandler = start
     parser.EndElementHandler = end
+    parser.CharacterDataHandler = data
     parser.StartDoctypeDeclHandler = doctype
     try:
         parser.Parse(text, True)
