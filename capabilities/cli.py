@@ -19,6 +19,7 @@ from typing import Any, TextIO
 from capabilities.base import CapabilityError, CapabilityRegistry
 from capabilities.cells import CELL_NAMES, CellError, open_cell
 from capabilities.collaboration.answers import CONFIRM_MODES, PromptAnswerer
+from capabilities.xml_commands import add_xml_commands
 from engine.build import BuildError, build_tree
 from engine.events import Event, LogMessage, RunFinished, StatusChanged
 from engine.executor import Executor
@@ -306,6 +307,7 @@ def _parser() -> argparse.ArgumentParser:
     show = trace_sub.add_parser("show", help="print a trace as a readable timeline")
     show.add_argument("file")
     show.set_defaults(func=_cmd_trace_show)
+    add_xml_commands(sub)
     return parser
 
 
