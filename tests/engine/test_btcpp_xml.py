@@ -54,7 +54,9 @@ def _transfer() -> SubtreeSpec:
                 op="markers.object_pose",
                 params={"object": Binding.reference("OBJECT"), "pose": Binding.reference("PLACED")},
             ),
-            NodeSpec(NodeKind.OPERATION, op="debug.log", params={"text": Binding.reference("BIN")}),
+            NodeSpec(
+                NodeKind.OPERATION, op="debug.log", params={"message": Binding.reference("BIN")}
+            ),
         ],
     )
     return SubtreeSpec(
