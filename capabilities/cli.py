@@ -307,7 +307,7 @@ def _parser() -> argparse.ArgumentParser:
     show = trace_sub.add_parser("show", help="print a trace as a readable timeline")
     show.add_argument("file")
     show.set_defaults(func=_cmd_trace_show)
-    add_xml_commands(sub)
+    add_xml_commands(sub, (EXIT_SUCCESS, EXIT_INVALID))
     return parser
 
 

@@ -25,14 +25,8 @@ def operation_manifests(registry: CapabilityRegistry | None = None) -> dict[str,
     return {manifest.id: manifest for manifest in registry.manifests()}
 
 
-def _exit_codes() -> tuple[int, int]:
-    from capabilities.cli import EXIT_INVALID, EXIT_SUCCESS  # cli imports this module
-
-    return EXIT_SUCCESS, EXIT_INVALID
-
-
 def _cmd_export(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
-    ok, invalid = _exit_codes()
+    ok, invalid = args.exit_codes
     registry = CapabilityRegistry()
     try:
         plan = load_plan(args.plan, aliases=registry.aliases())
@@ -47,7 +41,7 @@ def _cmd_export(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
 
 def _cmd_import(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
-    ok, invalid = _exit_codes()
+    ok, invalid = args.exit_codes
     try:
         plan = load_xml(args.xml, operation_manifests())
         save_plan(plan, args.out)
@@ -62,17 +56,22 @@ def _cmd_import(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     return ok
 
 
-def add_xml_commands(sub: Any) -> None:
-    """Add ``export-xml`` and ``import-xml`` to the ``costar`` subcommands."""
+def add_xml_commands(sub: Any, exit_codes: tuple[int, int]) -> None:
+    """Add ``export-xml`` and ``import-xml`` to the ``costar`` subcommands.
+
+    Args:
+        sub: the subparsers of ``costar``.
+        exit_codes: ``costar``'s codes for success and for invalid input.
+    """
     export = sub.add_parser(
         "export-xml", help="write a plan as BehaviorTree.CPP v4 XML (opens in Groot2)"
     )
     export.add_argument("plan", help="the plan (*.costar.json)")
     export.add_argument("out", help="the XML file to write")
-    export.set_defaults(func=_cmd_export)
+    export.set_defaults(func=_cmd_export, exit_codes=exit_codes)
     imported = sub.add_parser(
         "import-xml", help="read BehaviorTree.CPP v4 XML into a plan; lists every problem"
     )
     imported.add_argument("xml", help="the XML file")
     imported.add_argument("out", help="the plan to write (*.costar.json)")
-    imported.set_defaults(func=_cmd_import)
+    imported.set_defaults(func=_cmd_import, exit_codes=exit_codes)
