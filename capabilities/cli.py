@@ -24,6 +24,7 @@ from engine.build import BuildError, build_tree
 from engine.events import Event, LogMessage, RunFinished, StatusChanged
 from engine.executor import Executor
 from engine.files import PlanFileError, load_plan
+from engine.library import Library, library_folder
 from engine.operations import OperationManifest
 from engine.spec import PlanSpec
 from engine.status import Status
@@ -59,6 +60,14 @@ def _open(args: argparse.Namespace, err: TextIO, start: bool) -> Any:
         return None
 
 
+def _library(args: argparse.Namespace, err: TextIO) -> Library:
+    """The subtree library (to tell of newer versions); its broken files are named, skipped."""
+    library = Library(library_folder(args.library)).scan()
+    for problem in library.problems:
+        print(f"warning: library file skipped: {problem}", file=err)
+    return library
+
+
 def _cmd_validate(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     cell = _open(args, err, start=False)
     if cell is None:
@@ -68,7 +77,7 @@ def _cmd_validate(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         plan = _load(args.plan, registry, err)
         if plan is None:
             return EXIT_INVALID
-        problems = validate_plan(plan, registry)
+        problems = validate_plan(plan, registry, _library(args, err))
     _print_problems(args.plan, problems, out)
     if has_errors(problems):
         count = sum(p.severity == "error" for p in problems)
@@ -127,7 +136,7 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         plan = _load(args.plan, registry, err)
         if plan is None:
             return EXIT_INVALID
-        problems = validate_plan(plan, registry)
+        problems = validate_plan(plan, registry, _library(args, err))
         if has_errors(problems):
             _print_problems(args.plan, problems, err)
             print(f"{args.plan}: invalid, not started", file=err)
@@ -274,6 +283,10 @@ def _parser() -> argparse.ArgumentParser:
         p.add_argument("--seed", type=int, default=0, help="scene seed of the simulated cell")
         p.add_argument(
             "--scene", help="scene of the simulated cell (name or path; default cup_to_bin)"
+        )
+        p.add_argument(
+            "--library",
+            help="the subtree library folder (default: $COSTAR_LIBRARY, else the user's)",
         )
 
     validate = sub.add_parser("validate", help="check a plan; exit 0 valid, 2 invalid")
