@@ -2,15 +2,13 @@
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Mapping
-from dataclasses import dataclass, field
 
 from engine.btcpp.errors import XmlFileError, XmlProblem
 from engine.btcpp.logic import LOGIC_BY_MODEL, LogicModel
 from engine.btcpp.names import decode_id, decode_port
-from engine.btcpp.values import param_type_of_model, parse_value
+from engine.btcpp.read_parts import Model, ReaderBase, read_models
 from engine.btcpp.writer import UNUSED_OUTPUT
 from engine.btcpp.xmltree import Element, XmlSyntaxError, parse
 from engine.kinds import setting as kind_setting
@@ -22,14 +20,11 @@ from engine.spec import (
     NodeKind,
     NodeLayout,
     NodeSpec,
-    ParameterDecl,
     PlanSpec,
-    RunPolicy,
-    SubtreePort,
     SubtreeSpec,
     new_id,
 )
-from engine.types import ParamType, Waypoint
+from engine.types import ParamType
 
 __all__ = ["import_xml", "load_xml"]
 
@@ -39,40 +34,13 @@ _SCRIPTS: tuple[str, ...] = ("_skipIf", "_successIf", "_failureIf", "_while", "_
 _SCRIPTS += ("_onFailure", "_onHalted", "_post")
 
 
-@dataclass
-class _Model:
-    element: str
-    ports: dict[str, tuple[str, ParamType, str | None, str]] = field(default_factory=dict)
-
-
-def _models(element: Element | None) -> dict[str, _Model]:
-    models: dict[str, _Model] = {}
-    for item in element.children if element is not None else []:
-        model = models.setdefault(item.attrs.get("ID", ""), _Model(item.tag))
-        for port in item.children:
-            doc = port.attrs.get("description") or port.text.strip()
-            ptype = param_type_of_model(port.attrs.get("type"))
-            entry = (port.tag, ptype, port.attrs.get("default"), doc)
-            try:
-                model.ports[decode_port(port.attrs.get("name", ""))] = entry
-            except ValueError:
-                continue  # not one of ours: its nodes are reported where they are used
-    return models
-
-
-class _Reader:
+class _Reader(ReaderBase):
     def __init__(self, manifests: Mapping[str, OperationManifest] | None) -> None:
+        super().__init__()
         self.manifests = manifests
-        self.problems: list[XmlProblem] = []
-        self.models: dict[str, _Model] = {}
         self.subtrees: dict[str, SubtreeSpec] = {}  # BehaviorTree ID -> definition
         self.ids: set[str] = set()
         self.foreign = False  # True: not written by us (no CostarPlan element)
-
-    def problem(self, line: int, expected: str, got: str) -> None:
-        self.problems.append(XmlProblem(line, expected, got))
-
-    # ---- the document
 
     def plan(self, root: Element) -> PlanSpec:
         if root.tag != "root":
@@ -85,7 +53,7 @@ class _Reader:
             groups.setdefault(child.tag, []).append(child)
         for extra in groups.get("TreeNodesModel", [])[1:]:
             self.problem(extra.line, "one <TreeNodesModel>", "a second one")
-        self.models = _models(next(iter(groups.get("TreeNodesModel", [])), None))
+        self.models = read_models(next(iter(groups.get("TreeNodesModel", [])), None))
         data = next(iter(groups.get("CostarPlan", [])), None)
         self.foreign = data is None
         trees: dict[str, Element] = {}
@@ -127,102 +95,6 @@ class _Reader:
             self.problem(root.line, "the main tree named and present", got)
             return None
         return wanted
-
-    def _plan_data(self, data: Element, plan: PlanSpec) -> None:
-        attrs = data.attrs
-        plan.id = attrs.get("id") or plan.id
-        plan.name = attrs.get("name", plan.name)
-        plan.description = attrs.get("description", "")
-        policies = [p.value for p in RunPolicy]
-        if attrs.get("run_policy", "once") in policies:
-            plan.run_policy = RunPolicy(attrs.get("run_policy", "once"))
-        else:
-            self.problem(
-                data.line, f"run_policy one of {', '.join(policies)}", repr(attrs["run_policy"])
-            )
-        plan.reset_cell = attrs.get("reset_cell") == "true"
-        for item in data.children:
-            if item.tag == "Parameter":
-                ptype = self._ptype(item, item.attrs.get("type", ""))
-                raw = item.attrs.get("value")
-                value = None if raw is None else self._value(item, ptype, raw, "value")
-                plan.parameters.append(
-                    ParameterDecl(
-                        item.attrs.get("name", ""), ptype, value, item.attrs.get("doc", "")
-                    )
-                )
-            elif item.tag == "Waypoint":
-                waypoint = self._value(
-                    item, ParamType.WAYPOINT, item.attrs.get("value", ""), "value"
-                )
-                if isinstance(waypoint, Waypoint):
-                    plan.waypoints.append(waypoint)
-            elif item.tag == "Object":
-                plan.objects.append(item.attrs.get("name", ""))
-            elif item.tag == "Layout":
-                plan.layout[item.attrs.get("_uid", "")] = self._layout(item) or NodeLayout()
-
-    def _ptype(self, element: Element, name: str) -> ParamType:
-        try:
-            return ParamType(name)
-        except ValueError:
-            self.problem(
-                element.line, f"a type ({', '.join(t.value for t in ParamType)})", repr(name)
-            )
-            return ParamType.ANY
-
-    def _value(self, element: Element, ptype: ParamType, text: str, what: str) -> object:
-        try:
-            return parse_value(ptype, text)
-        except ValueError as exc:
-            self.problem(element.line, f"{what}: {exc}", f"<{element.tag}>")
-            return None
-
-    def _subtree(self, tree_id: str, element: Element) -> SubtreeSpec:
-        attrs = element.attrs
-        sub = SubtreeSpec(
-            id=attrs.get("_uid", tree_id),
-            name=attrs.get("_name", tree_id),
-            tree=NodeSpec(NodeKind.SEQUENCE),
-            date=attrs.get("_date", ""),
-            description=attrs.get("_description", ""),
-        )
-        try:
-            sub.version = int(attrs.get("_version", "1"))
-            shared = json.loads(attrs.get("_shared", "[]"))
-            if not isinstance(shared, list) or not all(isinstance(s, str) for s in shared):
-                raise ValueError
-            sub.shared = shared
-        except ValueError:
-            self.problem(
-                element.line, "_version a whole number, _shared a JSON list of names", "other"
-            )
-        model = self.models.get(tree_id)
-        for name, (direction, ptype, default, doc) in (model.ports if model else {}).items():
-            value = (
-                None
-                if default is None
-                else self._value(element, ptype, default, f"default of {name}")
-            )
-            port = SubtreePort(name, ptype, doc, value if direction != "output_port" else None)
-            (sub.outputs if direction == "output_port" else sub.inputs).append(port)
-        return sub
-
-    # ---- nodes
-
-    def _layout(self, element: Element) -> NodeLayout | None:
-        if "_x" not in element.attrs and "_y" not in element.attrs:
-            return None
-        try:
-            x, y = float(element.attrs.get("_x", "0")), float(element.attrs.get("_y", "0"))
-        except ValueError:
-            self.problem(
-                element.line,
-                "_x and _y numbers",
-                f"{element.attrs.get('_x')!r}, {element.attrs.get('_y')!r}",
-            )
-            return None
-        return NodeLayout(x, y, element.attrs.get("_collapsed") == "true")
 
     def _node(self, element: Element, layout: dict[str, NodeLayout]) -> NodeSpec | None:
         node = self._kind_of(element)
@@ -310,7 +182,7 @@ class _Reader:
         return node
 
     def _port_type(
-        self, manifest: OperationManifest | None, declared: _Model | None, port: str
+        self, manifest: OperationManifest | None, declared: Model | None, port: str
     ) -> ParamType | None:
         if manifest is not None:
             spec = manifest.port(port)
