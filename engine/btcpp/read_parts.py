@@ -4,6 +4,7 @@ own data (``<CostarPlan>``) and subtree definitions; and the problem list every 
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import dataclass, field
 
 from engine.btcpp.errors import XmlProblem
@@ -149,6 +150,8 @@ class ReaderBase:
             return None
         try:
             x, y = float(element.attrs.get("_x", "0")), float(element.attrs.get("_y", "0"))
+            if not (math.isfinite(x) and math.isfinite(y)):
+                raise ValueError
         except ValueError:
             self.problem(
                 element.line,

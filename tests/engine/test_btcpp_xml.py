@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import random
+import re
 from pathlib import Path
 
 import pytest
@@ -296,3 +297,22 @@ def test_a_bad_value_text_says_what_was_expected(
 ) -> None:
     with pytest.raises(ValueError, match=expected):
         parse_value(ptype, text)
+
+
+def test_damaged_files_give_problems_never_other_exceptions() -> None:
+    """Every attribute value of an exported plan replaced in turn with junk: the import
+    succeeds or raises XmlFileError (a broken file never crashes the app)."""
+    text = export_xml(_kitting(), {})
+    junk = ["", "{", "nan", "-1", "json:{", "1;2", "{=}", "x" * 3, "_5g_", "inf", "true"]
+    rng = random.Random(3)
+    values = list(dict.fromkeys(re.findall(r'="([^"]*)"', text)))
+    outcomes = set()
+    for value in values:
+        damaged = text.replace(f'="{value}"', f'="{rng.choice(junk)}"')
+        try:
+            import_xml(damaged, "damaged.xml")
+            outcomes.add("read")
+        except XmlFileError as exc:
+            assert exc.problems and all(p.line >= 1 for p in exc.problems)
+            outcomes.add("problems")
+    assert outcomes == {"read", "problems"}
