@@ -6,13 +6,14 @@ import os
 from collections.abc import Mapping
 
 from engine.btcpp.errors import XmlFileError, XmlProblem
+from engine.btcpp.infer import infer_subtree_ports, instances_of
 from engine.btcpp.logic import LOGIC_BY_MODEL, LogicModel
 from engine.btcpp.names import decode_id, decode_port
 from engine.btcpp.read_parts import Model, ReaderBase, read_models
 from engine.btcpp.writer import UNUSED_OUTPUT
 from engine.btcpp.xmltree import Element, XmlSyntaxError, parse
 from engine.kinds import setting as kind_setting
-from engine.operations import OperationManifest
+from engine.operations import Direction, OperationManifest
 from engine.spec import (
     KIND_CATEGORY,
     Binding,
@@ -64,7 +65,12 @@ class _Reader(ReaderBase):
         plan = PlanSpec(name=main_id or "")
         for tree_id, element in trees.items():
             if tree_id != main_id:
-                self.subtrees[tree_id] = self._subtree(tree_id, element)
+                self.subtrees[tree_id] = sub = self._subtree(tree_id, element)
+                if tree_id not in self.models:  # written by BehaviorTree.CPP or Groot2
+                    instances = instances_of(tree_id, list(trees.values()))
+                    sub.inputs, sub.outputs = infer_subtree_ports(
+                        element, instances, self._port_info
+                    )
         for tree_id, element in trees.items():  # instances are read once all trees are known
             if tree_id != main_id:
                 sub = self.subtrees[tree_id]
@@ -75,6 +81,23 @@ class _Reader(ReaderBase):
         if data is not None:
             self._plan_data(data, plan)
         return plan
+
+    def _port_info(self, element: Element, attr: str) -> tuple[Direction, ParamType] | None:
+        """The direction and type of a port of an operation node, if it is known."""
+        model_id = element.attrs.get("ID", "") if element.tag in _EXPLICIT else element.tag
+        try:
+            op, port = decode_id(model_id), decode_port(attr)
+        except ValueError:
+            return None
+        manifest = self.manifests.get(op) if self.manifests is not None else None
+        spec = manifest.port(port) if manifest is not None else None
+        if spec is not None:
+            return spec.direction, spec.type
+        declared = self.models.get(model_id)
+        if declared is None or port not in declared.ports:
+            return None
+        tag, ptype = declared.ports[port][:2]
+        return (Direction.OUT if tag == "output_port" else Direction.IN), ptype
 
     def _root_node(self, tree: Element, layout: dict[str, NodeLayout]) -> NodeSpec | None:
         """The one node under a BehaviorTree; node ids are a namespace per tree."""

@@ -16,7 +16,7 @@ from engine.btcpp.names import decode_id, decode_port
 from engine.btcpp.xmltree import parse
 from engine.files import load_plan
 from engine.operations import Direction, OperationKind
-from engine.spec import Binding, NodeKind, NodeSpec
+from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
 from engine.types import ParamType
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -113,15 +113,21 @@ def test_a_tree_over_btcpp_written_models_imports_with_their_types() -> None:
     assert enforce.children[0].op == "markers.object_found"
 
 
-def _shape(node: NodeSpec, defaults_of: dict[str, Any] | None = None) -> Any:
-    """Kind, operation, bindings and children; with ``defaults_of`` (manifests), a fixed
-    binding equal to its port's default counts as unbound (BehaviorTree.CPP writes them)."""
+def _shape(
+    node: NodeSpec, defaults_of: dict[str, Any] | None = None, plan: PlanSpec | None = None
+) -> Any:
+    """Kind, operation (or subtree name), bindings and children; with ``defaults_of``
+    (manifests), a fixed binding equal to its port's default counts as unbound
+    (BehaviorTree.CPP writes them)."""
     params = dict(node.params)
+    if plan is not None and node.subtree is not None:
+        sub = plan.subtree(node.subtree)
+        return (node.kind, sub.name if sub is not None else None, params)
     manifest = (defaults_of or {}).get(node.op or "")
     for port in manifest.ports if manifest is not None else ():
         if params.get(port.name) == Binding.fixed(port.default, port.type):
             del params[port.name]
-    children = [_shape(child, defaults_of) for child in node.children]
+    children = [_shape(child, defaults_of, plan) for child in node.children]
     return (node.kind, node.op, params, children)
 
 
@@ -136,3 +142,26 @@ def test_a_tree_btcpp_wrote_after_loading_our_export_imports_as_the_plan() -> No
     assert plan.tree is not None and original.tree is not None
     assert _shape(plan.tree, manifests) == _shape(original.tree, manifests)
     assert [n.name for _, n in plan.walk()] == [n.name for _, n in original.walk()]
+
+
+def test_a_plan_with_subtrees_btcpp_wrote_imports_with_the_remapping() -> None:
+    """kitting_written_by_btcpp.xml: our export of the kitting plan loaded and written back by
+    BehaviorTree.CPP 4.10, which keeps one BehaviorTree per instance and no SubTree models:
+    the subtrees' ports come from the remapping and the operations inside."""
+    written = (BTCPP_DATA / "kitting_written_by_btcpp.xml").read_text(encoding="utf-8")
+    manifests = operation_manifests()
+    plan = import_xml(written, "kitting.xml", manifests)
+    original = load_plan(EXAMPLES / "kitting.costar.json")
+    assert plan.tree is not None and original.tree is not None
+    assert _shape(plan.tree, manifests, plan) == _shape(original.tree, manifests, original)
+    assert sorted(s.name for s in plan.subtrees) == sorted(s.name for s in original.subtrees)
+    for sub in plan.subtrees:
+        mine = next(s for s in original.subtrees if s.name == sub.name)
+        assert _shape(sub.tree, manifests, plan) == _shape(mine.tree, manifests, original)
+        # a port every instance leaves to its default is not in BehaviorTree.CPP's output
+        used = {p for _, n in original.walk() if n.subtree == mine.ref for p in n.params}
+        expected_in = {(p.name, p.type) for p in mine.inputs if p.name in used}
+        assert {(p.name, p.type) for p in sub.inputs} == expected_in
+        assert {(p.name, p.type) for p in sub.outputs} == {
+            (p.name, p.type) for p in mine.outputs if p.name in used
+        }
