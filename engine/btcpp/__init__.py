@@ -23,12 +23,22 @@ A plan is written as::
 
 - One ``<BehaviorTree>`` for the plan (named in ``main_tree_to_execute``) and one per
   subtree its instances run; an instance is a ``<SubTree>`` whose attributes remap the
-  subtree's declared inputs and outputs (BehaviorTree.CPP's port remapping); a name the
-  subtree shares on purpose is remapped to itself (``BIN_POSE="{BIN_POSE}"``).
+  subtree's declared inputs and outputs (BehaviorTree.CPP's port remapping, the ports
+  declared in the TreeNodesModel's ``<SubTree>`` with types, defaults and descriptions); a
+  name the subtree shares on purpose is remapped to itself (``BIN_POSE="{BIN_POSE}"``); an
+  output the instance does not copy out goes to the private sink ``{_}``, since
+  BehaviorTree.CPP wants every declared port remapped. Reading XML without SubTree models
+  (BehaviorTree.CPP's ``WriteTreeToXML`` keeps none), a subtree's ports are the names its
+  instances remap: outputs where an operation inside writes them, inputs else.
 - Operations in the compact syntax, their ids mapped reversibly to the characters
   BehaviorTree.CPP 4.8.4+ accepts (:mod:`engine.btcpp.names`); every operation used is
   declared in the TreeNodesModel with its typed ports, conditions as ``<Condition>``,
   queries as ``<Action>`` with output ports.
+- Import knows: the mapped built-ins, Iterator and Enforce, ``<SubTree>`` of a tree in the
+  file, and operations (those of the given manifests; without manifests, the Actions and
+  Conditions the file's TreeNodesModel declares). Any other node type, BehaviorTree.CPP
+  scripts (``_skipIf``...), ``_autoremap="true"``, unknown ports and values not in their
+  port's form are problems, all of them reported with their lines (:class:`XmlFileError`).
 - Logic nodes as BehaviorTree.CPP's built-ins, Iterator and Enforce as declared
   decorators (:mod:`engine.btcpp.logic`).
 - A reference is ``{NAME}``; a fixed value is text in one exact form per type
