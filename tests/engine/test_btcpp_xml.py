@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import random
 import re
@@ -316,3 +317,20 @@ def test_damaged_files_give_problems_never_other_exceptions() -> None:
             assert exc.problems and all(p.line >= 1 for p in exc.problems)
             outcomes.add("problems")
     assert outcomes == {"read", "problems"}
+
+
+def test_every_field_of_the_spec_is_carried() -> None:
+    """A new field of the plan spec must be taught to engine.btcpp (writer and read_parts),
+    or the XML round trip silently drops it: this test names the fields it knows."""
+    carried = {
+        PlanSpec: {"tree", "name", "description", "run_policy", "reset_cell", "parameters"}
+        | {"waypoints", "objects", "layout", "id", "subtrees"},
+        NodeSpec: {"kind", "name", "id", "op", "params", "children", "subtree"},
+        SubtreeSpec: {"id", "name", "tree", "version", "date", "description", "inputs"}
+        | {"outputs", "shared", "layout"},
+        SubtreePort: {"name", "type", "doc", "default"},
+        NodeLayout: {"x", "y", "collapsed"},
+        ParameterDecl: {"name", "type", "value", "doc"},
+    }
+    for spec, known in carried.items():
+        assert {f.name for f in dataclasses.fields(spec)} == known, spec.__name__
