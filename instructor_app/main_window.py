@@ -23,11 +23,14 @@ from PySide6.QtWidgets import (
 )
 
 from engine.executor import ExecutorState
+from engine.library import library_folder
+from engine.spec import NodeKind
 from instructor_app.dialogs import APP_TITLE, DISCARD, SAVE, Dialogs
 from instructor_app.document.autosave import DEFAULT_INTERVAL_MS, Autosaver, offer_recoveries
 from instructor_app.document.editing import PlanDocument
 from instructor_app.document.model import DocumentError
 from instructor_app.document.tree_ops import can_have_child
+from instructor_app.library_wiring import LibraryController
 from instructor_app.node_factory import make_node, manifest_or_none
 from instructor_app.panels.operator import OperatorPanel
 from instructor_app.panels.start_page import StartPage, find_examples
@@ -88,6 +91,11 @@ class MainWindow(QMainWindow):
         self.operator_panel = OperatorPanel(self)
         self.failure_button = FailureButton(self._node_label, self)
         self.selection: list[str] = []
+        self.library = LibraryController(
+            self.document, self.views, lambda: self.session.registry, self._insertion_point,
+            library_folder(setting=self.settings.library_folder()), self,
+        )  # fmt: skip
+        self.library.message.connect(self.show_message)
         self._build_layout()
         self.actions_by_name: dict[str, QAction] = {}
         self._build_menus()
@@ -114,6 +122,9 @@ class MainWindow(QMainWindow):
         self._dock("plan", "Plan", self.views.plan_settings, area.RightDockWidgetArea)
         self._dock("waypoints", "Waypoints", self.views.waypoints, area.RightDockWidgetArea)
         self._dock("operator", "Operator", self.operator_panel, area.RightDockWidgetArea)
+        self._dock("library", "Library", self.views.library, area.LeftDockWidgetArea)
+        self.tabifyDockWidget(self.docks["palette"], self.docks["library"])
+        self.docks["palette"].raise_()
         self.splitDockWidget(self.docks["inspector"], self.docks["plan"], Qt.Orientation.Vertical)
         self.tabifyDockWidget(self.docks["plan"], self.docks["waypoints"])
         self.tabifyDockWidget(self.docks["waypoints"], self.docks["operator"])
@@ -196,6 +207,7 @@ class MainWindow(QMainWindow):
         run_menu.addActions(self.run_actions.all())
         run_menu.addSeparator()
         run_menu.addAction(reset)
+        self.library.fill_menu(bar.addMenu("&Library"))
         help_menu = bar.addMenu("&Help")
         help_menu.addAction(self._action("about", f"&About {APP_TITLE}", self._about))
         toolbar = self.addToolBar("Run")
@@ -306,6 +318,8 @@ class MainWindow(QMainWindow):
         if not item.available:
             self.show_message(f"{item.label} cannot be used on this cell: {item.reason}")
             return None
+        if item.kind is NodeKind.SUBTREE:  # a library subtree: an instance, its subtree embedded
+            return self.library.insert(item.op)
         node = make_node(item, manifest_or_none(self.session.registry, item.op))
         try:
             parent_id, index = self._insertion_point()

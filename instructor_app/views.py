@@ -34,6 +34,7 @@ class Views:
     log: Any
     plan_settings: Any
     waypoints: Any
+    library: Any
 
     def set_registry(self, registry: Any) -> None:
         """Another cell: every view that shows operations rebuilds from its registry."""
@@ -62,6 +63,7 @@ def make_views(document: PlanDocument, session: CellSession, parent: QWidget) ->
     from instructor_app.panels import (
         BlackboardPanel,
         InspectorPanel,
+        LibraryPanel,
         LogPanel,
         PalettePanel,
         PlanSettingsPanel,
@@ -85,6 +87,7 @@ def make_views(document: PlanDocument, session: CellSession, parent: QWidget) ->
         LogPanel(parent=parent),
         PlanSettingsPanel(document, parent),
         WaypointsPanel(document, registry, parent),
+        LibraryPanel(parent),
     )
     views.set_registry(registry)
     return views

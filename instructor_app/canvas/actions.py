@@ -26,9 +26,7 @@ NodeFactory = Callable[[NodeKind, "str | None"], NodeSpec]
 
 # What "Add child" offers first: every kind but operations (those follow, by capability) and
 # subtree instances (those come from the library).
-LOGIC_KINDS = tuple(
-    kind for kind in NodeKind if kind not in (NodeKind.OPERATION, NodeKind.SUBTREE)
-)
+LOGIC_KINDS = tuple(kind for kind in NodeKind if kind not in (NodeKind.OPERATION, NodeKind.SUBTREE))
 
 _SHORTCUTS: dict[str, tuple[str, QKeySequence | QKeySequence.StandardKey | str]] = {
     "delete": ("Delete", QKeySequence.StandardKey.Delete),

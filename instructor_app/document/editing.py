@@ -122,7 +122,15 @@ class PlanDocument(PlanModel):
         if fragment.tree is None:
             raise DocumentError("the clipboard holds no plan nodes")
         clone, layout = tree_ops.fresh_copy(fragment.tree, fragment.layout)
-        return self.add_node(clone, parent_id, index, layout)
+        missing = [s for s in fragment.subtrees if self.plan.subtree(s.ref) is None]
+        if not missing:
+            return self.add_node(clone, parent_id, index, layout)
+        self.undo_stack.beginMacro(f"Paste {clone.label}")  # its instances' subtrees come too
+        try:
+            self._push(SetPlanFieldCommand(self, "subtrees", [*self.plan.subtrees, *missing]))
+            return self.add_node(clone, parent_id, index, layout)
+        finally:
+            self.undo_stack.endMacro()
 
     def duplicate(self, node_id: str) -> str:
         """A copy of the node placed right after it."""

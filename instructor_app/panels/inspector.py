@@ -21,6 +21,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from engine.instances import instance_manifest
 from engine.kinds import KIND_DOC, KIND_PORTS
 from engine.operations import Direction, OperationSource, PortSpec
 from engine.spec import Binding, NodeKind, NodeSpec
@@ -201,6 +202,8 @@ class InspectorPanel(QWidget):
         self._names.setStringList(self.parameter_names())
         if node.kind is NodeKind.OPERATION:
             self._layout_operation(node)
+        elif node.kind is NodeKind.SUBTREE:
+            self._layout_instance(node)
         else:
             self.kind_label.setText(f"<b>{readable(node.kind.value)}</b>")
             self.doc_label.setText(KIND_DOC.get(node.kind, ""))
@@ -221,6 +224,17 @@ class InspectorPanel(QWidget):
         self.kind_label.setText(f"<b>{manifest.id}</b> ({manifest.kind.value})")
         self.doc_label.setText(manifest.doc)
         self._add_port_rows(manifest.ports)
+
+    def _layout_instance(self, node: NodeSpec) -> None:
+        """An instance's binding form: its subtree's inputs and outputs are its ports."""
+        subtree = self.document.plan.subtree(node.subtree) if node.subtree else None
+        if subtree is None:
+            self.kind_label.setText("<b>Subtree missing</b>")
+            self.doc_label.setText("This plan does not hold the subtree this instance runs.")
+            return
+        self.kind_label.setText(f"<b>Subtree {subtree.name}</b> (version {subtree.version})")
+        self.doc_label.setText(subtree.description)
+        self._add_port_rows(instance_manifest(subtree).ports)
 
     def _add_port_rows(self, ports: tuple[PortSpec, ...]) -> None:
         """One row per port, of an operation or of a logic node kind: one row type for both."""
