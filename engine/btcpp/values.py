@@ -80,15 +80,21 @@ def param_type_of_model(type_name: str | None) -> ParamType:
 
 
 def _numbers(values: tuple[float, ...]) -> str:
+    if not all(math.isfinite(v) for v in values):
+        raise ValueError(f"finite numbers, not {values}")
     return ";".join(repr(float(v)) for v in values)
 
 
 def value_text(ptype: ParamType, value: Any) -> str:
-    """The text form of a fixed value of type ``ptype`` (see the module doc)."""
+    """The text form of a fixed value of type ``ptype`` (see the module doc).
+
+    Raises:
+        ValueError: the value holds a number that is not finite.
+    """
     ptype = ParamType(ptype)
     numeric = isinstance(value, (int, float)) and not isinstance(value, bool)
     if ptype in (ParamType.NUMBER, ParamType.DURATION) and numeric:
-        return repr(float(value))
+        return _numbers((float(value),))
     if ptype is ParamType.BOOL and isinstance(value, bool):
         return "true" if value else "false"
     if ptype is ParamType.TEXT and isinstance(value, str):

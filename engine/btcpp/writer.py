@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -19,6 +20,7 @@ from engine.types import ParamType, check_value, type_of_value
 
 __all__ = ["FORMAT_VERSION", "UNUSED_OUTPUT", "export_xml"]
 
+_ILLEGAL = re.compile(r"[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
 FORMAT_VERSION = 1  # of the CostarPlan element: what BehaviorTree.CPP does not hold
 # An output an instance does not copy out: BehaviorTree.CPP needs every declared port of a
 # SubTree remapped, so it goes to this private (``_``) entry, which nothing reads.
@@ -219,8 +221,6 @@ class _Writer:
             text = value_text(ptype, binding.value)
         except ValueError as exc:
             raise self.fail(f"{path} [{port}]", "finite numbers", str(exc)) from exc
-        if any(ord(c) < 32 and c not in "\t\n\r" for c in text):
-            raise self.fail(f"{path} [{port}]", "text without control characters", repr(text))
         return text
 
     def _operation(self, node: NodeSpec, attrs: dict[str, str], path: str) -> str:
@@ -301,6 +301,18 @@ class _Writer:
         return models
 
 
+def _check_characters(root: ET.Element, plan: str) -> None:
+    """XML 1.0 cannot hold most control characters, not even escaped: refuse them by name."""
+    for element in root.iter():
+        for key, value in element.attrib.items():
+            bad = next((c for c in value if _ILLEGAL.match(c)), None)
+            if bad is not None:
+                where = element.get("name") or element.get("_uid") or element.tag
+                raise XmlExportError(
+                    plan, f"{where} [{key}]", "text without control characters", repr(bad)
+                )
+
+
 def export_xml(plan: PlanSpec, manifests: Mapping[str, OperationManifest]) -> str:
     """The BehaviorTree.CPP v4 XML of a plan (see :mod:`engine.btcpp`).
 
@@ -314,6 +326,7 @@ def export_xml(plan: PlanSpec, manifests: Mapping[str, OperationManifest]) -> st
             value that is not finite, or an instance without its subtree's definition.
     """
     root = _Writer(plan, manifests).document()
+    _check_characters(root, plan.name or "<plan>")
     ET.indent(root, space="  ")
     body = ET.tostring(root, encoding="unicode", short_empty_elements=True)
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + body + "\n"

@@ -334,3 +334,15 @@ def test_every_field_of_the_spec_is_carried() -> None:
     }
     for spec, known in carried.items():
         assert {f.name for f in dataclasses.fields(spec)} == known, spec.__name__
+
+
+@pytest.mark.parametrize("text", ["bell\x07", "lone \ud800"])
+def test_text_xml_cannot_hold_is_refused_by_node(text: str) -> None:
+    leaf = NodeSpec(NodeKind.OPERATION, op="debug.log", name="say it")
+    leaf.params["message"] = Binding.fixed(text, ParamType.TEXT)
+    with pytest.raises(XmlExportError, match=r"say it \[message\]: expected text without"):
+        export_xml(PlanSpec(tree=leaf, name="p"), {})
+    leaf.params.clear()
+    leaf.name = text
+    with pytest.raises(XmlExportError, match="control characters"):
+        export_xml(PlanSpec(tree=leaf, name="p"), {})
