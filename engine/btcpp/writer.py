@@ -128,12 +128,16 @@ class _Writer:
         for decl in plan.parameters:
             attrs = {"name": decl.name, "type": ParamType(decl.type).value}
             if decl.value is not None:
-                attrs["value"] = value_text(decl.type, decl.value)
+                attrs["value"] = self._text(decl.type, decl.value, f"parameter {decl.name}")
             if decl.doc:
                 attrs["doc"] = decl.doc
             ET.SubElement(data, "Parameter", attrs)
         for waypoint in plan.waypoints:
-            ET.SubElement(data, "Waypoint", {"value": value_text(ParamType.WAYPOINT, waypoint)})
+            ET.SubElement(
+                data,
+                "Waypoint",
+                {"value": self._text(ParamType.WAYPOINT, waypoint, f"waypoint {waypoint.name}")},
+            )
         for name in plan.objects:
             ET.SubElement(data, "Object", {"name": name})
         in_tree = {node.id for _, node in plan.walk()}
@@ -217,11 +221,13 @@ class _Writer:
             attrs["_types"] = ";".join(other_types)
 
     def _value(self, binding: Binding, ptype: ParamType, path: str, port: str) -> str:
+        return self._text(ptype, binding.value, f"{path} [{port}]")
+
+    def _text(self, ptype: ParamType, value: Any, where: str) -> str:
         try:
-            text = value_text(ptype, binding.value)
+            return value_text(ptype, value)
         except ValueError as exc:
-            raise self.fail(f"{path} [{port}]", "finite numbers", str(exc)) from exc
-        return text
+            raise self.fail(where, "finite numbers", str(exc)) from exc
 
     def _operation(self, node: NodeSpec, attrs: dict[str, str], path: str) -> str:
         if node.op is None:
