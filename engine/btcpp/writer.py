@@ -227,7 +227,7 @@ class _Writer:
         try:
             return value_text(ptype, value)
         except ValueError as exc:
-            raise self.fail(where, "finite numbers", str(exc)) from exc
+            raise self.fail(where, "finite numbers", repr(value)[:80]) from exc
 
     def _operation(self, node: NodeSpec, attrs: dict[str, str], path: str) -> str:
         if node.op is None:
