@@ -21,7 +21,7 @@ from pathlib import Path
 
 import pytest
 from btcpp_models import models_text
-from test_btcpp_xml import EXAMPLES, _kitting
+from test_btcpp_xml import EXAMPLES, _kitting, _nested
 
 from capabilities.xml_commands import operation_manifests
 from engine.btcpp import export_xml
@@ -48,7 +48,10 @@ def _load_in_btcpp(tmp_path: Path, xml: str) -> subprocess.CompletedProcess[str]
 
 
 def _plans() -> list[tuple[str, PlanSpec]]:
-    return [(p.name, load_plan(p)) for p in EXAMPLES] + [("kitting (subtrees)", _kitting())]
+    return [(p.name, load_plan(p)) for p in EXAMPLES] + [
+        ("kitting (subtrees)", _kitting()),
+        ("nested subtrees", _nested()),
+    ]
 
 
 def test_btcpp_loads_the_export_of_every_example_and_a_plan_with_subtrees(tmp_path: Path) -> None:

@@ -346,3 +346,44 @@ def test_text_xml_cannot_hold_is_refused_by_node(text: str) -> None:
     leaf.name = text
     with pytest.raises(XmlExportError, match="control characters"):
         export_xml(PlanSpec(tree=leaf, name="p"), {})
+
+
+def _nested() -> PlanSpec:
+    """A subtree holding instances of another, two versions of one subtree, and a plan named
+    like one of its subtrees."""
+    msg = [SubtreePort("MSG", ParamType.TEXT)]
+    log = NodeSpec(NodeKind.OPERATION, op="debug.log", params={"message": Binding.reference("MSG")})
+    inner = SubtreeSpec(id="a.inner", name="Inner", tree=log, inputs=msg)
+    inner_v2 = SubtreeSpec(
+        id="a.inner", name="Inner", version=2, tree=NodeSpec(NodeKind.OPERATION, op="debug.succeed")
+    )
+    uses = [
+        NodeSpec(NodeKind.SUBTREE, subtree=inner.ref, params={"MSG": Binding.fixed("hi", _TEXT)}),
+        NodeSpec(NodeKind.SUBTREE, subtree=inner.ref, params={"MSG": Binding.reference("OUT")}),
+    ]
+    outer = SubtreeSpec(
+        id="a.outer",
+        name="Outer",
+        tree=NodeSpec(NodeKind.SEQUENCE, children=uses),
+        inputs=[SubtreePort("OUT", ParamType.TEXT, default="x")],
+    )
+    root = NodeSpec(
+        NodeKind.SEQUENCE,
+        children=[
+            NodeSpec(NodeKind.SUBTREE, subtree=outer.ref),
+            NodeSpec(NodeKind.SUBTREE, subtree=inner_v2.ref),
+        ],
+    )
+    plan = PlanSpec(name="Outer", tree=root, subtrees=[outer, inner, inner_v2])
+    return loads_plan(dump_plan(plan))
+
+
+_TEXT = ParamType.TEXT
+
+
+def test_nested_subtrees_and_two_versions_of_one_come_back() -> None:
+    plan = _nested()
+    text = export_xml(plan, {})
+    assert '<BehaviorTree ID="Inner_2" _uid="a.inner" _name="Inner" _version="2"' in text
+    assert '<SubTree ID="Inner" MSG="{OUT}"' in text
+    assert _round_trip(plan) == plan
