@@ -24,6 +24,7 @@ from capabilities.cells import CELL_NAMES, CellError, is_cell_file, open_cell
 from capabilities.collaboration.answers import CONFIRM_MODES, PromptAnswerer
 from capabilities.doctor import cmd_doctor
 from capabilities.shipped_examples import cmd_examples
+from capabilities.xml_commands import add_xml_commands
 from engine.build import BuildError, build_tree
 from engine.events import Event, LogMessage, RunFinished, RunHeld, StatusChanged
 from engine.executor import Executor
@@ -387,6 +388,7 @@ def _parser() -> argparse.ArgumentParser:
     show = trace_sub.add_parser("show", help="print a trace as a readable timeline")
     show.add_argument("file")
     show.set_defaults(func=_cmd_trace_show)
+    add_xml_commands(sub, (EXIT_SUCCESS, EXIT_INVALID))
     return parser
 
 

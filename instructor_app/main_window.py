@@ -54,6 +54,7 @@ from instructor_app.settings import (
     is_shipped_example,
 )
 from instructor_app.views import Views, make_views
+from instructor_app.xml_files import export_plan_xml, import_plan_xml
 
 OPEN_CELL_FILE = "Open cell file…"
 
@@ -251,6 +252,17 @@ class MainWindow(QMainWindow):
         files.addSeparator()
         files.addAction(self._action("save", "&Save", self.save_plan, "Ctrl+S"))
         files.addAction(self._action("save_as", "Save &As…", self.save_plan_as, "Ctrl+Shift+S"))
+        files.addSeparator()
+        files.addAction(
+            self._action(
+                "export_xml", "&Export BehaviorTree.CPP XML…", lambda: export_plan_xml(self)
+            )
+        )
+        files.addAction(
+            self._action(
+                "import_xml", "&Import BehaviorTree.CPP XML…", lambda: import_plan_xml(self)
+            )
+        )
         files.addSeparator()
         files.addAction(self._action("quit", "&Quit", self.close, "Ctrl+Q"))
         self._build_edit_menus()
