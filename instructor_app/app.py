@@ -17,7 +17,7 @@ import argparse
 import os
 import sys
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -114,38 +114,68 @@ def main(argv: Sequence[str] | None = None) -> int:
     return _interactive(args)
 
 
+def _start_session(args: argparse.Namespace, speed: float | None) -> CellSession:
+    """A session on the cell without a robot (opens at once), so that the window can show
+    before the cell asked for is open; the window then opens that one in the background."""
+    session = CellSession(args.cell, seed=args.seed, speed=speed)
+    session.cell_failed.connect(lambda message: print(f"error: {message}", file=sys.stderr))
+    session.open("none")
+    return session
+
+
 def _interactive(args: argparse.Namespace) -> int:
-    session = CellSession(args.cell, seed=args.seed, speed=1.0)  # real time on screen
-    failures: list[str] = []
-    session.cell_failed.connect(failures.append)
-    session.open()
+    session = _start_session(args, speed=1.0)  # real time on screen
     try:
         window = MainWindow(session)
         window.show()
-        for message in failures:  # the window did not exist yet when the cell failed
-            print(f"error: {message}", file=sys.stderr)
-            window.views.log.append(f"{message}; using no cell", "error")
-            window.show_message(f"{message}; using no cell")
+        window.switch_cell(args.cell)
         QTimer.singleShot(0, window.offer_recoveries)
         if args.plan:
-            QTimer.singleShot(
-                0, lambda: window.open_plan(args.plan) and args.run and window.controller.run()
-            )
+            QTimer.singleShot(0, lambda: _open_plan(window, args.plan, args.run))
         return QApplication.exec()
     finally:
         session.close()
 
 
+def _open_plan(window: MainWindow, plan: str, run: bool) -> None:
+    """Open the plan of the command line; with ``--run``, run it once the cell is open."""
+    if window.open_plan(plan) and run:
+        _when_ready(window.session, window.controller.run)
+
+
+def _when_ready(session: CellSession, then: Callable[[], object]) -> None:
+    """Call ``then()`` once no cell is opening any more (at once when none is)."""
+    if not session.opening:
+        then()
+        return
+
+    def ready(_ok: bool) -> None:
+        session.cell_ready.disconnect(ready)
+        then()
+
+    session.cell_ready.connect(ready)
+
+
+def _wait_for_cell(session: CellSession) -> None:
+    """Run the event loop until the cell that is opening is open (or failed)."""
+    if not session.opening:
+        return
+    loop = QEventLoop()
+    session.cell_ready.connect(loop.quit)
+    loop.exec()
+    session.cell_ready.disconnect(loop.quit)
+
+
 def _screenshot(args: argparse.Namespace) -> int:
     # As fast as possible when running for a picture; real time otherwise (nothing moves).
-    session = CellSession(args.cell, seed=args.seed, speed=None if args.run else 1.0)
-    session.cell_failed.connect(lambda message: print(f"error: {message}", file=sys.stderr))
-    session.open()
+    session = _start_session(args, speed=None if args.run else 1.0)
     with tempfile.TemporaryDirectory(prefix="costar-shot-") as scratch:
         # A throwaway settings file and recovery folder: a picture never touches the user's.
         settings = AppSettings(QSettings(str(Path(scratch, "s.ini")), QSettings.Format.IniFormat))
         window = MainWindow(session, settings, HeadlessDialogs(), Path(scratch, "recovery"))
         try:
+            window.switch_cell(args.cell)
+            _wait_for_cell(session)  # the picture shows the cell asked for, ready
             if args.plan:
                 try:
                     window.document.open(args.plan)

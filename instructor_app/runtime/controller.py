@@ -179,14 +179,19 @@ class RunController(QObject):
     # ------------------------------------------------------------------ starting
 
     def reset_cell(self) -> bool:
-        """Put the cell back to its start (see CellSession.reset); False while a plan runs."""
-        if self.is_running:
+        """Put the cell back to its start (see CellSession.reset); False while a plan runs
+        or a cell opens."""
+        if self.is_running or self.session.opening:
             return False
         self.session.reset()
         self.log_message.emit(f"The {self.session.name} cell was reset", "info")
         return True
 
     def _start(self, paused: bool) -> bool:
+        if self.session.opening:  # the registry is about to change under the plan
+            message = f"the {self.session.opening} cell is still opening; run when it is ready"
+            self.run_refused.emit([Problem(ERROR, None, "plan", None, message)])
+            return False
         plan = copy.deepcopy(self.document.plan)  # edits during the run do not reach it
         if plan.reset_cell:
             self.reset_cell()
