@@ -1,6 +1,6 @@
 """``costar-instructor``: the desktop application.
 
-``costar-instructor [PLAN | example:NAME] [--cell sim|none] [--seed N] [--run]
+``costar-instructor [PLAN | example:NAME] [--cell sim|none|FILE] [--seed N] [--run]
 [--screenshot PNG] [--size WxH]``
 
 Without ``--screenshot`` it opens the window and runs the event loop. With it, it renders the
@@ -29,10 +29,12 @@ from PySide6.QtCore import QEventLoop, QSettings, QTimer
 from PySide6.QtGui import QIcon
 from PySide6.QtWidgets import QApplication, QWidget
 
+from capabilities.cells import CELL_NAMES, is_cell_file
 from engine.library import LIBRARY_ENV
 from engine.status import Status
 from instructor_app.document.model import DocumentError
 from instructor_app.main_window import Dialogs, MainWindow
+from instructor_app.panels.cameras import camera_interfaces
 from instructor_app.runtime.controller import RunOutcome
 from instructor_app.runtime.session import CellSession
 from instructor_app.settings import APPLICATION, ORGANIZATION, AppSettings
@@ -58,8 +60,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "plan", nargs="?", help="a plan file (*.costar.json) or example:NAME (costar examples)"
     )
-    parser.add_argument("--cell", choices=("sim", "none"), default="sim",
-                        help="the cell to work with (default: sim, the simulated cell)")  # fmt: skip
+    parser.add_argument("--cell", type=_cell, default="sim",
+                        help="the cell to work with: sim (the default, the simulated cell), "
+                        "none, or a cell file (*.cell.json); it opens after the window shows")  # fmt: skip
     parser.add_argument("--seed", type=int, default=0, help="scene seed of the simulated cell")
     parser.add_argument("--run", action="store_true", help="run the plan once it is open")
     parser.add_argument("--library", metavar="FOLDER",
@@ -72,6 +75,15 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--timeout", type=float, default=120.0,
                         help="with --screenshot --run: give up after this many seconds (exit 3)")  # fmt: skip
     return parser
+
+
+def _cell(text: str) -> str:
+    """A built-in cell's name or a cell file (read when it is opened: its errors come then)."""
+    if text in CELL_NAMES or is_cell_file(text):
+        return text
+    raise argparse.ArgumentTypeError(
+        f"unknown cell {text!r}: expected {', '.join(CELL_NAMES)} or a cell file (*.cell.json)"
+    )
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -166,6 +178,27 @@ def _wait_for_cell(session: CellSession) -> None:
     session.cell_ready.disconnect(loop.quit)
 
 
+def _wait_for_camera_pictures(window: MainWindow, timeout_s: float = 5.0) -> None:
+    """Run the event loop until every camera of the cell shows a picture (bounded: a camera
+    that never sends one leaves its pane empty in the picture, as it would on screen)."""
+    panel = window.cell_views.cameras
+    cameras = set(camera_interfaces(window.session.cell))
+    loop = QEventLoop()
+    poll = QTimer()
+    poll.setInterval(20)
+
+    def check() -> None:
+        if cameras <= set(panel.shown):
+            loop.quit()
+
+    poll.timeout.connect(check)
+    QTimer.singleShot(int(timeout_s * 1000), loop.quit)
+    poll.start()
+    if not cameras <= set(panel.shown):
+        loop.exec()
+    poll.stop()
+
+
 def _screenshot(args: argparse.Namespace) -> int:
     # As fast as possible when running for a picture; real time otherwise (nothing moves).
     session = _start_session(args, speed=None if args.run else 1.0)
@@ -176,6 +209,7 @@ def _screenshot(args: argparse.Namespace) -> int:
         try:
             window.switch_cell(args.cell)
             _wait_for_cell(session)  # the picture shows the cell asked for, ready
+            _wait_for_camera_pictures(window)
             if args.plan:
                 try:
                     window.document.open(args.plan)
