@@ -130,13 +130,13 @@ def _start_session(args: argparse.Namespace, speed: float | None) -> CellSession
     """A session on the cell without a robot (opens at once), so that the window can show
     before the cell asked for is open; the window then opens that one in the background."""
     session = CellSession(args.cell, seed=args.seed, speed=speed)
-    session.cell_failed.connect(lambda message: print(f"error: {message}", file=sys.stderr))
     session.open("none")
     return session
 
 
 def _interactive(args: argparse.Namespace) -> int:
     session = _start_session(args, speed=1.0)  # real time on screen
+    session.cell_failed.connect(lambda message: print(f"error: {message}", file=sys.stderr))
     try:
         window = MainWindow(session)
         window.show()

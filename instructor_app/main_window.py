@@ -545,8 +545,9 @@ class MainWindow(QMainWindow):
     def _on_cell_failed(self, message: str) -> None:
         self._show_cell(self.session.name)
         still = f"still using the {self.session.name} cell" if self.session.cell else "no cell"
-        self.show_message(f"{message}; {still}", 0)
-        self.views.log.append(f"{message}; {still}", "error")
+        text = f"{message.rstrip('.')}; {still}"
+        self.show_message(text, 0)
+        self.views.log.append(text, "error")
         self.dialogs.error(self, "Cell", message)
 
     # ------------------------------------------------------------------ files

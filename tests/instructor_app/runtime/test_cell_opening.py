@@ -72,7 +72,7 @@ def test_a_dead_robot_host_leaves_the_window_responsive_and_the_old_cell_in_use(
             assert "still opening" in window.statusBar().currentMessage()
             assert not window.controller.run() and "still opening" in refused[0].message
         assert ready.args == [False]
-        assert opener.ticks_seen == [3] and opener.threads[-1].startswith("costar-cell")
+        assert opener.ticks_seen[0] >= 3 and opener.threads[-1].startswith("costar-cell")
         assert "sim" not in opener.names
         ((title, message),) = dialogs.errors
         assert title == "Cell" and f"cannot connect to the UR controller at {DEAD_HOST}" in message
