@@ -64,6 +64,7 @@ class _Arrival:
 
     name: str
     cell: Any
+    registry: CapabilityRegistry | None
     error: str
     generation: int
 
@@ -172,24 +173,27 @@ class CellSession(QObject):
         return True
 
     def _open_on_worker(self, wanted: str, generation: int) -> None:
-        cell, error = None, ""
+        cell, registry, error = None, None, ""
         try:
             cell = self._opener(wanted, seed=self.seed, scene=self.scene, speed=self.speed)
+            # here too: the first registry imports every capability (over half a second)
+            registry = self._registry_factory(cell)
         except CellError as exc:
             error = str(exc)
         except Exception as exc:  # an opener's bug must not leave the window waiting
             error = f"the {wanted} cell did not open: {type(exc).__name__}: {exc}"
-        if generation != self._generation:  # closed meanwhile: nobody wants this cell
-            if cell is not None:
-                cell.close()
+        if cell is not None and (error or generation != self._generation):
+            cell.close()  # it failed after opening, or was closed meanwhile: nobody wants it
+            cell = None
+        if generation != self._generation:
             return
         with contextlib.suppress(RuntimeError):  # the session is gone: nobody to tell
-            self._arrived.emit(_Arrival(wanted, cell, error, generation))
+            self._arrived.emit(_Arrival(wanted, cell, registry, error, generation))
 
     def _on_arrived(self, arrival: object) -> None:
         """(GUI thread) The worker's result: use the cell, or keep the old one and say why."""
         assert isinstance(arrival, _Arrival)
-        if arrival.generation != self._generation:
+        if arrival.generation != self._generation:  # closed after the worker looked
             if arrival.cell is not None:
                 self._pool.submit(arrival.cell.close)
             return
@@ -197,7 +201,7 @@ class CellSession(QObject):
         if arrival.error:
             self._failed(arrival.error)
             return
-        self._use(arrival.name, arrival.cell, close_old_in_background=True)
+        self._use(arrival.name, arrival.cell, True, arrival.registry)
         self.cell_ready.emit(True)
 
     def _failed(self, message: str) -> bool:
@@ -207,10 +211,17 @@ class CellSession(QObject):
         self.cell_ready.emit(False)
         return False
 
-    def _use(self, name: str, cell: Any, close_old_in_background: bool) -> None:
-        """Make ``cell`` the one in use, tell the views, then release the one before."""
+    def _use(
+        self,
+        name: str,
+        cell: Any,
+        close_old_in_background: bool,
+        registry: CapabilityRegistry | None = None,
+    ) -> None:
+        """Make ``cell`` the one in use with ``registry`` (made here when None), tell the
+        views, then release the one before."""
         old, self.cell, self.name = self.cell, cell, name
-        self.registry = self._registry_factory(cell)
+        self.registry = registry if registry is not None else self._registry_factory(cell)
         self.cell_changed.emit(name)
         self.registry_changed.emit(self.registry)
         if old is not None and old is not cell:

@@ -35,10 +35,10 @@ def test_a_cell_file_whose_robot_does_not_answer_is_named_and_the_picture_taken(
     qapp: Any, tmp_path: Path, capsys: Any
 ) -> None:
     cell_file = tmp_path / "dead.cell.json"
-    robot = {"kind": "ur", "host": "127.0.0.250", "model": "UR5e"}
+    robot = {"kind": "ur", "host": "127.254.0.1", "model": "UR5e"}
     cell_file.write_text(json.dumps({"format_version": 2, "robot": robot}), "utf-8")
     png = tmp_path / "dead.png"
     args = ["--cell", str(cell_file), "--screenshot", str(png), "--size", "800x600"]
     assert main(args) == EXIT_OK
     err = capsys.readouterr().err
-    assert "cannot connect to the UR controller at 127.0.0.250" in err and png.is_file()
+    assert "cannot connect to the UR controller at 127.254.0.1" in err and png.is_file()

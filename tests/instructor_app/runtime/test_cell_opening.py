@@ -17,7 +17,7 @@ from capabilities.cells import open_cell
 from instructor_app.runtime.session import CellSession
 from tests.instructor_app.gui_driver import ScriptedDialogs, make_window
 
-DEAD_HOST = "127.0.0.250"  # loopback with nothing listening (the emulators use 127.20+.x.y)
+DEAD_HOST = "127.254.0.1"  # loopback, nothing listening (test emulators: 127.20-219.x.y)
 
 
 class TickWaitingOpener:
