@@ -1,19 +1,20 @@
 """Which cell the Instructor works with, and the capability registry made for it.
 
 Opening a cell can take long: the simulated cell starts its physics and renders its
-cameras, a real cell connects to the robot's controller (up to its connect timeout against a
-host that does not answer). The window therefore opens cells with :meth:`CellSession.open_in_background`:
-the opener runs on ONE worker thread (as the teaching commands do in ``teach.py``) and its
-result comes back to the GUI thread through a queued signal, where the registry is swapped
-and the panels told. Until then the cell that was open stays in use, and it stays in use
-when the new one fails. :meth:`CellSession.open` does the same while the caller waits (tests,
-scripts).
+cameras, a real cell connects to the robot's controller (up to its connect timeout against
+a host that does not answer). The window therefore opens cells with
+:meth:`CellSession.open_in_background`: the opener runs on a worker thread (one opening at a
+time) and its result comes back to the GUI thread through a queued signal (as the teaching
+commands' results do in ``teach.py``), where the registry is swapped and the panels told.
+Until then the cell that was open stays in use, and it stays in use when the new one fails.
+:meth:`CellSession.open` does the same while the caller waits (tests, scripts).
 """
 
 from __future__ import annotations
 
 import contextlib
 import itertools
+import threading
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -119,7 +120,7 @@ class CellSession(QObject):
         self._registry_factory = registry_factory
         self.cell: Any = None
         self.registry: CapabilityRegistry = registry_factory(None)
-        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="costar-cell")
+        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="costar-cell-close")
         self._generations = itertools.count(1)
         self._generation = 0  # the opening whose result is still wanted
         self._opening = ""  # the cell being opened in the background ("" when none)
@@ -169,7 +170,14 @@ class CellSession(QObject):
         self._opening = wanted
         self._generation = generation = next(self._generations)
         self.cell_opening.emit(wanted, opening_words(wanted))
-        self._pool.submit(self._open_on_worker, wanted, generation)
+        # A daemon thread of its own, not the pool: quitting must not wait for a connect to a
+        # robot that does not answer (the pool's threads are joined at exit).
+        threading.Thread(
+            target=self._open_on_worker,
+            args=(wanted, generation),
+            name="costar-cell-open",
+            daemon=True,
+        ).start()
         return True
 
     def _open_on_worker(self, wanted: str, generation: int) -> None:
