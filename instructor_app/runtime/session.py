@@ -24,7 +24,9 @@ from typing import Any
 from PySide6.QtCore import QObject, Signal
 
 from capabilities.base import CapabilityRegistry
+from capabilities.cell_robot import read_robot
 from capabilities.cells import CELL_NAMES, CellError, is_cell_file, open_cell
+from engine.json_reader import JsonFileError, JsonReader, read_json_file
 
 __all__ = ["CellSession", "CellOpener", "RegistryFactory", "opening_words"]
 
@@ -39,8 +41,8 @@ def _default_registry(cell: Any) -> CapabilityRegistry:
 def opening_words(name: str) -> str:
     """What opening the cell ``name`` does, for the status bar ("Connecting to 10.0.0.5…").
 
-    Reads a cell file's ``robot`` block only (a small JSON file); a file that cannot be read
-    is named as it is, and its error comes when it is opened.
+    Reads a cell file's ``robot`` block only (a small JSON file, on the caller's thread); a
+    file that cannot be read is named as it is, and its error comes when it is opened.
     """
     if name == "sim":
         return "Starting the simulated cell…"
@@ -48,11 +50,9 @@ def opening_words(name: str) -> str:
         return "Opening no cell…"
     if not is_cell_file(name):
         return f"Opening the {name} cell…"
-    from capabilities.sim.config import CellConfig, CellConfigError
-
-    try:
-        robot = CellConfig.load(name).robot
-    except CellConfigError:
+    try:  # the robot block only: the whole configuration would import the simulator here
+        robot = read_robot(JsonReader(read_json_file(name, "cell file"), name))
+    except JsonFileError:
         return f"Opening {Path(name).name}…"
     if robot.kind == "ur":
         return f"Connecting to {robot.host}…"

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import json
 import threading
+from pathlib import Path
 from typing import Any
 
 from capabilities.cells import CellError, ManagedCell
-from instructor_app.runtime.session import CellSession
+from instructor_app.runtime.session import CellSession, opening_words
 
 
 class FakeCell(ManagedCell):
@@ -133,3 +135,16 @@ def test_closing_while_a_cell_opens_closes_it_when_it_arrives(qtbot: Any) -> Non
     opener.go.set()
     qtbot.waitUntil(lambda: len(opener.cells) == 2 and opener.cells[-1].closed)
     assert session.cell is None, "a cell nobody waits for any more is not used"
+
+
+def test_what_an_opening_does_is_said_in_words(tmp_path: Path) -> None:
+    ur = tmp_path / "ur.cell.json"
+    ur.write_text(json.dumps({"format_version": 2, "robot": {"kind": "ur", "host": "10.0.0.5"}}))
+    simulated = tmp_path / "sim.cell.json"
+    simulated.write_text(json.dumps({"format_version": 2, "robot": {"kind": "sim"}}))
+    broken = tmp_path / "broken.cell.json"
+    broken.write_text("{")
+    assert opening_words("sim") == "Starting the simulated cell…"
+    assert opening_words(str(ur)) == "Connecting to 10.0.0.5…"
+    assert opening_words(str(simulated)) == "Starting the simulated cell of sim.cell.json…"
+    assert opening_words(str(broken)) == "Opening broken.cell.json…"
