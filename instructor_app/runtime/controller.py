@@ -178,10 +178,13 @@ class RunController(QObject):
 
     # ------------------------------------------------------------------ starting
 
-    def reset_cell(self) -> bool:
-        """Put the cell back to its start (see CellSession.reset); False while a plan runs."""
+    def reset_cell(self, scene: str = "") -> bool:
+        """Put the cell back to its start (see CellSession.reset); False while a plan runs.
+        ``scene``: the simulated scene to start from instead (the plan's own)."""
         if self.is_running:
             return False
+        if scene and self.session.name == "sim":
+            self.session.scene = scene
         self.session.reset()
         self.log_message.emit(f"The {self.session.name} cell was reset", "info")
         return True
@@ -189,7 +192,7 @@ class RunController(QObject):
     def _start(self, paused: bool) -> bool:
         plan = copy.deepcopy(self.document.plan)  # edits during the run do not reach it
         if plan.reset_cell:
-            self.reset_cell()
+            self.reset_cell(plan.scene)
         registry = self.session.registry
         problems = validate_plan(plan, registry)
         if has_errors(problems):
