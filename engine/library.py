@@ -39,6 +39,7 @@ from engine.plan_format import MAX_NESTING, SUBTREE_FIELDS, PlanFileError
 from engine.plan_reader import read_subtree
 from engine.plan_writer import dump_json, encode_subtree, write_atomic
 from engine.spec import SubtreeSpec
+from resources import resource_path
 
 __all__ = [
     "LIBRARY_ENV",
@@ -58,7 +59,7 @@ FORMAT = "costar-subtree"
 FORMAT_VERSION = 1
 SUBTREE_SUFFIX = ".subtree.json"
 LIBRARY_ENV = "COSTAR_LIBRARY"
-SHIPPED_LIBRARY = Path(__file__).resolve().parents[1] / "resources" / "library"
+SHIPPED_LIBRARY = resource_path("library")  # package data, found as every shipped file is
 _FILE_FIELDS = ("format", "format_version", *SUBTREE_FIELDS)
 # A lock older than this was left by a writer that died: it is broken.
 STALE_LOCK_SECONDS = 30.0

@@ -109,6 +109,7 @@ class _Reader:
                 )
             ),
             reset_cell=self.flag(doc.get("reset_cell", False), "$.reset_cell"),
+            scene=self.text(doc.get("scene", ""), "$.scene"),
         )
         if doc.get("tree") is not None:
             plan.tree = self.node(doc["tree"], "$.tree", 1)

@@ -141,6 +141,7 @@ def dump_plan(plan: PlanSpec) -> str:
         "description": plan.description,
         "run_policy": RunPolicy(plan.run_policy).value,
         **({"reset_cell": True} if plan.reset_cell else {}),
+        **({"scene": plan.scene} if plan.scene else {}),
         "parameters": [_encode_parameter(decl) for decl in plan.parameters],
         "tree": None if plan.tree is None else _encode_node(plan.tree, 1),
         "waypoints": [encode_value(waypoint) for waypoint in plan.waypoints],

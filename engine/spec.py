@@ -267,6 +267,9 @@ class PlanSpec:
     run_policy: RunPolicy = RunPolicy.ONCE
     # Put the cell back to its scene's seed (robot home, objects in place) before each run.
     reset_cell: bool = False
+    # The simulated cell's scene the plan was taught on ("kitting_handoff"); the simulated
+    # cell opens it for this plan unless told otherwise. Empty: the cell's default scene.
+    scene: str = ""
     parameters: list[ParameterDecl] = field(default_factory=list)
     waypoints: list[Waypoint] = field(default_factory=list)
     objects: list[str] = field(default_factory=list)

@@ -488,7 +488,7 @@ class MainWindow(QMainWindow):
 
     def reset_cell(self) -> None:
         """Put robot and objects back to the scene's start (not while a plan runs)."""
-        if self.controller.reset_cell():
+        if self.controller.reset_cell(self.document.plan.scene):
             self.views.canvas.clear_statuses()
             self.show_message(f"The {self.session.name} cell was reset")
         elif self.session.opening:

@@ -17,6 +17,7 @@ import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from capabilities.errors import CapabilityError
 from capabilities.jobs import CommandHandleLike
 from capabilities.motion.backend import ArmBackend
 from capabilities.motion.geometry import axis_rotation, format_pose_mm
@@ -40,7 +41,7 @@ _MIN_FRACTION = 1 / 64  # the shortest retry, as a part of the wanted distance
 _POLL_S = 0.01
 
 
-class JogFailed(Exception):
+class JogFailed(CapabilityError):
     """A jog could not start (the arm refused every distance tried); the message says why."""
 
 

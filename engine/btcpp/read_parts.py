@@ -76,6 +76,7 @@ class ReaderBase:
                 data.line, f"run_policy one of {', '.join(policies)}", repr(attrs["run_policy"])
             )
         plan.reset_cell = attrs.get("reset_cell") == "true"
+        plan.scene = attrs.get("scene", "")
         for item in data.children:
             if item.tag == "Parameter":
                 ptype = self._ptype(item, item.attrs.get("type", ""))

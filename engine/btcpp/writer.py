@@ -123,6 +123,7 @@ class _Writer:
                 "description": plan.description,
                 "run_policy": plan.run_policy.value,
                 "reset_cell": "true" if plan.reset_cell else "false",
+                "scene": plan.scene,
             },
         )
         for decl in plan.parameters:

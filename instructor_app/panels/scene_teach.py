@@ -1,7 +1,7 @@
 """Teaching in the 3D scene: drag the tool gizmo and the arm follows; preview waypoints.
 
-Uses only the scene's public API (helper cams3d's ``Scene3DPanel``, see
-``/work/issues/COORD-scene3d.md``): ``available``, ``set_gizmo(pose | None)``,
+Uses only the scene's public API (:class:`instructor_app.panels.scene3d.Scene3DPanel`):
+``available``, ``set_gizmo(pose | None)``,
 ``show_ghost(joints | None)`` and the signals ``gizmo_dragged(Pose)`` and
 ``gizmo_released(Pose)``. The gizmo sits on the TCP while nobody drags it; a drag sends the
 newest pose to the RobotTeacher (freedrive drag on the simulated cell, IK and joint moves

@@ -178,11 +178,14 @@ class RunController(QObject):
 
     # ------------------------------------------------------------------ starting
 
-    def reset_cell(self) -> bool:
+    def reset_cell(self, scene: str = "") -> bool:
         """Put the cell back to its start (see CellSession.reset); False while a plan runs
-        or a cell opens."""
+        or a cell opens. ``scene``: the simulated scene to start from instead (the plan's
+        own)."""
         if self.is_running or self.session.opening:
             return False
+        if scene and self.session.name == "sim":
+            self.session.scene = scene
         self.session.reset()
         self.log_message.emit(f"The {self.session.name} cell was reset", "info")
         return True
@@ -194,7 +197,7 @@ class RunController(QObject):
             return False
         plan = copy.deepcopy(self.document.plan)  # edits during the run do not reach it
         if plan.reset_cell:
-            self.reset_cell()
+            self.reset_cell(plan.scene)
         registry = self.session.registry
         problems = validate_plan(plan, registry)
         if has_errors(problems):

@@ -308,9 +308,11 @@ def kitting() -> PlanSpec:
         tree, "Kitting (Figure 7, simulated cell)",
         "The paper's kitting task composed from the shipped library: wait for the worker to hand "
         "the kit bin in, take the suction tool, put one each of the 3-, 4- and 8-hole plates into "
-        "the bin (whichever is on the table), holster the tool and return the bin. Run it with: "
-        "costar run kitting.costar.json --cell sim --scene kitting_handoff --seed N.",
-        RunPolicy.ONCE, objects=["kit_bin", *PLATE_THICKNESS],
+        "the bin (whichever is on the table), holster the tool and return the bin. It is taught "
+        "on the simulated scene kitting_handoff (a worker hands the bin in), which the simulated "
+        "cell opens for it. Run it with: costar run example:kitting --seed N.",
+        RunPolicy.ONCE, objects=["kit_bin", *PLATE_THICKNESS], reset_cell=True,
+        scene="kitting_handoff",
         id=uuid.uuid5(_NAMESPACE, "kitting").hex, subtrees=list(subs.values()),
     )  # fmt: skip
 

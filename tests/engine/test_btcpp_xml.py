@@ -323,8 +323,8 @@ def test_every_field_of_the_spec_is_carried() -> None:
     """A new field of the plan spec must be taught to engine.btcpp (writer and read_parts),
     or the XML round trip silently drops it: this test names the fields it knows."""
     carried = {
-        PlanSpec: {"tree", "name", "description", "run_policy", "reset_cell", "parameters"}
-        | {"waypoints", "objects", "layout", "id", "subtrees"},
+        PlanSpec: {"tree", "name", "description", "run_policy", "reset_cell", "scene"}
+        | {"parameters", "waypoints", "objects", "layout", "id", "subtrees"},
         NodeSpec: {"kind", "name", "id", "op", "params", "children", "subtree"},
         SubtreeSpec: {"id", "name", "tree", "version", "date", "description", "inputs"}
         | {"outputs", "shared", "layout"},

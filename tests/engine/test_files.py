@@ -484,3 +484,17 @@ SCHEMA_BAD = [
 )
 def test_schema_refuses_what_the_reader_refuses(doc: Any, path: str) -> None:
     assert schema_errors(doc), f"the schema accepts a document the reader refuses at {path}"
+
+
+def test_the_scene_a_plan_was_taught_on_round_trips(tmp_path: Path) -> None:
+    plan = PlanSpec(
+        NodeSpec(NodeKind.WAIT, params={"seconds": Binding.fixed(1.0, ParamType.DURATION)})
+    )
+    plan.scene = "kitting_handoff"
+    path = tmp_path / "scene.costar.json"
+    save_plan(plan, path)
+    assert '"scene": "kitting_handoff"' in path.read_text(encoding="utf-8")
+    assert load_plan(path).scene == "kitting_handoff"
+    plan.scene = ""
+    save_plan(plan, path)
+    assert '"scene"' not in path.read_text(encoding="utf-8")

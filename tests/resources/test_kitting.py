@@ -78,7 +78,7 @@ def test_kitting_composes_the_library_as_in_figure_7() -> None:
 @pytest.mark.parametrize("seed", range(10))
 def test_costar_run_kitting_succeeds(seed: int) -> None:
     out, err = io.StringIO(), io.StringIO()
-    args = ["run", str(KITTING), "--cell", "sim", "--scene", "kitting_handoff", "--seed", str(seed)]
+    args = ["run", str(KITTING), "--seed", str(seed)]  # the plan names its scene
     code = costar([*args, "--timeout", "600"], out, err)
     assert code == 0, out.getvalue() + err.getvalue()
     assert "SUCCESS" in out.getvalue()

@@ -107,7 +107,7 @@ ROOT = Path(__file__).resolve().parents[4]
     not os.environ.get("DISPLAY"), reason="needs an X display with GL (run under xvfb-run)"
 )
 def test_with_opengl_a_mouse_drag_of_the_gizmo_teaches_a_waypoint_a_plan_reaches() -> None:
-    """The real 3D scene (helper cams3d's) in the window, in its own process on Xvfb's GL."""
+    """The real 3D scene (Scene3DPanel) in the window, in its own process on Xvfb's GL."""
     env = {**os.environ, "QT_QPA_PLATFORM": "xcb", "PYTHONPATH": str(ROOT)}
     done = subprocess.run(
         [sys.executable, str(Path(__file__).with_name("scene_drag_gl_check.py"))],
