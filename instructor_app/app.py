@@ -1,6 +1,6 @@
 """``costar-instructor``: the desktop application.
 
-``costar-instructor [PLAN | example:NAME] [--cell sim|none] [--seed N] [--run]
+``costar-instructor [PLAN | example:NAME] [--cell sim|none|FILE] [--seed N] [--run]
 [--screenshot PNG] [--size WxH]``
 
 Without ``--screenshot`` it opens the window and runs the event loop. With it, it renders the
@@ -17,7 +17,7 @@ import argparse
 import os
 import sys
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -29,10 +29,12 @@ from PySide6.QtCore import QEventLoop, QSettings, QTimer
 from PySide6.QtGui import QIcon
 from PySide6.QtWidgets import QApplication, QWidget
 
+from capabilities.cells import CELL_NAMES, is_cell_file
 from engine.library import LIBRARY_ENV
 from engine.status import Status
 from instructor_app.document.model import DocumentError
 from instructor_app.main_window import Dialogs, MainWindow
+from instructor_app.panels.cameras import camera_interfaces
 from instructor_app.runtime.controller import RunOutcome
 from instructor_app.runtime.session import CellSession
 from instructor_app.settings import APPLICATION, ORGANIZATION, AppSettings
@@ -58,8 +60,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "plan", nargs="?", help="a plan file (*.costar.json) or example:NAME (costar examples)"
     )
-    parser.add_argument("--cell", choices=("sim", "none"), default="sim",
-                        help="the cell to work with (default: sim, the simulated cell)")  # fmt: skip
+    parser.add_argument("--cell", type=_cell, default="sim",
+                        help="the cell to work with: sim (the default, the simulated cell), "
+                        "none, or a cell file (*.cell.json); it opens after the window shows")  # fmt: skip
     parser.add_argument("--seed", type=int, default=0, help="scene seed of the simulated cell")
     parser.add_argument("--run", action="store_true", help="run the plan once it is open")
     parser.add_argument("--library", metavar="FOLDER",
@@ -72,6 +75,15 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--timeout", type=float, default=120.0,
                         help="with --screenshot --run: give up after this many seconds (exit 3)")  # fmt: skip
     return parser
+
+
+def _cell(text: str) -> str:
+    """A built-in cell's name or a cell file (read when it is opened: its errors come then)."""
+    if text in CELL_NAMES or is_cell_file(text):
+        return text
+    raise argparse.ArgumentTypeError(
+        f"unknown cell {text!r}: expected {', '.join(CELL_NAMES)} or a cell file (*.cell.json)"
+    )
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -114,38 +126,90 @@ def main(argv: Sequence[str] | None = None) -> int:
     return _interactive(args)
 
 
+def _start_session(args: argparse.Namespace, speed: float | None) -> CellSession:
+    """A session on the cell without a robot (opens at once), so that the window can show
+    before the cell asked for is open; the window then opens that one in the background."""
+    session = CellSession(args.cell, seed=args.seed, speed=speed)
+    session.open("none")
+    return session
+
+
 def _interactive(args: argparse.Namespace) -> int:
-    session = CellSession(args.cell, seed=args.seed, speed=1.0)  # real time on screen
-    failures: list[str] = []
-    session.cell_failed.connect(failures.append)
-    session.open()
+    session = _start_session(args, speed=1.0)  # real time on screen
+    session.cell_failed.connect(lambda message: print(f"error: {message}", file=sys.stderr))
     try:
         window = MainWindow(session)
         window.show()
-        for message in failures:  # the window did not exist yet when the cell failed
-            print(f"error: {message}", file=sys.stderr)
-            window.views.log.append(f"{message}; using no cell", "error")
-            window.show_message(f"{message}; using no cell")
+        window.switch_cell(args.cell)
         QTimer.singleShot(0, window.offer_recoveries)
         if args.plan:
-            QTimer.singleShot(
-                0, lambda: window.open_plan(args.plan) and args.run and window.controller.run()
-            )
+            QTimer.singleShot(0, lambda: _open_plan(window, args.plan, args.run))
         return QApplication.exec()
     finally:
         session.close()
 
 
+def _open_plan(window: MainWindow, plan: str, run: bool) -> None:
+    """Open the plan of the command line; with ``--run``, run it once the cell is open."""
+    if window.open_plan(plan) and run:
+        _when_ready(window.session, window.controller.run)
+
+
+def _when_ready(session: CellSession, then: Callable[[], object]) -> None:
+    """Call ``then()`` once no cell is opening any more (at once when none is)."""
+    if not session.opening:
+        then()
+        return
+
+    def ready(_ok: bool) -> None:
+        session.cell_ready.disconnect(ready)
+        then()
+
+    session.cell_ready.connect(ready)
+
+
+def _wait_for_cell(session: CellSession) -> None:
+    """Run the event loop until the cell that is opening is open (or failed)."""
+    if not session.opening:
+        return
+    loop = QEventLoop()
+    session.cell_ready.connect(loop.quit)
+    loop.exec()
+    session.cell_ready.disconnect(loop.quit)
+
+
+def _wait_for_camera_pictures(window: MainWindow, timeout_s: float = 5.0) -> None:
+    """Run the event loop until every camera of the cell shows a picture (bounded: a camera
+    that never sends one leaves its pane empty in the picture, as it would on screen)."""
+    panel = window.cell_views.cameras
+    cameras = set(camera_interfaces(window.session.cell))
+    loop = QEventLoop()
+    poll = QTimer()
+    poll.setInterval(20)
+
+    def check() -> None:
+        if cameras <= set(panel.shown):
+            loop.quit()
+
+    poll.timeout.connect(check)
+    QTimer.singleShot(int(timeout_s * 1000), loop.quit)
+    poll.start()
+    if not cameras <= set(panel.shown):
+        loop.exec()
+    poll.stop()
+
+
 def _screenshot(args: argparse.Namespace) -> int:
     # As fast as possible when running for a picture; real time otherwise (nothing moves).
-    session = CellSession(args.cell, seed=args.seed, speed=None if args.run else 1.0)
-    session.cell_failed.connect(lambda message: print(f"error: {message}", file=sys.stderr))
-    session.open()
+    session = _start_session(args, speed=None if args.run else 1.0)
     with tempfile.TemporaryDirectory(prefix="costar-shot-") as scratch:
         # A throwaway settings file and recovery folder: a picture never touches the user's.
         settings = AppSettings(QSettings(str(Path(scratch, "s.ini")), QSettings.Format.IniFormat))
         window = MainWindow(session, settings, HeadlessDialogs(), Path(scratch, "recovery"))
         try:
+            window.switch_cell(args.cell)
+            _wait_for_cell(session)  # the picture shows the cell asked for, ready
+            _wait_for_camera_pictures(window)
             if args.plan:
                 try:
                     window.document.open(args.plan)

@@ -334,7 +334,9 @@ class MainWindow(QMainWindow):
         self.failure_button.node_selected.connect(self.select_node)
         self.session.registry_changed.connect(self._on_registry)
         self.session.cell_changed.connect(self._on_cell_changed)
-        self.session.cell_failed.connect(lambda message: self.dialogs.error(self, "Cell", message))
+        self.session.cell_failed.connect(self._on_cell_failed)
+        self.session.cell_opening.connect(self._on_cell_opening)
+        self.session.cell_ready.connect(lambda _ok: self._on_run_state(self.controller.state))
         self.cell_combo.activated.connect(
             lambda index: self.switch_cell(str(self.cell_combo.itemData(index) or ""))
         )
@@ -474,15 +476,23 @@ class MainWindow(QMainWindow):
     # ------------------------------------------------------------------ cell
 
     def _on_run_state(self, state: object) -> None:
+        """The cell chooser, Reset and Run follow the run's state; all wait while a cell opens."""
         idle = state in (ExecutorState.READY, ExecutorState.FINISHED)
-        self.cell_combo.setEnabled(idle)
-        self.actions_by_name["reset_cell"].setEnabled(idle)
+        opening = bool(self.session.opening)
+        self.cell_combo.setEnabled(idle and not opening)
+        self.actions_by_name["reset_cell"].setEnabled(idle and not opening)
+        self.run_actions.update_state(state)
+        if opening:
+            self.run_actions.run.setEnabled(False)
+            self.run_actions.step.setEnabled(False)
 
     def reset_cell(self) -> None:
         """Put robot and objects back to the scene's start (not while a plan runs)."""
         if self.controller.reset_cell(self.document.plan.scene):
             self.views.canvas.clear_statuses()
             self.show_message(f"The {self.session.name} cell was reset")
+        elif self.session.opening:
+            self.show_message(f"Wait until the {self.session.opening} cell is open.")
         else:
             self.show_message("Stop the run before resetting the cell.")
 
@@ -496,7 +506,15 @@ class MainWindow(QMainWindow):
         self.cell_combo.setCurrentIndex(index)
 
     def switch_cell(self, name: str) -> None:
-        """Open another cell: a name, a cell file, or "" to ask for one (not while running)."""
+        """Open another cell: a name, a cell file, or "" to ask for one (not while running,
+        not while another opens). It opens in the background (see CellSession): the window
+        answers meanwhile, and the cell that was open stays in use until the new one is."""
+        if self.session.opening:
+            self._show_cell(self.session.opening)
+            self.show_message(
+                f"The {self.session.opening} cell is still opening; choose again when it is."
+            )
+            return
         if not name:
             folder = str(Path(self.session.name).parent) if Path(self.session.name).suffix else ""
             name = self.dialogs.open_cell_path(self, folder)
@@ -509,8 +527,7 @@ class MainWindow(QMainWindow):
             self._show_cell(self.session.name)
             self.show_message("Stop the run before switching the cell.")
             return
-        self.show_message(f"Opening the {name} cell…")
-        self.session.open(name)
+        self.session.open_in_background(name)
 
     def _on_registry(self, registry: Any) -> None:
         self.views.set_registry(registry)
@@ -518,6 +535,20 @@ class MainWindow(QMainWindow):
     def _on_cell_changed(self, name: str) -> None:
         self._show_cell(name)
         self.show_message(f"Cell in use: {name}")
+
+    def _on_cell_opening(self, name: str, words: str) -> None:
+        """(A background opening started) Say what it does until it ends; no run meanwhile."""
+        self._show_cell(name)
+        self.show_message(words, 0)
+        self._on_run_state(self.controller.state)
+
+    def _on_cell_failed(self, message: str) -> None:
+        self._show_cell(self.session.name)
+        still = f"still using the {self.session.name} cell" if self.session.cell else "no cell"
+        text = f"{message.rstrip('.')}; {still}"
+        self.show_message(text, 0)
+        self.views.log.append(text, "error")
+        self.dialogs.error(self, "Cell", message)
 
     # ------------------------------------------------------------------ files
 

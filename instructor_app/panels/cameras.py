@@ -181,8 +181,8 @@ class CameraPanel(QWidget):
         self.feed = CameraFeed(cameras, self.painter, self.fps)
         feed = self.feed  # a panel deleted without stop() still ends its thread
         self.destroyed.connect(lambda *_: feed.stop(0.5))
-        if not cameras:
-            self.rate_label.setText("this cell has no cameras")
+        # cleared too: a cell with cameras after one without (the window starts on none)
+        self.rate_label.setText("" if cameras else "this cell has no cameras")
         self._update_active()
 
     def set_regions(self, regions: Iterable[tuple[str, Region]]) -> None:

@@ -179,9 +179,10 @@ class RunController(QObject):
     # ------------------------------------------------------------------ starting
 
     def reset_cell(self, scene: str = "") -> bool:
-        """Put the cell back to its start (see CellSession.reset); False while a plan runs.
-        ``scene``: the simulated scene to start from instead (the plan's own)."""
-        if self.is_running:
+        """Put the cell back to its start (see CellSession.reset); False while a plan runs
+        or a cell opens. ``scene``: the simulated scene to start from instead (the plan's
+        own)."""
+        if self.is_running or self.session.opening:
             return False
         if scene and self.session.name == "sim":
             self.session.scene = scene
@@ -190,6 +191,10 @@ class RunController(QObject):
         return True
 
     def _start(self, paused: bool) -> bool:
+        if self.session.opening:  # the registry is about to change under the plan
+            message = f"the {self.session.opening} cell is still opening; run when it is ready"
+            self.run_refused.emit([Problem(ERROR, None, "plan", None, message)])
+            return False
         plan = copy.deepcopy(self.document.plan)  # edits during the run do not reach it
         if plan.reset_cell:
             self.reset_cell(plan.scene)

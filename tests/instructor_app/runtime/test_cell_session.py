@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import json
+import threading
+from pathlib import Path
 from typing import Any
 
 from capabilities.cells import CellError, ManagedCell
-from instructor_app.runtime.session import CellSession
+from instructor_app.runtime.session import CellSession, opening_words
 
 
 class FakeCell(ManagedCell):
@@ -65,3 +68,83 @@ def test_a_cell_that_fails_falls_back_to_none_and_says_why(qtbot: Any) -> None:
 def test_the_real_none_cell_opens(none_session: CellSession) -> None:
     assert none_session.name == "none"
     assert none_session.registry.availability("debug.succeed").available
+
+
+class BlockingOpener(Opener):
+    """Opens fake cells on the worker thread once :attr:`go` is set; records the thread."""
+
+    def __init__(self, sim_fails: bool = False) -> None:
+        super().__init__(sim_fails)
+        self.go = threading.Event()
+        self.threads: list[str] = []
+        self.cells: list[FakeCell] = []
+
+    def __call__(self, name: str, **kwargs: Any) -> FakeCell:
+        self.threads.append(threading.current_thread().name)
+        assert self.go.wait(10.0), "the test never let the opening go on"
+        cell = super().__call__(name, **kwargs)
+        self.cells.append(cell)
+        return cell
+
+
+def test_a_background_opening_keeps_the_old_cell_until_the_new_one_is_there(qtbot: Any) -> None:
+    opener = BlockingOpener()
+    opener.go.set()
+    session = CellSession("none", opener=opener)
+    session.open()
+    old = session.cell
+    opener.go.clear()
+    with qtbot.waitSignal(session.cell_opening) as opening:
+        assert session.open_in_background("sim")
+    assert opening.args == ["sim", "Starting the simulated cell…"]
+    assert session.opening == "sim" and session.cell is old and session.name == "none"
+    assert not session.open_in_background("none"), "one opening at a time"
+    assert not session.open("none") and session.cell is old
+    with qtbot.waitSignal(session.cell_ready) as ready:
+        opener.go.set()
+    assert ready.args == [True] and session.name == "sim" and session.cell.name == "sim"
+    assert opener.threads[-1].startswith("costar-cell") and session.opening == ""
+    qtbot.waitUntil(lambda: old.closed)  # closed on the worker, after the views moved on
+    session.close()
+
+
+def test_a_background_failure_keeps_the_cell_that_was_open(qtbot: Any) -> None:
+    opener = BlockingOpener(sim_fails=True)
+    opener.go.set()
+    session = CellSession("none", opener=opener)
+    session.open()
+    old = session.cell
+    failures: list[str] = []
+    session.cell_failed.connect(failures.append)
+    with qtbot.waitSignal(session.cell_ready) as ready:
+        session.open_in_background("sim")
+    assert ready.args == [False] and len(failures) == 1 and "no GPU today" in failures[0]
+    assert session.cell is old and not old.closed and session.name == "none"
+    session.close()
+
+
+def test_closing_while_a_cell_opens_closes_it_when_it_arrives(qtbot: Any) -> None:
+    opener = BlockingOpener()
+    opener.go.set()
+    session = CellSession("none", opener=opener)
+    session.open("none")
+    opener.go.clear()
+    session.open_in_background("sim")
+    session.close()
+    assert session.cell is None and session.opening == ""
+    opener.go.set()
+    qtbot.waitUntil(lambda: len(opener.cells) == 2 and opener.cells[-1].closed)
+    assert session.cell is None, "a cell nobody waits for any more is not used"
+
+
+def test_what_an_opening_does_is_said_in_words(tmp_path: Path) -> None:
+    ur = tmp_path / "ur.cell.json"
+    ur.write_text(json.dumps({"format_version": 2, "robot": {"kind": "ur", "host": "10.0.0.5"}}))
+    simulated = tmp_path / "sim.cell.json"
+    simulated.write_text(json.dumps({"format_version": 2, "robot": {"kind": "sim"}}))
+    broken = tmp_path / "broken.cell.json"
+    broken.write_text("{")
+    assert opening_words("sim") == "Starting the simulated cell…"
+    assert opening_words(str(ur)) == "Connecting to 10.0.0.5…"
+    assert opening_words(str(simulated)) == "Starting the simulated cell of sim.cell.json…"
+    assert opening_words(str(broken)) == "Opening broken.cell.json…"

@@ -38,9 +38,13 @@ def test_the_toolbar_shows_each_robot_state(qtbot, tmp_path: Path, emulator) -> 
     window = make_window(qtbot, session, tmp_path, dialogs)
     label = window.robot_status
     assert not label.isVisibleTo(window)  # no robot controller on the "none" cell
-    # The cell chooser's last entry asks for a cell file.
+    # The cell chooser's last entry asks for a cell file; it opens in the background.
     combo = window.cell_combo
-    combo.activated.emit(combo.count() - 1)
+    with qtbot.waitSignal(session.cell_ready, timeout=WAIT_MS) as ready:
+        combo.activated.emit(combo.count() - 1)
+        assert window.statusBar().currentMessage() == f"Connecting to {emulator.host}…"
+        assert not combo.isEnabled() and not window.run_actions.run.isEnabled()
+    assert ready.args == [True] and combo.isEnabled() and window.run_actions.run.isEnabled()
     assert session.name == cell_file and combo.currentText() == "emulated.cell.json"
     try:
         text = label.text
