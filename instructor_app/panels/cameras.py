@@ -6,6 +6,8 @@ colour picture and the depth picture, both with the overlays of
 confidence, markers, the plan's regions). Frames are captured and drawn by a
 :class:`~instructor_app.runtime.camera_feed.CameraFeed` thread; a GUI timer only shows the
 newest picture of each camera when it changed. A hidden or paused panel captures nothing.
+A camera that gives no picture (the simulated cell's live-view renderer stopped, a camera
+failed) is named in the toolbar with the reason; the rest of the app goes on.
 
 Regions by pointing: with "Draw region" on, press on a depth picture where the region's
 centre is and drag out its radius; on release ``region_drawn(Region)`` fires (the window saves
@@ -236,6 +238,12 @@ class CameraPanel(QWidget):
             depth.setImage(latest.depth, autoLevels=False, levels=(0, 255))
             self.shown[name] = latest
             self.frames_shown += 1
+        failures = dict(self.feed.failures)
+        if failures:  # e.g. the simulated cell's live-view renderer stopped: say so
+            text = "; ".join(f"{name}: {why}" for name, why in sorted(failures.items()))
+            self.rate_label.setText(f"No live picture ({text})")
+            self.rate_label.setToolTip(text)
+            return
         elapsed = time.perf_counter() - self._rate_start
         if elapsed > 1.0:
             per_camera = (
