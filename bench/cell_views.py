@@ -9,8 +9,11 @@ between phases with the camera and 3D docks hidden (nothing captured or drawn) a
   the same run (goal at least 0.9).
 - ``scene3d_fps``: frames per second the 3D scene draws while the arm moves (null where no
   OpenGL context can be made: run under xvfb-run).
-- ``sim_speed_on`` / ``sim_speed_off``: simulated seconds per wall second in each phase (the
-  CPU renderer runs on the physics thread, so camera frames cost the simulation time).
+- ``sim_speed_on`` / ``sim_speed_off``: simulated seconds per wall second in each phase.
+- ``camera_fps_by_camera``: frames each camera's feed captured per second (shown phase).
+- ``first_picture_s``: seconds from showing the panels to the first picture of every camera
+  (the live view's renderer processes start); the phase is measured after it.
+- ``load_average``: the machine's load (1, 5, 15 min) at the end: the figures depend on it.
 
 Run it on its own or through ``bench/gui.py`` (which runs it in a process of its own with
 ``QT_QPA_PLATFORM=xcb`` when there is a display)::
@@ -58,10 +61,17 @@ def _phase(window: Any, shown: bool, seconds: float) -> dict[str, float]:
     for name in ("cameras", "scene3d"):
         window.docks[name].setVisible(shown)
     _wait(1.0)  # settle: the feed starts or stops, the docks lay out
+    started = time.perf_counter()
+    while shown and len(views.cameras.shown) < len(views.cameras._pictures):
+        _wait(0.1)  # the live view's renderers start once (a fresh process each): not counted
+        if time.perf_counter() - started > 60.0:
+            raise RuntimeError("the camera panel showed no picture within 60 s")
+    first_picture = time.perf_counter() - started
     executor = window.controller._executor  # the bench reads the engine's tick counter
     cell = window.session.cell
     ticks0, sim0, wall0 = executor.tree.ctx.tick_count, cell.sim.time(), time.perf_counter()
     frames0, drawn0 = views.cameras.frames_shown, views.scene3d.frames_drawn
+    seq0 = {name: frame.seq for name, frame in views.cameras.shown.items()}
     _wait(seconds)
     wall = time.perf_counter() - wall0
     cameras = max(len(views.cameras.shown), 1)
@@ -70,6 +80,12 @@ def _phase(window: Any, shown: bool, seconds: float) -> dict[str, float]:
         "camera_fps": (views.cameras.frames_shown - frames0) / wall / cameras,
         "scene3d_fps": (views.scene3d.frames_drawn - drawn0) / wall,
         "sim_speed": (cell.sim.time() - sim0) / wall,
+        # Frames each camera's feed captured (the panel may show fewer).
+        "per_camera": {
+            name: round((frame.seq - seq0.get(name, 0)) / wall, 1)
+            for name, frame in views.cameras.shown.items()
+        },
+        "first_picture_s": first_picture,
     }
 
 
@@ -110,6 +126,10 @@ def measure_cell_views(seconds: float = 6.0) -> dict[str, Any]:
         "ticks_per_s_panels_off": round(off["ticks_per_s"], 1),
         "sim_speed_on": round(on["sim_speed"], 2),
         "sim_speed_off": round(off["sim_speed"], 2),
+        "camera_fps_by_camera": on["per_camera"],
+        "first_picture_s": round(on["first_picture_s"], 1),
+        # Others' work on the machine: compare figures only with runs under a similar load.
+        "load_average": [round(v, 2) for v in os.getloadavg()],
     }
 
 

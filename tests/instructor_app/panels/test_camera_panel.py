@@ -4,6 +4,8 @@ read by ``occupancy.is_occupied``."""
 
 from __future__ import annotations
 
+import os
+import signal
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -133,3 +135,19 @@ def test_a_region_without_a_selected_region_node_becomes_a_plan_parameter(qapp: 
     assert plan_regions(document.plan) == [("KEEP_OUT", Region((0.5, 0.0, 0.1), 0.1))]
     save_region(document, Region((0.6, 0.0, 0.1), 0.2), None, "KEEP_OUT")
     assert plan_regions(document.plan) == [("KEEP_OUT", Region((0.6, 0.0, 0.1), 0.2))]
+
+
+def test_the_panel_says_when_a_live_view_stopped_and_the_other_camera_goes_on(qtbot) -> None:
+    with SimCellSession("cup_to_bin", seed=0) as cell:
+        widget = CameraPanel(fps=15.0)
+        qtbot.addWidget(widget)
+        widget.set_cell(cell)
+        widget.show()
+        qtbot.waitUntil(lambda: {"shoulder", "wrist"} <= set(widget.shown), timeout=30000)
+        assert cell.live_view is not None
+        os.kill(cell.live_view.pids()["shoulder"], signal.SIGKILL)  # the renderer crashes
+        qtbot.waitUntil(lambda: "No live picture" in widget.rate_label.text(), timeout=20000)
+        assert "shoulder" in widget.rate_label.text() and "stopped" in widget.rate_label.text()
+        wrist = widget.shown["wrist"].seq
+        qtbot.waitUntil(lambda: widget.shown["wrist"].seq > wrist, timeout=20000)
+        widget.stop()
