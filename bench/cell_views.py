@@ -11,6 +11,8 @@ between phases with the camera and 3D docks hidden (nothing captured or drawn) a
   OpenGL context can be made: run under xvfb-run).
 - ``sim_speed_on`` / ``sim_speed_off``: simulated seconds per wall second in each phase.
 - ``camera_fps_by_camera``: frames each camera's feed captured per second (shown phase).
+- ``renderer_cpu_ms_per_frame``: CPU time each camera's live-view renderer process spent per
+  frame (independent of the load; 1000 / it is what an idle core would give).
 - ``first_picture_s``: seconds from showing the panels to the first picture of every camera
   (the live view's renderer processes start); the phase is measured after it.
 - ``load_average``: the machine's load (1, 5, 15 min) at the end: the figures depend on it.
@@ -56,7 +58,22 @@ def _wait(seconds: float) -> None:
     loop.exec()
 
 
-def _phase(window: Any, shown: bool, seconds: float) -> dict[str, float]:
+def _cpu_seconds(pid: int) -> float | None:
+    """CPU time (user + system) a process has used so far (Linux; None elsewhere)."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return None
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def _renderers(cell: Any) -> dict[str, int]:
+    """Camera -> process id of its live-view renderer (none on a cell without one)."""
+    live = getattr(cell, "live_view", None)
+    return live.pids() if live is not None else {}
+
+
+def _phase(window: Any, shown: bool, seconds: float) -> dict[str, Any]:
     views = window.cell_views
     for name in ("cameras", "scene3d"):
         window.docks[name].setVisible(shown)
@@ -72,6 +89,7 @@ def _phase(window: Any, shown: bool, seconds: float) -> dict[str, float]:
     ticks0, sim0, wall0 = executor.tree.ctx.tick_count, cell.sim.time(), time.perf_counter()
     frames0, drawn0 = views.cameras.frames_shown, views.scene3d.frames_drawn
     seq0 = {name: frame.seq for name, frame in views.cameras.shown.items()}
+    cpu0 = {name: _cpu_seconds(pid) for name, pid in _renderers(cell).items()}
     _wait(seconds)
     wall = time.perf_counter() - wall0
     cameras = max(len(views.cameras.shown), 1)
@@ -86,6 +104,14 @@ def _phase(window: Any, shown: bool, seconds: float) -> dict[str, float]:
             for name, frame in views.cameras.shown.items()
         },
         "first_picture_s": first_picture,
+        # CPU milliseconds each renderer process spent per frame: what a frame costs whatever
+        # the machine's load (1000 / it is the rate one idle core would give).
+        "cpu_ms_per_frame": {
+            name: round(1000 * (cpu - start) / max(frame.seq - seq0.get(name, 0), 1), 1)
+            for name, frame in views.cameras.shown.items()
+            if (start := cpu0.get(name)) is not None
+            and (cpu := _cpu_seconds(_renderers(cell).get(name, -1))) is not None
+        },
     }
 
 
@@ -128,6 +154,7 @@ def measure_cell_views(seconds: float = 6.0) -> dict[str, Any]:
         "sim_speed_off": round(off["sim_speed"], 2),
         "camera_fps_by_camera": on["per_camera"],
         "first_picture_s": round(on["first_picture_s"], 1),
+        "renderer_cpu_ms_per_frame": on["cpu_ms_per_frame"],
         # Others' work on the machine: compare figures only with runs under a similar load.
         "load_average": [round(v, 2) for v in os.getloadavg()],
     }
