@@ -147,6 +147,8 @@ class _Mirror:
                     raise TimeoutError(f"the renderer did not start within {START_TIMEOUT:.0f} s")
             except (EOFError, OSError, TimeoutError) as exc:
                 raise self._stopped(str(exc) or "it ended while starting") from exc
+            if self._closed:  # closed while it started, before it could be killed
+                raise self._stopped("closed")
         return self._conn
 
     def _start(self) -> Connection:
@@ -167,14 +169,26 @@ class _Mirror:
             with contextlib.suppress(subprocess.TimeoutExpired):
                 code = self.process.wait(0.5)
         ended = f" (exit code {code})" if code is not None else ""
+        if self._closed:
+            why = "the live view was closed with the cell"
         self._failure = f"the live view of camera {self.camera.name!r} stopped{ended}: {why}"
         self._shutdown()
         return LiveViewError(self._failure)
 
     def close(self) -> None:
-        with self._lock:
-            self._closed = True
-            self._shutdown()
+        self._closed = True
+        if self._lock.acquire(timeout=1.0):
+            try:
+                self._shutdown()
+            finally:
+                self._lock.release()
+            return
+        # A frame or the start is in flight (a start may take seconds): end the process; the
+        # thread waiting for it reads end-of-file and shuts the rest down.
+        process = self.process
+        if process is not None and process.poll() is None:
+            process.kill()
+            process.wait(2.0)
 
     def _shutdown(self) -> None:
         conn, process, self._conn = self._conn, self.process, None

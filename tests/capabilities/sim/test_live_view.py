@@ -9,6 +9,7 @@ import signal
 import subprocess
 import sys
 import textwrap
+import threading
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -135,3 +136,29 @@ def test_a_crashed_mirror_fails_its_pictures_and_the_cell_goes_on() -> None:
         session.sim.wait_sim(0.1)
         assert session.clock() > now
         assert camera.capture(SIZE).rgb.shape == (240, 320, 3)  # perception's frames go on
+
+
+def test_closing_the_cell_while_a_mirror_starts_ends_it() -> None:
+    session = SimCellSession("cup_to_bin", seed=0)
+    errors: list[Exception] = []
+
+    def watch() -> None:
+        try:
+            session.cameras["shoulder"].preview(SIZE)
+        except LiveViewError as exc:
+            errors.append(exc)
+
+    watcher = threading.Thread(target=watch)
+    watcher.start()
+    assert session.live_view is not None
+    mirror = session.live_view._mirrors["shoulder"]
+    end = time.monotonic() + 10.0
+    while mirror.process is None and time.monotonic() < end:
+        time.sleep(0.01)  # the watcher is starting the mirror process
+    process = mirror.process
+    assert process is not None
+    session.close()  # does not wait for the start to finish
+    watcher.join(30.0)
+    assert not watcher.is_alive()
+    assert process.poll() is not None  # ended and reaped
+    assert len(errors) == 1 and "closed" in str(errors[0])
