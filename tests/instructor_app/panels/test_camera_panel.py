@@ -62,7 +62,10 @@ def test_detections_of_the_world_model_are_outlined_with_class_and_confidence(
     qtbot, panel: CameraPanel, cell: SimCellSession
 ) -> None:
     before = panel.shown["shoulder"].seq
-    plain = panel.feed.latest("shoulder").frame.rgb  # the rendered picture, without overlays
+    assert panel.feed is not None
+    newest = panel.feed.latest("shoulder")
+    assert newest is not None
+    plain = newest.frame.rgb  # the rendered picture, without overlays
     # A detection as the perception operations write it (its pose taken from the truth here,
     # in the test only).
     cell.world_model.replace("test", [Detection("cup", cell.truth_pose("cup"), 0.9, 0.0, "test")])
@@ -84,7 +87,7 @@ def test_pause_stops_capturing_and_snapshot_writes_a_png(
     qtbot, panel: CameraPanel, tmp_path: Path
 ) -> None:
     panel.pause_button.setChecked(True)
-    assert panel.feed.active == frozenset()
+    assert panel.feed is not None and panel.feed.active == frozenset()
     path = panel.snapshot(tmp_path / "cams.png")
     assert path is not None and path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     panel.pause_button.setChecked(False)
@@ -115,7 +118,9 @@ def test_a_region_drawn_on_the_depth_picture_is_saved_in_the_plan_and_read_by_is
         qtbot.mouseRelease(
             viewport, Qt.MouseButton.LeftButton, pos=_viewport_point(panel, "shoulder", u + 25, v)
         )
-    region = document.plan.find(node.id).params["region"].value
+    found = document.plan.find(node.id)
+    assert found is not None
+    region = found.params["region"].value
     assert isinstance(region, Region)
     assert np.linalg.norm(np.subtract(region.center, cup)) < 0.08  # a point on the cup
     assert 0.03 < region.radius < 0.3
