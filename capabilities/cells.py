@@ -1,16 +1,22 @@
-"""Opening a cell by name: what ``costar run --cell NAME`` and the Instructor use."""
+"""Opening a cell by name or cell file: what ``costar run --cell NAME|FILE`` and the Instructor use.
+
+A cell file (``*.cell.json``) with ``"robot": {"kind": "sim"}`` opens the simulated cell with
+that configuration; with ``"robot": {"kind": "ur", "host": ...}`` it connects to that UR
+controller (``capabilities.ur``, imported only then).
+"""
 
 from __future__ import annotations
 
 import time
 from collections.abc import Mapping
+from pathlib import Path
 from types import TracebackType
 from typing import Any
 
 from capabilities.collaboration.console import OperatorConsole
 from capabilities.errors import CapabilityError
 
-__all__ = ["CELL_NAMES", "CellError", "ManagedCell", "open_cell"]
+__all__ = ["CELL_NAMES", "CellError", "ManagedCell", "is_cell_file", "open_cell"]
 
 CELL_NAMES: tuple[str, ...] = ("none", "sim")
 
@@ -69,7 +75,8 @@ def open_cell(
     """The cell called ``name``, as a context manager.
 
     Args:
-        name: "none" (no robot) or "sim" (the pybullet cell; imported only when asked for).
+        name: "none" (no robot), "sim" (the pybullet cell; imported only when asked for) or
+            the path of a cell file (``*.cell.json``).
         seed: randomisation seed of the simulated scene.
         start: begin the cell's threads (the simulated cell always starts: it needs its
             physics thread to answer anything).
@@ -78,6 +85,8 @@ def open_cell(
     """
     if name == "none":
         return ManagedCell()
+    if is_cell_file(name):
+        return _open_cell_file(Path(name), seed, scene, speed)
     if name == "sim":
         try:
             from capabilities.sim.session import SimCellSession
@@ -87,4 +96,37 @@ def open_cell(
             return SimCellSession(scene or "cup_to_bin", seed, speed)
         except Exception as exc:  # scene or model errors: say which, do not crash the CLI/GUI
             raise CellError(f"the simulated cell did not start: {exc}") from exc
-    raise CellError(f"unknown cell {name!r}; cells: {', '.join(CELL_NAMES)}")
+    raise CellError(
+        f"unknown cell {name!r}; cells: {', '.join(CELL_NAMES)}, or a cell file (*.cell.json)"
+    )
+
+
+def is_cell_file(name: str) -> bool:
+    """True when ``name`` names a cell file rather than a built-in cell."""
+    return name not in CELL_NAMES and (name.endswith(".json") or Path(name).exists())
+
+
+def _open_cell_file(path: Path, seed: int, scene: str | None, speed: float | None) -> Any:
+    from capabilities.sim.config import CellConfig, CellConfigError
+
+    try:
+        config = CellConfig.load(path)
+    except CellConfigError as exc:
+        raise CellError(str(exc)) from exc
+    if config.robot.kind == "ur":
+        try:
+            from capabilities.ur.cell import URCellSession
+
+            return URCellSession(config)
+        except ImportError as exc:
+            raise CellError(f"{path}: the UR cell needs ur_rtde: {exc}") from exc
+        except CapabilityError as exc:
+            raise CellError(f"{path}: {exc}") from exc
+    try:
+        from capabilities.sim.session import SimCellSession
+    except ImportError as exc:
+        raise CellError(f"the simulated cell cannot load: {exc}") from exc
+    try:
+        return SimCellSession(scene or "cup_to_bin", seed, speed, config=config)
+    except Exception as exc:
+        raise CellError(f"{path}: the simulated cell did not start: {exc}") from exc

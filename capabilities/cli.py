@@ -20,14 +20,18 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from capabilities.base import CapabilityError, CapabilityRegistry
-from capabilities.cells import CELL_NAMES, CellError, open_cell
+from capabilities.cells import CELL_NAMES, CellError, is_cell_file, open_cell
 from capabilities.collaboration.answers import CONFIRM_MODES, PromptAnswerer
 from capabilities.doctor import cmd_doctor
 from capabilities.shipped_examples import cmd_examples
+from capabilities.xml_commands import add_xml_commands
 from engine.build import BuildError, build_tree
-from engine.events import Event, LogMessage, RunFinished, StatusChanged
+from engine.events import Event, LogMessage, RunFinished, RunHeld, StatusChanged
 from engine.executor import Executor
 from engine.files import PlanFileError, load_plan
+from engine.instances import runtime_paths
+from engine.json_reader import JsonFileError, read_json_file
+from engine.library import Library, library_folder
 from engine.operations import OperationManifest
 from engine.run_report import FailureLog
 from engine.spec import PlanSpec
@@ -59,13 +63,34 @@ def _load(path: str, registry: CapabilityRegistry, err: TextIO) -> PlanSpec | No
         return None
 
 
-def _open(args: argparse.Namespace, err: TextIO, start: bool) -> Any:
-    """The cell the command asked for, or None after saying why it could not be opened."""
+def _plan_scene(path: str) -> str | None:
+    """The simulated scene a plan names (its ``scene``), or None; a file that cannot be read
+    is left to the plan's own load, which says what is wrong with it."""
     try:
-        return open_cell(args.cell, seed=args.seed, start=start, scene=args.scene)
+        scene = read_json_file(path).get("scene")
+    except (JsonFileError, AttributeError):
+        return None
+    return scene if isinstance(scene, str) and scene else None
+
+
+def _open(args: argparse.Namespace, err: TextIO, start: bool) -> Any:
+    """The cell the command asked for, or None after saying why it could not be opened.
+    The simulated cell opens ``--scene``, else the scene the plan was taught on."""
+    plan = getattr(args, "plan", None)
+    scene = args.scene or (_plan_scene(plan) if plan else None)
+    try:
+        return open_cell(args.cell, seed=args.seed, start=start, scene=scene)
     except CellError as exc:
         print(f"error: {exc}", file=err)
         return None
+
+
+def _library(args: argparse.Namespace, err: TextIO) -> Library:
+    """The subtree library (to tell of newer versions); its broken files are named, skipped."""
+    library = Library(library_folder(args.library)).scan()
+    for problem in library.problems:
+        print(f"warning: library file skipped: {problem}", file=err)
+    return library
 
 
 def _cmd_validate(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
@@ -77,7 +102,7 @@ def _cmd_validate(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         plan = _load(args.plan, registry, err)
         if plan is None:
             return EXIT_INVALID
-        problems = validate_plan(plan, registry)
+        problems = validate_plan(plan, registry, _library(args, err))
     _print_problems(args.plan, problems, out)
     if has_errors(problems):
         count = sum(p.severity == "error" for p in problems)
@@ -97,7 +122,7 @@ class _VerbosePrinter:
     """Prints one line per status change (on the dispatcher thread)."""
 
     def __init__(self, plan: PlanSpec, out: TextIO) -> None:
-        self._paths = dict((node.id, path) for path, node in plan.walk())
+        self._paths = runtime_paths(plan)  # instances' insides too
         self._out = out
 
     def __call__(self, event: Event) -> None:
@@ -114,21 +139,43 @@ class _VerbosePrinter:
             print(f"tick {event.tick:>5}  {path}: {event.message}", file=self._out, flush=True)
 
 
+_STOP_SIGNALS = ("SIGINT", "SIGTERM", "SIGHUP")  # Ctrl-C, kill, a closed terminal
+
+
 def _install_interrupt(executor: Executor) -> Callable[[], None]:
-    """Ctrl-C stops the run cleanly (halting what runs); returns a function to undo it."""
-    if threading.current_thread() is threading.main_thread():
-        previous = signal.getsignal(signal.SIGINT)
+    """Ctrl-C, SIGTERM and a closed terminal (SIGHUP) stop the run cleanly, halting what runs;
+    returns a function to undo it."""
+    if threading.current_thread() is not threading.main_thread():
+        return lambda: None
+    signals = [getattr(signal, name) for name in _STOP_SIGNALS if hasattr(signal, name)]
+    previous = {signum: signal.getsignal(signum) for signum in signals}
 
-        def on_interrupt(signum: int, frame: Any) -> None:
-            executor.stop("stopped", timeout=0)
+    def on_stop(signum: int, frame: Any) -> None:
+        executor.stop("stopped", timeout=0)
 
-        signal.signal(signal.SIGINT, on_interrupt)
+    for signum in signals:
+        signal.signal(signum, on_stop)
 
-        def restore() -> None:
-            signal.signal(signal.SIGINT, previous)
+    def restore() -> None:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
 
-        return restore
-    return lambda: None
+    return restore
+
+
+def _print_holds(out: TextIO) -> Callable[[Event], None]:
+    """A listener that says when a run is held by its cell (and when it goes on)."""
+
+    def on_event(event: Event) -> None:
+        if isinstance(event, RunHeld):
+            text = (
+                f"held: {event.reason} (the run goes on once the robot is ready; Ctrl-C stops it)"
+                if event.reason
+                else "the robot is ready: the run goes on"
+            )
+            print(f"tick {event.tick:>5}  {text}", file=out, flush=True)
+
+    return on_event
 
 
 def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
@@ -140,7 +187,7 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         plan = _load(args.plan, registry, err)
         if plan is None:
             return EXIT_INVALID
-        problems = validate_plan(plan, registry)
+        problems = validate_plan(plan, registry, _library(args, err))
         if has_errors(problems):
             _print_problems(args.plan, problems, err)
             print(f"{args.plan}: invalid, not started", file=err)
@@ -151,12 +198,14 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             print(f"error: {exc}", file=err)
             return EXIT_INVALID
         failures = FailureLog(plan)
-        listeners: list[Callable[[Event], None]] = [failures]
+        listeners: list[Callable[[Event], None]] = []
+        if args.trace:  # first: what a line on screen says is already in the trace
+            listeners.append(TraceRecorder(args.trace, plan))
+        listeners += [failures, _print_holds(out)]
         if args.verbose:
             listeners.append(_VerbosePrinter(plan, out))
-        if args.trace:
-            listeners.append(TraceRecorder(args.trace, plan))
-        executor = Executor(tree, args.rate, listeners, plan_name=plan.name)
+        hold = getattr(cell, "hold_reason", None)
+        executor = Executor(tree, args.rate, listeners, plan_name=plan.name, hold=hold)
         restore = _install_interrupt(executor)
         console = cell.interfaces().get("operator")
         answerer = PromptAnswerer(console, args.confirm, args.stdin, out) if console else None
@@ -283,6 +332,15 @@ def _cmd_trace_show(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     return EXIT_SUCCESS
 
 
+def _cell_argument(value: str) -> str:
+    """A built-in cell name or the path of a cell file."""
+    if value in CELL_NAMES or is_cell_file(value):
+        return value
+    raise argparse.ArgumentTypeError(
+        f"{value!r} is not a cell: {', '.join(CELL_NAMES)}, or a cell file (*.cell.json)"
+    )
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="costar", description="CoSTAR task plans from the command line."
@@ -290,10 +348,14 @@ def _parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     def add_cell(p: argparse.ArgumentParser) -> None:
-        p.add_argument("--cell", choices=CELL_NAMES, default="sim", help=CELL_HELP)
+        p.add_argument("--cell", type=_cell_argument, default="sim", help=CELL_HELP)
         p.add_argument("--seed", type=int, default=0, help="scene seed of the simulated cell")
         p.add_argument(
             "--scene", help="scene of the simulated cell (name or path; default cup_to_bin)"
+        )
+        p.add_argument(
+            "--library",
+            help="the subtree library folder (default: $COSTAR_LIBRARY, else the user's)",
         )
 
     validate = sub.add_parser("validate", help="check a plan; exit 0 valid, 2 invalid")
@@ -319,20 +381,28 @@ def _parser() -> argparse.ArgumentParser:
 
     ops = sub.add_parser("ops", help="list every operation with its parameters")
     ops.add_argument("--json", action="store_true")
-    ops.add_argument("--cell", choices=CELL_NAMES, default="sim", help=CELL_HELP)
+    ops.add_argument("--cell", type=_cell_argument, default="sim", help=CELL_HELP)
     ops.set_defaults(func=_cmd_ops)
 
     examples = sub.add_parser("examples", help="list the plans shipped with the application")
     examples.set_defaults(func=cmd_examples)
 
     doctor = sub.add_parser("doctor", help="check this computer can run the Instructor")
+    doctor.add_argument("--cell", help="also check this cell file's robot and cameras")
     doctor.set_defaults(func=cmd_doctor)
+
+    sub.add_parser(  # handled in main(): its own options are the emulator's
+        "ur-emulator",
+        add_help=False,
+        help="a loopback UR controller backed by the simulated cell (--help for its options)",
+    )
 
     trace = sub.add_parser("trace", help="traces of runs")
     trace_sub = trace.add_subparsers(dest="trace_command", required=True)
     show = trace_sub.add_parser("show", help="print a trace as a readable timeline")
     show.add_argument("file")
     show.set_defaults(func=_cmd_trace_show)
+    add_xml_commands(sub, (EXIT_SUCCESS, EXIT_INVALID))
     return parser
 
 
@@ -345,6 +415,14 @@ def main(
     """Entry point of ``costar``; returns the exit code (``inp``: answers to prompts)."""
     out = out or sys.stdout
     err = err or sys.stderr
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv[:1] == ["ur-emulator"]:
+        from capabilities.ur.emulator.__main__ import main as emulator_main
+
+        try:
+            return emulator_main(argv[1:], prog="costar ur-emulator")
+        except SystemExit as exc:  # its argparse: bad arguments or --help
+            return int(exc.code or 0)
     parser = _parser()
     try:
         args = parser.parse_args(argv)

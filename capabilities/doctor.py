@@ -18,9 +18,9 @@ import os
 import subprocess
 import sys
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from typing import TextIO
 
+from capabilities.check_result import CheckResult
 from resources import example_plans, resource_path
 
 __all__ = ["CheckResult", "cell_checks", "checks", "cmd_doctor", "run_checks"]
@@ -30,16 +30,9 @@ PROBE_TIMEOUT = 60.0  # s; a first start of Qt or Mesa on a slow PC can take a w
 INSTALL_HINT = "run bash packaging/install.sh (it installs the system libraries Qt needs)"
 
 
-@dataclass(frozen=True)
-class CheckResult:
-    """What one check found: ``detail`` says what is there (ok) or how to fix it (not ok)."""
-
-    name: str
-    ok: bool
-    detail: str
-
-
-Check = Callable[[], CheckResult]
+# A check returns one result, or several when one probe answers several questions (a robot
+# connection: reachable, version, modes).
+Check = Callable[[], "CheckResult | list[CheckResult]"]
 
 
 def check_python() -> CheckResult:
@@ -169,9 +162,18 @@ def checks(extra: Sequence[Check] = ()) -> list[Check]:
 
 
 def cell_checks(args: argparse.Namespace) -> list[Check]:
-    """The checks of the real cell the command line names (the robot answers, the cameras
-    stream): the hook for ``costar doctor --cell FILE``; none until that option exists."""
-    return []
+    """The checks of the cell file ``--cell`` names: the file, the robot answering, each camera
+    giving a frame (:mod:`capabilities.ur.doctor`, imported only when a cell is named)."""
+    path = getattr(args, "cell", None)
+    if not path:
+        return []
+
+    def check_cell() -> list[CheckResult]:
+        from capabilities.ur.doctor import cell_checks as ur_cell_checks
+
+        return ur_cell_checks(path)
+
+    return [check_cell]
 
 
 def run_checks(to_run: list[Check], out: TextIO) -> int:
@@ -179,12 +181,13 @@ def run_checks(to_run: list[Check], out: TextIO) -> int:
     failed = 0
     for check in to_run:
         try:
-            result = check()
+            found = check()
         except Exception as exc:  # a check that breaks is a failed check, not a crash
-            result = CheckResult(check.__name__, False, f"the check broke: {exc!r}")
-        mark = "ok  " if result.ok else "FIX "
-        print(f"{mark} {result.name}: {result.detail}", file=out, flush=True)
-        failed += not result.ok
+            found = CheckResult(check.__name__, False, f"the check broke: {exc!r}")
+        for result in found if isinstance(found, list) else [found]:
+            mark = "ok  " if result.ok else "FIX "
+            print(f"{mark} {result.name}: {result.detail}", file=out, flush=True)
+            failed += not result.ok
     verdict = "all ok" if not failed else f"{failed} to fix"
     print(f"doctor: {verdict}", file=out)
     return 0 if not failed else 1

@@ -76,6 +76,11 @@ class WorldModel:
         with self._lock:
             return self._markers.get(marker_id)
 
+    def markers(self) -> dict[int, tuple[Pose, float]]:
+        """Every marker seen: id -> (pose in the world, stamp)."""
+        with self._lock:
+            return dict(self._markers)
+
     def clear(self) -> None:
         with self._lock:
             self._by_source.clear()

@@ -7,6 +7,7 @@ cannot build raises :class:`BuildError` naming the node's path.
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
 from engine.blackboard import Blackboard, BlackboardError
@@ -30,6 +31,7 @@ from engine.decorators import (
     Timeout,
 )
 from engine.errors import EngineError
+from engine.instances import ROOT_SCOPE, InputCopy, Scope, SubtreeInstance
 from engine.kinds import settings_of
 from engine.leaves import OperationLeaf, Wait
 from engine.node import Node
@@ -69,35 +71,36 @@ def _policy(value: str | float) -> str | int:
     return value if isinstance(value, str) else int(value)
 
 
-def _logic_node(spec: NodeSpec, ctx: TreeContext) -> Node:
+def _logic_node(spec: NodeSpec, ctx: TreeContext, node_id: str) -> Node:
     simple = _SIMPLE.get(spec.kind)
     if simple is not None:
-        return simple(ctx, spec.id, spec.label)
+        return simple(ctx, node_id, spec.label)
     # The same checks as validation: a Repeat without a count must not become an endless loop.
     cfg = settings_of(spec.kind, spec.params)
     label = spec.label
     factories: dict[NodeKind, Callable[[], Node]] = {
         NodeKind.PARALLEL: lambda: Parallel(
             ctx,
-            spec.id,
+            node_id,
             label,
             ParallelPolicy(_policy(cfg["success"]), _policy(cfg["failure"])),
         ),
         NodeKind.ITERATOR: lambda: Iterator(
-            ctx, spec.id, label, _whole_or_none(cfg["count"]), float(cfg["timeout"]) or None
+            ctx, node_id, label, _whole_or_none(cfg["count"]), float(cfg["timeout"]) or None
         ),
         NodeKind.ENFORCE: lambda: Enforce(
-            ctx, spec.id, label, _whole_or_none(cfg["count"]), float(cfg["timeout"]) or None
+            ctx, node_id, label, _whole_or_none(cfg["count"]), float(cfg["timeout"]) or None
         ),
-        NodeKind.REPEAT: lambda: Repeat(ctx, spec.id, label, int(cfg["count"])),
-        NodeKind.RETRY: lambda: Retry(ctx, spec.id, label, int(cfg["count"])),
-        NodeKind.TIMEOUT: lambda: Timeout(ctx, spec.id, label, float(cfg["seconds"])),
-        NodeKind.WAIT: lambda: Wait(ctx, spec.id, label, float(cfg["seconds"])),
+        NodeKind.REPEAT: lambda: Repeat(ctx, node_id, label, int(cfg["count"])),
+        NodeKind.RETRY: lambda: Retry(ctx, node_id, label, int(cfg["count"])),
+        NodeKind.TIMEOUT: lambda: Timeout(ctx, node_id, label, float(cfg["seconds"])),
+        NodeKind.WAIT: lambda: Wait(ctx, node_id, label, float(cfg["seconds"])),
     }
     return factories[spec.kind]()
 
 
-def _operation_leaf(spec: NodeSpec, ctx: TreeContext, source: OperationSource, path: str) -> Node:
+def _operation_leaf(spec: NodeSpec, build: _Build, path: str, scope: Scope) -> Node:
+    source = build.source
     if not spec.op:
         raise BuildError(path, "an operation node needs an operation id")
     try:
@@ -116,30 +119,78 @@ def _operation_leaf(spec: NodeSpec, ctx: TreeContext, source: OperationSource, p
         binding = spec.params.get(port.name)
         if port.direction is Direction.OUT:
             if binding is not None and binding.ref:
-                outputs[port.name] = binding.ref
+                outputs[port.name] = scope.key(binding.ref)
             continue
         if binding is None:
             if port.default is None:
                 raise BuildError(path, f"parameter {port.name!r} is not set")
             fixed[port.name] = port.default
         elif binding.ref is not None:
-            refs[port.name] = binding.ref
+            refs[port.name] = scope.key(binding.ref)
         else:
             fixed[port.name] = binding.value
     return OperationLeaf(
-        ctx, spec.id, spec.label, manifest.kind, operation, fixed, refs, outputs,
-        ports=manifest.inputs,
+        build.ctx, scope.node_id(spec.id), spec.label, manifest.kind, operation, fixed, refs,
+        outputs, ports=manifest.inputs,
     )  # fmt: skip
 
 
-def _build_node(spec: NodeSpec, ctx: TreeContext, source: OperationSource, path: str) -> Node:
-    try:
-        if spec.kind is NodeKind.OPERATION:
-            node = _operation_leaf(spec, ctx, source, path)
+@dataclass(frozen=True)
+class _Build:
+    """What every node of one build needs."""
+
+    plan: PlanSpec
+    ctx: TreeContext
+    source: OperationSource
+
+
+def _instance(spec: NodeSpec, build: _Build, path: str, scope: Scope) -> Node:
+    """An instance: its inside built in a scope of its own, inputs in and outputs out."""
+    if spec.subtree is None:
+        raise BuildError(path, "a subtree instance needs the subtree it runs")
+    subtree = build.plan.subtree(spec.subtree)
+    if subtree is None:
+        raise BuildError(
+            path, f"the plan holds no subtree {spec.subtree.id!r} version {spec.subtree.version}"
+        )
+    if subtree.ref in scope.stack:
+        raise BuildError(path, f"the subtree {subtree.name!r} holds an instance of itself")
+    if spec.children:
+        raise BuildError(path, "a subtree instance cannot have children")
+    inner = scope.inside(spec, subtree)
+    inputs: list[InputCopy] = []
+    for port in subtree.inputs:
+        binding = spec.params.get(port.name)
+        key = inner.key(port.name)
+        build.ctx.blackboard.declare(key, port.type)
+        if binding is not None and binding.ref is not None:
+            inputs.append(InputCopy(key, source=scope.key(binding.ref)))
+        elif binding is not None and binding.value is not None:
+            inputs.append(InputCopy(key, value=binding.value))
+        elif port.default is not None:
+            inputs.append(InputCopy(key, value=port.default))
         else:
-            node = _logic_node(spec, ctx)
+            raise BuildError(path, f"input {port.name!r} of {subtree.name!r} is not set")
+    outputs = [
+        (inner.key(port.name), scope.key(binding.ref))
+        for port in subtree.outputs
+        if (binding := spec.params.get(port.name)) is not None and binding.ref
+    ]
+    node = SubtreeInstance(build.ctx, scope.node_id(spec.id), spec.label, inputs, outputs)
+    node.set_children([_build_node(subtree.tree, build, f"{path}/{subtree.name}", inner)])
+    return node
+
+
+def _build_node(spec: NodeSpec, build: _Build, path: str, scope: Scope) -> Node:
+    try:
+        if spec.kind is NodeKind.SUBTREE:
+            return _instance(spec, build, path, scope)
+        if spec.kind is NodeKind.OPERATION:
+            node = _operation_leaf(spec, build, path, scope)
+        else:
+            node = _logic_node(spec, build.ctx, scope.node_id(spec.id))
         children = [
-            _build_node(child, ctx, source, f"{path}/{child.label}[{index}]")
+            _build_node(child, build, f"{path}/{child.label}[{index}]", scope)
             for index, child in enumerate(spec.children)
         ]
         if isinstance(node, (OperationLeaf, Wait)):
@@ -181,7 +232,7 @@ def build_tree(
             except BlackboardError as exc:
                 raise BuildError(f"parameters/{decl.name}", str(exc)) from exc
     ctx = TreeContext(board, clock) if clock is not None else TreeContext(board)
-    top = _build_node(plan.tree, ctx, source, plan.tree.label)
+    top = _build_node(plan.tree, _Build(plan, ctx, source), plan.tree.label, ROOT_SCOPE)
     root = Root(ctx, ROOT_ID, plan.name or "root", plan.run_policy)
     root.set_children([top])
     return BehaviorTree(root, ctx)

@@ -15,6 +15,7 @@ __all__ = [
     "BlackboardWritten",
     "LogMessage",
     "RunFinished",
+    "RunHeld",
     "Listener",
 ]
 
@@ -63,5 +64,18 @@ class RunFinished:
     time: float
 
 
-Event = RunStarted | StatusChanged | BlackboardWritten | LogMessage | RunFinished
+@dataclass(frozen=True, slots=True)
+class RunHeld:
+    """The cell cannot act (a protective stop, a lost connection...): the run is held.
+
+    ``reason`` says why in words; an empty reason means the cell is clear again and the run
+    goes on from the nodes that were running.
+    """
+
+    tick: int
+    reason: str
+    time: float
+
+
+Event = RunStarted | StatusChanged | BlackboardWritten | LogMessage | RunFinished | RunHeld
 Listener = Callable[[Event], None]

@@ -4,6 +4,11 @@ The engine thread ticks; when an asynchronous job finishes it wakes the engine, 
 again at once instead of waiting for the next period. Events are queued by the engine
 thread and delivered to listeners by a separate dispatcher thread, so a slow listener
 (a GUI, a file) never holds up a tick.
+
+A cell that can stop on its own (a real robot's protective stop, a lost connection) gives the
+executor a ``hold`` check, asked before every tick: while it names a reason the run is held
+(the running leaves are halted, nothing is ticked, a RunHeld event says why); once it is clear
+again the run goes on, and the composites tick the halted leaves afresh.
 """
 
 from __future__ import annotations
@@ -12,6 +17,7 @@ import collections
 import enum
 import threading
 import time
+from collections.abc import Callable
 
 from engine.events import (
     BlackboardWritten,
@@ -19,6 +25,7 @@ from engine.events import (
     Listener,
     LogMessage,
     RunFinished,
+    RunHeld,
     RunStarted,
     StatusChanged,
 )
@@ -89,6 +96,7 @@ class Executor:
         rate_hz: ticks per second when nothing wakes it earlier (the paper's delta).
         listeners: callables that receive every :mod:`engine.events` event.
         plan_name: for the RunStarted event.
+        hold: asked before every tick; a non-empty answer (why, in words) holds the run.
     """
 
     def __init__(
@@ -97,6 +105,7 @@ class Executor:
         rate_hz: float = 20.0,
         listeners: list[Listener] | None = None,
         plan_name: str = "",
+        hold: Callable[[], str] | None = None,
     ) -> None:
         if rate_hz <= 0:
             raise ValueError(f"rate must be above 0 Hz, not {rate_hz}")
@@ -110,6 +119,8 @@ class Executor:
         self._steps = 0
         self._stop_reason: str | None = None
         self._state = ExecutorState.READY
+        self._hold = hold
+        self._held = ""  # the reason the run is held now ("" when it is not)
         self._result: RunFinished | None = None
         self._done = threading.Event()
         self._dispatcher = _Dispatcher(self._listeners)
@@ -238,6 +249,8 @@ class Executor:
                     reason = stop
                     break
                 next_tick = time.monotonic() + self.period
+                if self._held_now():
+                    continue
                 status = self.tree.tick()
                 if status is not RUNNING:
                     message = self.tree.root.message
@@ -247,6 +260,28 @@ class Executor:
         if status is RUNNING or reason != "finished":
             self._halt_all()
         self._finish(status, reason, message)
+
+    @property
+    def held(self) -> str:
+        """Why the run is held now ("" when it is not)."""
+        return self._held
+
+    def _held_now(self) -> bool:
+        """Ask the hold check; halt the running leaves when a hold begins (engine thread)."""
+        if self._hold is None:
+            return False
+        try:
+            reason = self._hold()
+        except Exception as exc:  # a broken check holds the run rather than ignoring the cell
+            reason = f"the cell's safety check failed: {type(exc).__name__}: {exc}"
+        if reason == self._held:
+            return bool(reason)
+        if reason and not self._held:
+            for leaf in self.tree.running_leaves():
+                leaf.reset()
+        self._held = reason
+        self._dispatcher.put(RunHeld(self.tree.ctx.tick_count, reason, time.monotonic()))
+        return bool(reason)
 
     def _halt_all(self) -> None:
         try:

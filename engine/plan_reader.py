@@ -17,6 +17,7 @@ from engine.plan_format import (
     NODE_FIELDS,
     NODE_FIELDS_V1,
     READABLE_VERSIONS,
+    SUBTREE_FIELDS,
     TOP_FIELDS,
     PlanFileError,
     at,
@@ -32,11 +33,14 @@ from engine.spec import (
     ParameterDecl,
     PlanSpec,
     RunPolicy,
+    SubtreePort,
+    SubtreeRef,
+    SubtreeSpec,
     new_id,
 )
 from engine.types import ParamType, Waypoint
 
-__all__ = ["load_plan", "loads_plan"]
+__all__ = ["load_plan", "loads_plan", "read_subtree"]
 
 V1_WAIT_OP = "timing.wait"  # format 1's operation for what is the Wait node
 
@@ -105,6 +109,7 @@ class _Reader:
                 )
             ),
             reset_cell=self.flag(doc.get("reset_cell", False), "$.reset_cell"),
+            scene=self.text(doc.get("scene", ""), "$.scene"),
         )
         if doc.get("tree") is not None:
             plan.tree = self.node(doc["tree"], "$.tree", 1)
@@ -112,7 +117,64 @@ class _Reader:
         plan.waypoints = self.waypoints(doc.get("waypoints", []), "$.waypoints")
         plan.objects = self.objects(doc.get("objects", []), "$.objects")
         plan.layout = self.layout(doc.get("layout", {"nodes": {}}), "$.layout")
+        for index, item in enumerate(self.items(doc.get("subtrees", []), "$.subtrees", "subtrees")):
+            here = at("$.subtrees", index)
+            subtree = self.subtree(item, here, SUBTREE_FIELDS)
+            if plan.subtree(subtree.ref) is not None:
+                self.fail(here, "each subtree version once", f"{subtree.name!r} a second time")
+            plan.subtrees.append(subtree)
         return plan
+
+    def subtree(self, value: Any, path: str, fields: tuple[str, ...]) -> SubtreeSpec:
+        """A subtree definition; its node ids are a namespace of their own (as in a file)."""
+        obj = self.fields(value, path, fields, ("id", "name", "version", "tree"))
+        outer_ids, self.ids = self.ids, {}
+        try:
+            tree = self.node(obj["tree"], at(path, "tree"), 1)
+        finally:
+            self.ids = outer_ids
+        inputs = self.ports(obj.get("inputs", []), at(path, "inputs"), with_default=True)
+        outputs = self.ports(obj.get("outputs", []), at(path, "outputs"), with_default=False)
+        shared: list[str] = []
+        for index, name in enumerate(
+            self.items(obj.get("shared", []), at(path, "shared"), "names")
+        ):
+            self.unique(name, shared, at(at(path, "shared"), index))
+            shared.append(self.text(name, at(at(path, "shared"), index), nonempty=True))
+        return SubtreeSpec(
+            id=self.text(obj["id"], at(path, "id"), nonempty=True),
+            name=self.text(obj["name"], at(path, "name"), nonempty=True),
+            tree=tree,
+            version=self.at(obj["version"], at(path, "version")).as_integer(lo=1),
+            date=self.text(obj.get("date", ""), at(path, "date")),
+            description=self.text(obj.get("description", ""), at(path, "description")),
+            inputs=inputs,
+            outputs=outputs,
+            shared=shared,
+            layout=self.layout(obj.get("layout", {"nodes": {}}), at(path, "layout")),
+        )
+
+    def ports(self, value: Any, path: str, with_default: bool) -> list[SubtreePort]:
+        ports: list[SubtreePort] = []
+        fields = ("name", "type", "doc", "default") if with_default else ("name", "type", "doc")
+        for index, item in enumerate(self.items(value, path, "ports")):
+            here = at(path, index)
+            obj = self.fields(item, here, fields, ("name", "type"))
+            name = self.text(obj["name"], at(here, "name"), nonempty=True)
+            self.unique(name, [p.name for p in ports], at(here, "name"))
+            ptype = self.ptype(obj["type"], at(here, "type"))
+            raw = obj.get("default")
+            default = None if raw is None else self.value(ptype, raw, at(here, "default"))
+            doc = self.text(obj.get("doc", ""), at(here, "doc"))
+            ports.append(SubtreePort(name, ptype, doc, default))
+        return ports
+
+    def subtree_ref(self, value: Any, path: str) -> SubtreeRef:
+        obj = self.fields(value, path, ("id", "version"), ("id", "version"))
+        return SubtreeRef(
+            self.text(obj["id"], at(path, "id"), nonempty=True),
+            self.at(obj["version"], at(path, "version")).as_integer(lo=1),
+        )
 
     def node(self, value: Any, path: str, depth: int) -> NodeSpec:
         if depth > MAX_TREE_DEPTH:
@@ -134,6 +196,20 @@ class _Reader:
         elif "op" in obj:
             self.fail(
                 at(path, "op"), "no op: only operation nodes have one", f"a {kind.value} node"
+            )
+        if kind is NodeKind.SUBTREE:
+            if "subtree" not in obj:
+                self.fail(
+                    at(path, "subtree"),
+                    'the subtree it runs {"id": ..., "version": ...}',
+                    "nothing",
+                )
+            node.subtree = self.subtree_ref(obj["subtree"], at(path, "subtree"))
+        elif "subtree" in obj:
+            self.fail(
+                at(path, "subtree"),
+                "no subtree: only subtree instances have one",
+                f"a {kind.value} node",
             )
         params = self.mapping(obj.get("params", {}), at(path, "params"), "port -> binding")
         node.params = {
@@ -289,6 +365,23 @@ def loads_plan(
     reader = _Reader(source_name, aliases or {})
     reader.check_format(doc)
     return reader.plan(doc)
+
+
+def read_subtree(
+    doc: Any, file: str, fields: tuple[str, ...], aliases: Mapping[str, str] | None = None
+) -> SubtreeSpec:
+    """A subtree definition from a parsed document (a library file's body).
+
+    Args:
+        doc: the parsed JSON object.
+        file: the file, for error messages.
+        fields: the fields the object may have (the definition's and the file header's).
+        aliases: former operation ids -> current ids.
+
+    Raises:
+        PlanFileError: the document is not a subtree definition.
+    """
+    return _Reader(file, aliases or {}).subtree(doc, "$", fields)
 
 
 def load_plan(path: str | os.PathLike[str], aliases: Mapping[str, str] | None = None) -> PlanSpec:

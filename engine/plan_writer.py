@@ -13,19 +13,23 @@ from engine.plan_format import (
     FORMAT,
     FORMAT_VERSION,
     MAX_TREE_DEPTH,
+    PLAIN_FORMAT_VERSION,
     PlanFileError,
 )
 from engine.spec import (
     Binding,
     NodeKind,
+    NodeLayout,
     NodeSpec,
     ParameterDecl,
     PlanSpec,
     RunPolicy,
+    SubtreePort,
+    SubtreeSpec,
 )
 from engine.types import ParamType, encode_value
 
-__all__ = ["dump_plan", "save_plan", "write_atomic"]
+__all__ = ["dump_json", "dump_plan", "encode_subtree", "save_plan", "write_atomic"]
 
 # --------------------------------------------------------------------------- writing
 
@@ -55,6 +59,8 @@ def _encode_node(node: NodeSpec, depth: int) -> dict[str, Any]:
         out["name"] = node.name
     if node.op is not None:
         out["op"] = node.op
+    if node.subtree is not None:
+        out["subtree"] = {"id": node.subtree.id, "version": node.subtree.version}
     # A binding with neither value nor reference says nothing: leave it out.
     params = {
         p: b
@@ -68,17 +74,43 @@ def _encode_node(node: NodeSpec, depth: int) -> dict[str, Any]:
     return out
 
 
-def _encode_layout(plan: PlanSpec) -> dict[str, Any]:
+def _encode_layout(tree: NodeSpec | None, layout: dict[str, NodeLayout]) -> dict[str, Any]:
     """Tree order first, then entries of nodes not in the tree, by id: one canonical order."""
-    order = [node.id for _, node in plan.walk() if node.id in plan.layout]
-    order += sorted(set(plan.layout) - set(order))
+    walked = tree.walk() if tree is not None else iter(())
+    order = [node.id for _, node in walked if node.id in layout]
+    order += sorted(set(layout) - set(order))
     return {
         node_id: {
-            "x": float(plan.layout[node_id].x),
-            "y": float(plan.layout[node_id].y),
-            "collapsed": bool(plan.layout[node_id].collapsed),
+            "x": float(layout[node_id].x),
+            "y": float(layout[node_id].y),
+            "collapsed": bool(layout[node_id].collapsed),
         }
         for node_id in order
+    }
+
+
+def _encode_port(port: SubtreePort) -> dict[str, Any]:
+    out: dict[str, Any] = {"name": port.name, "type": ParamType(port.type).value}
+    if port.doc:
+        out["doc"] = port.doc
+    if port.default is not None:
+        out["default"] = _encode_typed(port.type, port.default)
+    return out
+
+
+def encode_subtree(subtree: SubtreeSpec) -> dict[str, Any]:
+    """The JSON object of a subtree definition (a plan's "subtrees" entry, a library file's body)."""
+    return {
+        "id": subtree.id,
+        "name": subtree.name,
+        "version": int(subtree.version),
+        "date": subtree.date,
+        "description": subtree.description,
+        "inputs": [_encode_port(port) for port in subtree.inputs],
+        "outputs": [_encode_port(port) for port in subtree.outputs],
+        "shared": list(subtree.shared),
+        "tree": _encode_node(subtree.tree, 1),
+        "layout": {"nodes": _encode_layout(subtree.tree, subtree.layout)},
     }
 
 
@@ -98,25 +130,39 @@ def dump_plan(plan: PlanSpec) -> str:
         PlanFileError: the plan holds a NaN or infinite number, or is deeper than
             :data:`MAX_TREE_DEPTH`.
     """
+    uses_subtrees = bool(plan.subtrees) or any(
+        node.kind is NodeKind.SUBTREE for _, node in plan.walk()
+    )
     doc = {
         "format": FORMAT,
-        "format_version": FORMAT_VERSION,
+        "format_version": FORMAT_VERSION if uses_subtrees else PLAIN_FORMAT_VERSION,
         "id": plan.id,
         "name": plan.name,
         "description": plan.description,
         "run_policy": RunPolicy(plan.run_policy).value,
         **({"reset_cell": True} if plan.reset_cell else {}),
+        **({"scene": plan.scene} if plan.scene else {}),
         "parameters": [_encode_parameter(decl) for decl in plan.parameters],
         "tree": None if plan.tree is None else _encode_node(plan.tree, 1),
         "waypoints": [encode_value(waypoint) for waypoint in plan.waypoints],
         "objects": list(plan.objects),
-        "layout": {"nodes": _encode_layout(plan)},
+        "layout": {"nodes": _encode_layout(plan.tree, plan.layout)},
+        **({"subtrees": [encode_subtree(s) for s in plan.subtrees]} if plan.subtrees else {}),
     }
+    return dump_json(doc, "<plan>")
+
+
+def dump_json(doc: dict[str, Any], what: str) -> str:
+    """Deterministic JSON text (indent 2, trailing newline) of a document.
+
+    Raises:
+        PlanFileError: the document holds a NaN or infinite number.
+    """
     try:
         return json.dumps(doc, indent=2, ensure_ascii=False, allow_nan=False) + "\n"
     except ValueError as exc:
         raise PlanFileError(
-            "<plan>", "", "finite numbers (JSON has no NaN or Infinity)", str(exc)
+            what, "", "finite numbers (JSON has no NaN or Infinity)", str(exc)
         ) from exc
 
 

@@ -20,6 +20,9 @@ from engine.types import ParamType, Waypoint
 __all__ = [
     "NodeKind",
     "Category",
+    "SubtreeRef",
+    "SubtreePort",
+    "SubtreeSpec",
     "KIND_CATEGORY",
     "Binding",
     "NodeSpec",
@@ -60,6 +63,8 @@ class NodeKind(str, enum.Enum):
     FORCE_FAILURE = "force_failure"
     WAIT = "wait"
     OPERATION = "operation"
+    # An instance of a library subtree: one leaf in the plan's tree, expanded when built.
+    SUBTREE = "subtree"
 
 
 KIND_CATEGORY: dict[NodeKind, Category] = {
@@ -78,6 +83,7 @@ KIND_CATEGORY: dict[NodeKind, Category] = {
     NodeKind.FORCE_FAILURE: Category.DECORATOR,
     NodeKind.WAIT: Category.LEAF,
     NodeKind.OPERATION: Category.LEAF,
+    NodeKind.SUBTREE: Category.LEAF,
 }
 
 
@@ -117,9 +123,11 @@ class NodeSpec:
         name: the label users gave it (may be empty: the UI shows the kind or operation).
         id: stable uuid, kept through edits, saves and copies within a document.
         op: operation id, for kind OPERATION.
-        params: port -> binding; the ports of an operation (its manifest) or of a logic
-            node kind (engine.kinds.KIND_PORTS: Parallel policy, counts, timeouts, seconds).
+        params: port -> binding; the ports of an operation (its manifest), of a logic
+            node kind (engine.kinds.KIND_PORTS: Parallel policy, counts, timeouts, seconds)
+            or of a subtree instance (its subtree's declared inputs and outputs).
         children: in tick order.
+        subtree: for kind SUBTREE, which subtree (id and version) the instance runs.
     """
 
     kind: NodeKind
@@ -128,6 +136,7 @@ class NodeSpec:
     op: str | None = None
     params: dict[str, Binding] = field(default_factory=dict)
     children: list[NodeSpec] = field(default_factory=list)
+    subtree: SubtreeRef | None = None
 
     @property
     def category(self) -> Category:
@@ -154,6 +163,79 @@ class NodeSpec:
             if node.id == node_id:
                 return node
         return None
+
+
+@dataclass(frozen=True)
+class SubtreeRef:
+    """Which subtree an instance runs: the subtree's stable id and the version it was made from.
+
+    Attributes:
+        id: the subtree's id (stable through renames and new versions).
+        version: the version the plan embeds; the library may hold a newer one.
+    """
+
+    id: str
+    version: int
+
+
+@dataclass(frozen=True)
+class SubtreePort:
+    """A declared input or output of a subtree (the ports of its instances).
+
+    Attributes:
+        name: the name inside the subtree (a reference its nodes read, or a query writes).
+        type: the value type.
+        doc: one line for the binding form.
+        default: for an input, the value used when an instance leaves it unbound (None:
+            the instance must bind it); outputs have none.
+    """
+
+    name: str
+    type: ParamType
+    doc: str = ""
+    default: Any = None
+
+
+@dataclass
+class SubtreeSpec:
+    """A reusable subtree (paper IV-A): a tree whose open parameters are declared inputs.
+
+    Inside ``tree``, an input is read by reference to its name; a declared output is a name a
+    query inside writes. Every other name the tree reads or writes is private to each
+    instance (its own scope), except the names in ``shared``, which cross scopes on purpose
+    (they are the same name in the plan that holds the instance).
+
+    Attributes:
+        id: stable id (uuid hex for user subtrees; shipped ones keep a readable one).
+        name: what the library and the canvas call it ("Transfer").
+        description: what it does, for the library panel.
+        version: 1 for the first save, +1 each later save to the library.
+        date: when this version was saved, ISO 8601 UTC ("2026-11-24T19:40:00Z").
+        tree: the subtree's nodes.
+        inputs: declared inputs, in binding-form order.
+        outputs: declared outputs.
+        shared: names that cross scopes on purpose.
+        layout: canvas positions of the nodes inside (the engine ignores it).
+    """
+
+    id: str
+    name: str
+    tree: NodeSpec
+    version: int = 1
+    date: str = ""
+    description: str = ""
+    inputs: list[SubtreePort] = field(default_factory=list)
+    outputs: list[SubtreePort] = field(default_factory=list)
+    shared: list[str] = field(default_factory=list)
+    layout: dict[str, NodeLayout] = field(default_factory=dict)
+
+    @property
+    def ref(self) -> SubtreeRef:
+        return SubtreeRef(self.id, self.version)
+
+    def port(self, name: str) -> SubtreePort | None:
+        """The declared input or output called ``name``, or None."""
+        return next((p for p in [*self.inputs, *self.outputs] if p.name == name), None)
 
 
 @dataclass
@@ -185,11 +267,20 @@ class PlanSpec:
     run_policy: RunPolicy = RunPolicy.ONCE
     # Put the cell back to its scene's seed (robot home, objects in place) before each run.
     reset_cell: bool = False
+    # The simulated cell's scene the plan was taught on ("kitting_handoff"); the simulated
+    # cell opens it for this plan unless told otherwise. Empty: the cell's default scene.
+    scene: str = ""
     parameters: list[ParameterDecl] = field(default_factory=list)
     waypoints: list[Waypoint] = field(default_factory=list)
     objects: list[str] = field(default_factory=list)
     layout: dict[str, NodeLayout] = field(default_factory=dict)
     id: str = field(default_factory=new_id)
+    # The definitions its instances run, embedded so that the plan runs without the library.
+    subtrees: list[SubtreeSpec] = field(default_factory=list)
+
+    def subtree(self, ref: SubtreeRef) -> SubtreeSpec | None:
+        """The embedded definition an instance refers to (same id and version), or None."""
+        return next((s for s in self.subtrees if s.id == ref.id and s.version == ref.version), None)
 
     def walk(self) -> Iterator[tuple[str, NodeSpec]]:
         if self.tree is not None:

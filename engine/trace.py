@@ -20,6 +20,7 @@ from engine.events import (
     Event,
     LogMessage,
     RunFinished,
+    RunHeld,
     StatusChanged,
 )
 from engine.json_reader import JsonFileError, parse_json
@@ -75,13 +76,16 @@ def _event_record(event: Event) -> dict[str, Any]:
             "message": event.message,
             "time": event.time,
         }
+    if isinstance(event, RunHeld):
+        return {"event": "held", "tick": event.tick, "reason": event.reason, "time": event.time}
     return {"event": "started", "plan": event.plan, "time": event.time}
 
 
 class TraceRecorder:
     """A listener that writes a run's events to a JSON-lines file.
 
-    It runs on the executor's dispatcher thread, so file writes never delay a tick.
+    It runs on the executor's dispatcher thread, so file writes never delay a tick. Each
+    event is flushed as it is written: a run that is killed leaves its trace up to that moment.
     """
 
     def __init__(self, path: str | os.PathLike[str], plan: PlanSpec | None = None) -> None:
@@ -111,6 +115,7 @@ class TraceRecorder:
         with self._lock:
             if self._file is not None:
                 self._file.write(line + "\n")
+                self._file.flush()
 
     def __call__(self, event: Event) -> None:
         self._write(_event_record(event))
@@ -203,5 +208,8 @@ def format_timeline(trace: Trace) -> Iterable[str]:
         elif kind == "finished":
             tail = f" ({event['message']})" if event.get("message") else ""
             yield f"{head} tick {event['tick']:>5}  run {event['reason']}: {event['status']}{tail}"
+        elif kind == "held":
+            what = f"held: {event['reason']}" if event.get("reason") else "resumed"
+            yield f"{head} tick {event['tick']:>5}  run {what}"
         elif kind == "started":
             yield f"{head} run of {event.get('plan') or 'plan'} started"

@@ -29,6 +29,7 @@ from PySide6.QtCore import QEventLoop, QSettings, QTimer
 from PySide6.QtGui import QIcon
 from PySide6.QtWidgets import QApplication, QWidget
 
+from engine.library import LIBRARY_ENV
 from engine.status import Status
 from instructor_app.document.model import DocumentError
 from instructor_app.main_window import Dialogs, MainWindow
@@ -61,6 +62,9 @@ def _parser() -> argparse.ArgumentParser:
                         help="the cell to work with (default: sim, the simulated cell)")  # fmt: skip
     parser.add_argument("--seed", type=int, default=0, help="scene seed of the simulated cell")
     parser.add_argument("--run", action="store_true", help="run the plan once it is open")
+    parser.add_argument("--library", metavar="FOLDER",
+                        help="the subtree library folder (default: $COSTAR_LIBRARY, else the "
+                        "setting, else the user's)")  # fmt: skip
     parser.add_argument("--screenshot", metavar="PNG",
                         help="render the window to PNG and exit (after the run with --run)")  # fmt: skip
     parser.add_argument("--size", type=_size, default=(1920, 1080), metavar="WxH",
@@ -89,6 +93,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         args = _parser().parse_args(argv)
     except SystemExit as exc:  # argparse exits on --help (0) and on bad arguments (2)
         return int(exc.code or 0)
+    if args.library:  # the option beats the environment and the setting (engine.library)
+        os.environ[LIBRARY_ENV] = args.library
     if args.plan:
         try:
             args.plan = plan_argument(args.plan)
@@ -153,9 +159,7 @@ def _screenshot(args: argparse.Namespace) -> int:
             _grab(window, Path(args.screenshot))
             return code
         finally:
-            window.controller.shutdown()
-            window.cell_views.stop()
-            window.autosaver.stop()
+            window.shutdown()
             window.hide()
             window.deleteLater()
             session.close()

@@ -4,10 +4,14 @@ from __future__ import annotations
 
 from PySide6.QtWidgets import QFileDialog, QMessageBox, QWidget
 
-__all__ = ["APP_TITLE", "CANCEL", "DISCARD", "PLAN_FILTER", "SAVE", "Dialogs"]
+__all__ = [
+    "APP_TITLE", "CANCEL", "CELL_FILTER", "DISCARD", "PLAN_FILTER", "SAVE", "XML_FILTER", "Dialogs",
+]  # fmt: skip
 
 APP_TITLE = "CoSTAR Instructor"
 PLAN_FILTER = "CoSTAR plans (*.costar.json);;JSON files (*.json);;All files (*)"
+CELL_FILTER = "CoSTAR cells (*.cell.json);;JSON files (*.json);;All files (*)"
+XML_FILTER = "BehaviorTree.CPP XML (*.xml);;All files (*)"
 SAVE, DISCARD, CANCEL = "save", "discard", "cancel"
 
 
@@ -47,8 +51,21 @@ class Dialogs:
     def open_path(self, parent: QWidget, folder: str) -> str:
         return QFileDialog.getOpenFileName(parent, "Open plan", folder, PLAN_FILTER)[0]
 
+    def open_cell_path(self, parent: QWidget, folder: str) -> str:
+        return QFileDialog.getOpenFileName(parent, "Open cell file", folder, CELL_FILTER)[0]
+
     def save_path(self, parent: QWidget, suggested: str) -> str:
         return QFileDialog.getSaveFileName(parent, "Save plan as", suggested, PLAN_FILTER)[0]
+
+    def xml_open_path(self, parent: QWidget, folder: str) -> str:
+        return QFileDialog.getOpenFileName(
+            parent, "Import BehaviorTree.CPP XML", folder, XML_FILTER
+        )[0]
+
+    def xml_save_path(self, parent: QWidget, suggested: str) -> str:
+        return QFileDialog.getSaveFileName(
+            parent, "Export as BehaviorTree.CPP XML", suggested, XML_FILTER
+        )[0]
 
     def about(self, parent: QWidget, text: str) -> None:
         QMessageBox.about(parent, f"About {APP_TITLE}", text)

@@ -11,28 +11,34 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtCore import Qt
+from PySide6.QtCore import QSize, Qt
 from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
 from PySide6.QtWidgets import (
     QComboBox,
     QDockWidget,
     QLabel,
     QMainWindow,
+    QScrollArea,
     QStackedWidget,
     QWidget,
 )
 
 from engine.executor import ExecutorState
+from engine.library import library_folder
+from engine.spec import NodeKind
 from instructor_app.dialogs import APP_TITLE, DISCARD, SAVE, Dialogs
 from instructor_app.document.autosave import DEFAULT_INTERVAL_MS, Autosaver, offer_recoveries
 from instructor_app.document.editing import PlanDocument
 from instructor_app.document.model import DocumentError
 from instructor_app.document.tree_ops import can_have_child
+from instructor_app.library_wiring import LibraryController
 from instructor_app.node_factory import make_node, manifest_or_none
 from instructor_app.panels.cell_views import CellViews
 from instructor_app.panels.operator import OperatorPanel
+from instructor_app.panels.scene_teach import SceneTeachLink
 from instructor_app.panels.start_page import StartPage, find_examples
 from instructor_app.runtime.controller import RunController
+from instructor_app.runtime.robot_status import RobotStatusLabel, ScriptRestartButton
 from instructor_app.runtime.run_view import (
     FailureButton,
     RunActions,
@@ -48,8 +54,27 @@ from instructor_app.settings import (
     is_shipped_example,
 )
 from instructor_app.views import Views, make_views
+from instructor_app.xml_files import export_plan_xml, import_plan_xml
+
+OPEN_CELL_FILE = "Open cell file…"
 
 __all__ = ["APP_TITLE", "DISCARD", "Dialogs", "MainWindow", "Views", "make_views"]
+
+
+class _Scrolled(QScrollArea):
+    """A tall panel in a scroll area that asks for no more than a side column's width, so
+    that its tab squeezes neither the inspector nor the palette."""
+
+    def sizeHint(self) -> QSize:
+        hint = super().sizeHint()
+        return QSize(min(hint.width(), 260), hint.height())
+
+
+def _scrolled(widget: QWidget) -> QScrollArea:
+    area = _Scrolled()
+    area.setWidgetResizable(True)
+    area.setWidget(widget)
+    return area
 
 
 class MainWindow(QMainWindow):
@@ -82,13 +107,18 @@ class MainWindow(QMainWindow):
         self.document = PlanDocument(self)
         self.autosaver = Autosaver(self.document, recovery_folder, autosave_interval_ms, self)
         self.controller = RunController(self.document, session, rate_hz=rate_hz, parent=self)
-        self.views: Views = make_views(self.document, session, self)
+        self.views: Views = make_views(self.document, session, self, self.autosaver.folder.parent)
         self.run_actions = RunActions(self.controller, self)
         self.running_panel = RunningNodesPanel(self._node_path, self)
         self.operator_panel = OperatorPanel(self)
         self.failure_button = FailureButton(self._node_label, self)
         self.selection: list[str] = []
         self.cell_views = CellViews(self.document, session, self._selected_node, parent=self)
+        self.library = LibraryController(
+            self.document, self.views, lambda: self.session.registry, self._insertion_point,
+            library_folder(setting=self.settings.library_folder()), self,
+        )  # fmt: skip
+        self.library.message.connect(self.show_message)
         self._build_layout()
         self.actions_by_name: dict[str, QAction] = {}
         self._build_menus()
@@ -111,13 +141,23 @@ class MainWindow(QMainWindow):
         self.docks: dict[str, QDockWidget] = {}
         area = Qt.DockWidgetArea
         self._dock("palette", "Palette", self.views.palette, area.LeftDockWidgetArea)
+        self._dock("move", "Move", _scrolled(self.views.move), area.LeftDockWidgetArea)
+        self._dock("objects", "Objects", self.views.objects, area.LeftDockWidgetArea)
+        self.tabifyDockWidget(self.docks["palette"], self.docks["move"])
+        self.tabifyDockWidget(self.docks["move"], self.docks["objects"])
+        self.docks["palette"].raise_()
         self._dock("inspector", "Inspector", self.views.inspector, area.RightDockWidgetArea)
         # The cell's views; where they go depends on the window's width (arrange_cell_views).
         self._dock("cameras", "Cameras", self.cell_views.cameras, area.RightDockWidgetArea)
         self._dock("scene3d", "3D scene", self.cell_views.scene3d, area.RightDockWidgetArea)
         self._dock("plan", "Plan", self.views.plan_settings, area.RightDockWidgetArea)
-        self._dock("waypoints", "Waypoints", self.views.waypoints, area.RightDockWidgetArea)
+        self._dock(
+            "waypoints", "Waypoints", _scrolled(self.views.waypoints), area.RightDockWidgetArea
+        )
         self._dock("operator", "Operator", self.operator_panel, area.RightDockWidgetArea)
+        self._dock("library", "Library", self.views.library, area.LeftDockWidgetArea)
+        self.tabifyDockWidget(self.docks["palette"], self.docks["library"])
+        self.docks["palette"].raise_()
         self.splitDockWidget(self.docks["inspector"], self.docks["plan"], Qt.Orientation.Vertical)
         self.tabifyDockWidget(self.docks["plan"], self.docks["waypoints"])
         self.tabifyDockWidget(self.docks["waypoints"], self.docks["operator"])
@@ -127,6 +167,7 @@ class MainWindow(QMainWindow):
             ("log", "Log", self.views.log),
             ("blackboard", "Blackboard", self.views.blackboard),
             ("running", "Running nodes", self.running_panel),
+            ("inside", "Inside instance", self.views.inside),
         ]
         for name, title, widget in bottom:
             self._dock(name, title, widget, area.BottomDockWidgetArea)
@@ -145,11 +186,21 @@ class MainWindow(QMainWindow):
         self.cell_label = QLabel(" Cell: ")
         self.cell_combo = QComboBox(self)
         self.cell_combo.setObjectName("CellCombo")
-        self.cell_combo.setToolTip("The cell plans run on: the simulated cell, or none (no robot)")
-        self.cell_combo.addItems(list(self.session.cell_names()))
-        self.cell_combo.setCurrentText(self.session.name)
+        self.cell_combo.setToolTip(
+            "The cell plans run on: the simulated cell, none (no robot), or a cell file"
+        )
+        for name in self.session.cell_names():
+            self.cell_combo.addItem(name, name)
+        self.cell_combo.addItem(OPEN_CELL_FILE, "")  # data "": ask for a file
+        self._show_cell(self.session.name)
+        self.robot_status = RobotStatusLabel(self.session, parent=self)
         self.problems_label = QLabel("")
         # permanent: a temporary status message would hide a normal status-bar widget
+        self.robot_restart = ScriptRestartButton(self.session, self.robot_status, self)
+        self.statusBar().addPermanentWidget(self.robot_restart)
+        self.statusBar().addPermanentWidget(self.robot_status)
+        self.robot_status.setVisible(self.robot_status.present)
+        self.robot_status.presence_changed.connect(self.robot_status.setVisible)
         self.statusBar().addPermanentWidget(self.failure_button)
         self.statusBar().addPermanentWidget(self.problems_label)
 
@@ -202,6 +253,17 @@ class MainWindow(QMainWindow):
         files.addAction(self._action("save", "&Save", self.save_plan, "Ctrl+S"))
         files.addAction(self._action("save_as", "Save &As…", self.save_plan_as, "Ctrl+Shift+S"))
         files.addSeparator()
+        files.addAction(
+            self._action(
+                "export_xml", "&Export BehaviorTree.CPP XML…", lambda: export_plan_xml(self)
+            )
+        )
+        files.addAction(
+            self._action(
+                "import_xml", "&Import BehaviorTree.CPP XML…", lambda: import_plan_xml(self)
+            )
+        )
+        files.addSeparator()
         files.addAction(self._action("quit", "&Quit", self.close, "Ctrl+Q"))
         self._build_edit_menus()
         reset = self._action("reset_cell", "Reset &Cell", self.reset_cell, "Ctrl+R")
@@ -210,6 +272,7 @@ class MainWindow(QMainWindow):
         run_menu.addActions(self.run_actions.all())
         run_menu.addSeparator()
         run_menu.addAction(reset)
+        self.library.fill_menu(bar.addMenu("&Library"))
         help_menu = bar.addMenu("&Help")
         help_menu.addAction(self._action("about", f"&About {APP_TITLE}", self._about))
         toolbar = self.addToolBar("Run")
@@ -251,7 +314,13 @@ class MainWindow(QMainWindow):
         views.canvas.selection_changed.connect(self._on_selection)
         views.canvas.message.connect(self.show_message)
         views.waypoints.message.connect(self.show_message)
+        views.teacher.message.connect(self.show_message)
+        views.objects.message.connect(self.show_message)
         self.cell_views.message.connect(self.show_message)
+        # Drag the tool gizmo in the 3D scene, preview waypoints as a ghost arm there.
+        self.scene_link = SceneTeachLink(
+            self.cell_views.scene3d, views.teacher, views.waypoints, self
+        )
         self.session.cell_changed.connect(lambda _name: self._attach_operator())
         self.operator_panel.prompt_shown.connect(lambda _text: self._raise_dock("operator"))
         self._attach_operator()
@@ -267,7 +336,7 @@ class MainWindow(QMainWindow):
         self.session.cell_changed.connect(self._on_cell_changed)
         self.session.cell_failed.connect(lambda message: self.dialogs.error(self, "Cell", message))
         self.cell_combo.activated.connect(
-            lambda index: self.switch_cell(self.cell_combo.itemText(index))
+            lambda index: self.switch_cell(str(self.cell_combo.itemData(index) or ""))
         )
         document.dirty_changed.connect(lambda _: self._update_title())
         document.path_changed.connect(lambda _: self._update_title())
@@ -278,11 +347,17 @@ class MainWindow(QMainWindow):
     def _wire_run(self) -> None:
         controller, views = self.controller, self.views
         controller.statuses_changed.connect(views.canvas.set_statuses)
+        controller.inner_statuses_changed.connect(views.inside.set_statuses)
         controller.blackboard_written.connect(views.blackboard.set_value)
         controller.log_message.connect(views.log.append)
         controller.running_nodes_changed.connect(self.running_panel.set_nodes)
         controller.failure_changed.connect(self.failure_button.show_failure)
         controller.run_state_changed.connect(self._on_run_state)
+        controller.run_state_changed.connect(
+            lambda state: views.teacher.set_run_active(
+                state not in (ExecutorState.READY, ExecutorState.FINISHED)
+            )
+        )
         self.run_presenter = RunPresenter(
             controller, views.canvas, views.blackboard, views.log, self.show_message, self
         )
@@ -324,6 +399,8 @@ class MainWindow(QMainWindow):
         if not item.available:
             self.show_message(f"{item.label} cannot be used on this cell: {item.reason}")
             return None
+        if item.kind is NodeKind.SUBTREE:  # a library subtree: an instance, its subtree embedded
+            return self.library.insert(item.op)
         node = make_node(item, manifest_or_none(self.session.registry, item.op))
         try:
             parent_id, index = self._insertion_point()
@@ -403,18 +480,33 @@ class MainWindow(QMainWindow):
 
     def reset_cell(self) -> None:
         """Put robot and objects back to the scene's start (not while a plan runs)."""
-        if self.controller.reset_cell():
+        if self.controller.reset_cell(self.document.plan.scene):
             self.views.canvas.clear_statuses()
             self.show_message(f"The {self.session.name} cell was reset")
         else:
             self.show_message("Stop the run before resetting the cell.")
 
+    def _show_cell(self, name: str) -> None:
+        """Select ``name`` in the cell chooser (a cell file gets an entry of its own)."""
+        index = self.cell_combo.findData(name)
+        if index < 0:
+            index = self.cell_combo.count() - 1  # before "Open cell file…"
+            self.cell_combo.insertItem(index, Path(name).name, name)
+            self.cell_combo.setItemData(index, name, Qt.ItemDataRole.ToolTipRole)
+        self.cell_combo.setCurrentIndex(index)
+
     def switch_cell(self, name: str) -> None:
-        """Open another cell (not while a plan runs)."""
+        """Open another cell: a name, a cell file, or "" to ask for one (not while running)."""
+        if not name:
+            folder = str(Path(self.session.name).parent) if Path(self.session.name).suffix else ""
+            name = self.dialogs.open_cell_path(self, folder)
+            if not name:
+                self._show_cell(self.session.name)
+                return
         if name == self.session.name:
             return
         if self.controller.is_running:
-            self.cell_combo.setCurrentText(self.session.name)
+            self._show_cell(self.session.name)
             self.show_message("Stop the run before switching the cell.")
             return
         self.show_message(f"Opening the {name} cell…")
@@ -424,7 +516,7 @@ class MainWindow(QMainWindow):
         self.views.set_registry(registry)
 
     def _on_cell_changed(self, name: str) -> None:
-        self.cell_combo.setCurrentText(name)
+        self._show_cell(name)
         self.show_message(f"Cell in use: {name}")
 
     # ------------------------------------------------------------------ files
@@ -530,12 +622,18 @@ class MainWindow(QMainWindow):
         else:
             self.arrange_cell_views()
 
+    def shutdown(self) -> None:
+        """Stop the run, the robot's teaching commands, background drawing and autosave."""
+        self.controller.shutdown()
+        self.cell_views.stop()
+        self.views.teacher.shutdown()
+        self.views.objects.shutdown()
+        self.autosaver.stop()
+
     def closeEvent(self, event: QCloseEvent) -> None:
         if not self.maybe_save():
             event.ignore()
             return
-        self.controller.shutdown()
-        self.cell_views.stop()
-        self.autosaver.stop()
+        self.shutdown()
         self.settings.save_window(self.saveGeometry(), self.saveState())
         event.accept()

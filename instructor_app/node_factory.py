@@ -97,7 +97,9 @@ def _logic_items() -> list[PaletteItem]:
     items = []
     for category, title in LOGIC_GROUPS.items():
         for kind in NodeKind:
-            if kind is NodeKind.OPERATION or KIND_CATEGORY[kind] is not category:
+            if kind in (NodeKind.OPERATION, NodeKind.SUBTREE):
+                continue  # operations come by capability, subtree instances from the library
+            if KIND_CATEGORY[kind] is not category:
                 continue
             items.append(
                 PaletteItem(kind, None, readable(kind.value), KIND_DOC.get(kind, ""), title)

@@ -37,6 +37,7 @@ DISTRIBUTION = "costar-instructor"
 
 _RECENT = "files/recent"
 _LAST_DIR = "files/last_dir"
+_LIBRARY = "library/folder"
 _GEOMETRY = "window/geometry"
 _STATE = "window/state"
 
@@ -96,6 +97,13 @@ class AppSettings:
 
     def set_last_dir(self, folder: str | Path) -> None:
         self.qsettings.setValue(_LAST_DIR, str(folder))
+
+    def library_folder(self) -> str:
+        """The subtree library folder chosen in the settings ("" when none was)."""
+        return str(self.qsettings.value(_LIBRARY, "") or "")
+
+    def set_library_folder(self, folder: str | Path) -> None:
+        self.qsettings.setValue(_LIBRARY, str(folder))
 
     def save_window(self, geometry: QByteArray, state: QByteArray) -> None:
         self.qsettings.setValue(_GEOMETRY, geometry)

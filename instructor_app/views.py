@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from PySide6.QtGui import QAction
@@ -34,10 +35,16 @@ class Views:
     log: Any
     plan_settings: Any
     waypoints: Any
+    library: Any
+    inside: Any
+    teacher: Any = None  # RobotTeacher: jog, freedrive, move-here off the GUI thread
+    move: Any = None
+    objects: Any = None
 
     def set_registry(self, registry: Any) -> None:
         """Another cell: every view that shows operations rebuilds from its registry."""
-        for view in (self.palette, self.inspector, self.validation, self.waypoints):
+        views = (self.teacher, self.objects, self.palette, self.inspector, self.validation)
+        for view in (*views, self.waypoints):
             view.set_registry(registry)
         self.canvas.set_operation_kinds({m.id: m.kind for m in registry.manifests()})
         operations: dict[str, list[tuple[str, str]]] = {}
@@ -56,21 +63,31 @@ def _item_for(kind: NodeKind, op: str | None) -> PaletteItem:
     return PaletteItem(kind, op, label, "", "")
 
 
-def make_views(document: PlanDocument, session: CellSession, parent: QWidget) -> Views:
-    """Create the canvas and the panels for ``document`` on the session's cell."""
+def make_views(
+    document: PlanDocument, session: CellSession, parent: QWidget, data_folder: Path | None = None
+) -> Views:
+    """Create the canvas and the panels for ``document`` on the session's cell; caches (the
+    object thumbnails) go under ``data_folder`` (default: the user's cache folder)."""
     from instructor_app.canvas import CanvasView
     from instructor_app.panels import (
         BlackboardPanel,
         InspectorPanel,
+        InstanceInsidePanel,
+        LibraryPanel,
         LogPanel,
         PalettePanel,
         PlanSettingsPanel,
         ValidationPanel,
         WaypointsPanel,
     )
+    from instructor_app.panels.move import MovePanel
+    from instructor_app.panels.object_library import ObjectLibraryPanel
+    from instructor_app.panels.object_thumbnails import ThumbnailCache
+    from instructor_app.runtime.teach import RobotTeacher
 
     registry = session.registry
     canvas = CanvasView(document, parent)
+    teacher = RobotTeacher(registry, parent=parent)
     canvas.set_node_factory(
         lambda kind, op: make_node(_item_for(kind, op), manifest_or_none(session.registry, op))
     )
@@ -84,7 +101,16 @@ def make_views(document: PlanDocument, session: CellSession, parent: QWidget) ->
         BlackboardPanel(parent),
         LogPanel(parent=parent),
         PlanSettingsPanel(document, parent),
-        WaypointsPanel(document, registry, parent),
+        WaypointsPanel(document, registry, parent, teacher=teacher),
+        LibraryPanel(parent),
+        InstanceInsidePanel(parent),
+        teacher,
+        MovePanel(teacher, parent),
+        ObjectLibraryPanel(
+            thumbnails=ThumbnailCache(data_folder / "thumbnails") if data_folder else None,
+            parent=parent,
+        ),
     )
+    views.inspector.set_teacher(teacher)
     views.set_registry(registry)
     return views

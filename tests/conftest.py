@@ -66,3 +66,11 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
                 item.add_marker(getattr(pytest.mark, mark))
         if "sim" not in item.keywords and uses_the_sim(item):
             item.add_marker(pytest.mark.sim)
+
+
+@pytest.fixture(autouse=True)
+def _own_subtree_library(
+    tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Tests never read or write the user's subtree library: COSTAR_LIBRARY is a fresh folder."""
+    monkeypatch.setenv("COSTAR_LIBRARY", str(tmp_path_factory.mktemp("library")))

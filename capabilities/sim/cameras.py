@@ -15,11 +15,12 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from capabilities.bullet import pybullet as p
+from capabilities.camera_source import RGBDFrame
 from capabilities.sim.objects import SceneError
 from capabilities.sim.transforms import matrix_to_pose, pose_to_matrix
 from engine.types import Pose
@@ -127,51 +128,6 @@ class LinkMount:
     body_id: int
     link_index: int
     T_link_camera: Pose = WRIST_MOUNT
-
-
-@dataclass(frozen=True, eq=False)
-class RGBDFrame:
-    """One RGB-D image with everything needed to turn it into world points.
-
-    Attributes:
-        rgb: HxWx3 uint8.
-        depth: HxW float32, metres along the optical axis; NaN where nothing was seen.
-        K: 3x3 intrinsics.
-        T_world_camera: the camera (OpenCV frame) in the world.
-        stamp: time of the capture (s; simulation time when the caller gave it).
-        camera: name of the camera.
-    """
-
-    rgb: np.ndarray
-    depth: np.ndarray
-    K: np.ndarray
-    T_world_camera: Pose
-    stamp: float
-    camera: str = ""
-    _cache: dict[int, np.ndarray] = field(default_factory=dict, repr=False, compare=False)
-
-    def _valid(self, stride: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        depth = self.depth[::stride, ::stride]
-        rows, cols = np.nonzero(np.isfinite(depth) & (depth > 0))
-        return rows * stride, cols * stride, depth[rows, cols].astype(np.float64)
-
-    def camera_points(self, stride: int = 1) -> np.ndarray:
-        """Nx3 points in the camera frame (every ``stride``-th pixel with a depth)."""
-        v, u, z = self._valid(stride)
-        fx, fy, cx, cy = self.K[0, 0], self.K[1, 1], self.K[0, 2], self.K[1, 2]
-        return np.column_stack(((u - cx) * z / fx, (v - cy) * z / fy, z))
-
-    def point_cloud(self, stride: int = 1) -> np.ndarray:
-        """Nx3 points in the world frame (every ``stride``-th pixel with a depth)."""
-        if stride not in self._cache:
-            t = pose_to_matrix(self.T_world_camera)
-            self._cache[stride] = self.camera_points(stride) @ t[:3, :3].T + t[:3, 3]
-        return self._cache[stride]
-
-    def point_colors(self, stride: int = 1) -> np.ndarray:
-        """Nx3 uint8 colours of the points of ``point_cloud(stride)``, in the same order."""
-        v, u, _ = self._valid(stride)
-        return self.rgb[v, u]
 
 
 def look_at(

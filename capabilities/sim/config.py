@@ -1,8 +1,11 @@
-"""Configuration of the simulated cell: where things stand, home joints, tool offsets.
+"""The cell file: where things stand, home joints, tool offsets, cameras, and the robot.
 
-Loaded from versioned JSON (``resources/cells/sim_default.json``). The world frame has z up;
-the UR base frame (what the robot's controller calls "base") stands at ``robot_base`` and
-the table top is at ``table_top_z``.
+One file type describes every cell (``*.cell.json``, schema ``resources/schemas/cell.schema
+.json``; the simulated cell's default is ``resources/cells/sim_default.json``). Its ``robot``
+block (``capabilities/cell_robot.py``) says whether the arm is the simulated one or a UR
+controller at a host. The world frame has z up; the UR base frame (what the robot's
+controller calls "base") stands at ``robot_base`` (the mounting) and the table top is at
+``table_top_z``. Format version 2 added ``robot`` and ``objects``; version 1 files still read.
 """
 
 from __future__ import annotations
@@ -11,6 +14,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from capabilities.camera_source import SOURCE_KINDS
+from capabilities.cell_robot import RobotSettings, read_robot
 from capabilities.sim.cameras import SHOULDER_EYE, SHOULDER_TARGET, WRIST_MOUNT, look_at
 from capabilities.sim.errors import SimError
 from engine.json_reader import JsonFileError, JsonReader, read_json_file
@@ -26,7 +31,8 @@ __all__ = [
     "FORMAT_VERSION",
 ]
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
+READABLE_VERSIONS = (1, 2)
 DEFAULT_CONFIG_PATH = resource_path("cells", "sim_default.json")
 
 
@@ -63,6 +69,11 @@ class CameraSettings:
         size: (width, height) of the images in pixels.
         fov_y_deg: vertical field of view in degrees.
         near, far: depth range (m); beyond it depth reads NaN.
+        source: where the frames come from: "sim" (rendered by the simulated cell),
+            "recorded" (a recording folder, ``where``), "stream" (a frame server at ``where``,
+            "host:port") or "realsense" (serial ``where``).
+        where: the recording folder (relative to the cell file), the frame server's address
+            or the RealSense serial.
     """
 
     pose: Pose
@@ -71,6 +82,8 @@ class CameraSettings:
     fov_y_deg: float = 45.0
     near: float = 0.1
     far: float = 3.0
+    source: str = "sim"
+    where: str = ""
 
 
 def _default_cameras() -> dict[str, CameraSettings]:
@@ -100,6 +113,9 @@ class CellConfig:
         stand_size: width and depth (m) of the robot's stand, which reaches from the floor up
             to the robot base.
         cameras: the RGB-D cameras by name ("shoulder", "wrist").
+        robot: the ``robot`` block: the simulated arm, or a UR controller at a host.
+        objects: the object model library folder ("" for ``resources/objects``); a relative
+            path is relative to the cell file.
         capabilities: the raw ``capabilities`` block (capability name -> its settings),
             checked by the capability registry against each capability's declared settings.
         source: the file this configuration was read from ("" when made in code).
@@ -119,6 +135,8 @@ class CellConfig:
     stand_size: tuple[float, float] = (0.2, 0.2)
     cameras: dict[str, CameraSettings] = field(default_factory=_default_cameras)
     capabilities: dict[str, Any] = field(default_factory=dict)
+    robot: RobotSettings = field(default_factory=RobotSettings)
+    objects: str = ""
     source: str = field(default="", compare=False)
 
     @classmethod
@@ -173,21 +191,59 @@ class CellConfig:
                     "fov_y_deg": c.fov_y_deg,
                     "near": c.near,
                     "far": c.far,
+                    **({"source": _source_json(c)} if c.source != "sim" else {}),
                 }
                 for name, c in self.cameras.items()
             },
             "capabilities": self.capabilities,
+            "robot": self.robot.to_json(),
+            **({"objects": self.objects} if self.objects else {}),
         }
+
+    def folder(self) -> Path | None:
+        """The cell file's folder (None for a configuration made in code)."""
+        return Path(self.source).parent if self.source else None
+
+    def objects_path(self) -> Path | None:
+        """The object library folder the file names (None: the default library)."""
+        if not self.objects:
+            return None
+        path = Path(self.objects)
+        return path if path.is_absolute() or not self.source else Path(self.source).parent / path
 
 
 FIELDS: tuple[str, ...] = ("format_version", "_comment", "robot_base", "home_joints", "tcp_offsets")
 FIELDS += ("holster_pose", "handle_grasp", "table", "stand_size", "cameras", "capabilities")
-CAMERA_FIELDS = ("pose", "on_wrist", "size", "fov_y_deg", "near", "far")
+FIELDS += ("robot", "objects")
+CAMERA_FIELDS = ("pose", "on_wrist", "size", "fov_y_deg", "near", "far", "source")
+_WHERE = {"recorded": "path", "realsense": "serial", "stream": "address"}
+
+
+def _source_json(c: CameraSettings) -> dict[str, str]:
+    return {"kind": c.source, _WHERE[c.source]: c.where}
+
+
+def _source(entry: JsonReader, base: CameraSettings) -> tuple[str, str]:
+    """A camera's ``source``: {"kind": "sim"}, {"kind": "recorded", "path": FOLDER},
+    {"kind": "stream", "address": "HOST:PORT"} or {"kind": "realsense", "serial": SERIAL}."""
+    if not entry.has("source"):
+        return base.source, base.where
+    block = entry.child("source", ("kind", "path", "serial", "address"), ("kind",))
+    kind = block.choice("kind", SOURCE_KINDS)
+    if kind == "sim":
+        block.as_object(("kind",))
+        return kind, ""
+    block.as_object(("kind", _WHERE[kind]))
+    if kind == "realsense":
+        return kind, block.text("serial", "")
+    return kind, block.text(_WHERE[kind], nonempty=True)
 
 
 def _config(r: JsonReader) -> CellConfig:
     r.as_object(FIELDS)
-    r.check_version((FORMAT_VERSION,))
+    version = r.check_version(READABLE_VERSIONS)
+    if version == 1:
+        r.as_object(FIELDS[:-2])  # robot and objects came with version 2
     default = CellConfig()
     table = r.child("table", ("size", "center", "top_z"))
     home = r.vector("home_joints", 6, default.home_joints)
@@ -207,6 +263,8 @@ def _config(r: JsonReader) -> CellConfig:
         cameras=_cameras(r, default.cameras),
         # Each capability checks its own block against its settings schema (capabilities.kit).
         capabilities={name: entry.value for name, entry in r.entries("capabilities", "settings")},
+        robot=read_robot(r),
+        objects=r.text("objects", "", nonempty=False),
         source=r.file,
     )
 
@@ -228,6 +286,7 @@ def _cameras(r: JsonReader, default: dict[str, CameraSettings]) -> dict[str, Cam
             fov,
             near,
             far,
+            *_source(entry, base),
         )
     return cameras
 

@@ -20,6 +20,8 @@ from typing import Any
 
 import numpy as np
 
+from capabilities.camera_source import CameraSource
+from capabilities.camera_sources import open_source
 from capabilities.collaboration.console import OperatorConsole
 from capabilities.jobs import WorkerPool
 from capabilities.sim.cameras import (
@@ -161,8 +163,8 @@ class SimCellSession:
                 )
             )  # fmt: skip
             sizes = {"shoulder": shoulder_size, "wrist": wrist_size}
-            self.cameras = {
-                name: SimCameraDevice(self.sim, self._camera(name, settings, sizes.get(name)))
+            self.cameras: dict[str, CameraSource] = {
+                name: self._device(name, settings, sizes.get(name))
                 for name, settings in self.sim.config.cameras.items()
             }
             self.worker = install_scene_worker(self.sim, self.scene, path, seed)
@@ -179,6 +181,14 @@ class SimCellSession:
             self.close()
             raise
 
+    def _device(
+        self, name: str, settings: CameraSettings, size: tuple[int, int] | None
+    ) -> CameraSource:
+        """A rendered camera, or the recorded or real source the cell file names."""
+        if settings.source == "sim":
+            return SimCameraDevice(self.sim, self._camera(name, settings, size))
+        return open_source(name, settings.source, settings.where, self.sim.config.folder())
+
     def _install_live_view(self, recipe: MirrorRecipe) -> None:
         """Give each camera the live view (its mirror starts on the first picture asked)."""
         sim = self.sim
@@ -186,9 +196,9 @@ class SimCellSession:
         def snapshot(known: set[str]) -> Any:
             return sim.call(lambda c: take_snapshot(c, sim.world, self.scene, sim.time(), known))
 
-        cameras = {name: device.camera for name, device in self.cameras.items()}
-        self.live_view = LiveView(recipe, cameras, snapshot)
-        for device in self.cameras.values():
+        rendered = {n: d for n, d in self.cameras.items() if isinstance(d, SimCameraDevice)}
+        self.live_view = LiveView(recipe, {n: d.camera for n, d in rendered.items()}, snapshot)
+        for device in rendered.values():  # a recorded or real source shows its own frames
             device.live = self.live_view
 
     def _camera(

@@ -12,7 +12,7 @@ import logging
 import queue
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from concurrent.futures import Future
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
@@ -42,10 +42,16 @@ class URState:
     tcp: tuple[float, ...] = (0.0,) * 6  # UR base frame, [x, y, z, rx, ry, rz]
     digital_outputs: int = 0
     digital_inputs: int = 0
+    status_bits: int = 0  # robot_status_bits: 0 power on, 1 program running, 2 teach button
     async_running: bool = False
     async_op_id: int = -1
     stamp: float = 0.0
     problem: str = field(default="")
+
+    @property
+    def teach_button(self) -> bool:
+        """The pendant's teach (freedrive) button is held down."""
+        return bool(self.status_bits & 4)
 
     @property
     def moving(self) -> bool:
@@ -83,12 +89,20 @@ class URConnection:
         host: the controller's address.
         tcp: the TCP as ``[x, y, z, rx, ry, rz]`` in the flange frame (sent with setTcp).
         rate: state polls per second.
+        payload: (mass kg, centre of gravity m in the flange frame), set with setPayload.
     """
 
-    def __init__(self, host: str, tcp: list[float] | None = None, rate: float = 125.0) -> None:
+    def __init__(
+        self,
+        host: str,
+        tcp: list[float] | None = None,
+        rate: float = 125.0,
+        payload: tuple[float, Sequence[float]] | None = None,
+    ) -> None:
         self.host = host
         self.version: PolyScopeVersion = (0, 0)
         self._tcp = list(tcp) if tcp is not None else [0.0] * 6
+        self._payload = payload
         self._period = 1.0 / rate
         self.state = URState()
         self._tasks: queue.Queue[Callable[[], None] | None] = queue.Queue()
@@ -206,7 +220,7 @@ class URConnection:
         import rtde_control
 
         if self.control is None:
-            self.control = rtde_control.RTDEControlInterface(self.host)
+            self.control = _control_interface(rtde_control, self.host)
         elif not self.control.isProgramRunning():
             if not self.control.isConnected():
                 self.control.reconnect()
@@ -216,11 +230,22 @@ class URConnection:
                 time.sleep(0.01)
         if any(self._tcp):
             self.control.setTcp(self._tcp)
+        if self._payload is not None and self._payload[0] > 0:
+            self.control.setPayload(self._payload[0], list(self._payload[1]))
         deadline = time.monotonic() + 2.0
         self.refresh()
         while not self.state.program_running and time.monotonic() < deadline:
             time.sleep(0.005)
             self.refresh()
+
+    def reconnect(self) -> None:
+        """(I/O thread) Drop the interfaces and connect afresh (the socket is really gone).
+
+        Raises:
+            Exception: whatever ur_rtde raises while the controller is still away.
+        """
+        self._disconnect()
+        self._connect()
 
     def with_io(self, fn: Callable[[Any], T]) -> T:
         """(I/O thread) ``fn(RTDEIOInterface)`` on an I/O interface opened for this call.
@@ -281,6 +306,7 @@ class URConnection:
             tcp=tuple(receive.getActualTCPPose()),
             digital_outputs=int(receive.getActualDigitalOutputBits()),
             digital_inputs=int(receive.getActualDigitalInputBits()),
+            status_bits=int(receive.getRobotStatus()),
             async_running=async_running,
             async_op_id=op_id,
             stamp=time.monotonic(),
@@ -296,6 +322,24 @@ class URConnection:
                 obj.disconnect()
             except Exception:  # a dead controller: nothing more to close
                 _log.debug("disconnecting %s failed", name, exc_info=True)
+
+
+def _control_interface(module: Any, host: str, attempts: int = 3) -> Any:
+    """ur_rtde's RTDEControlInterface, tried again when its start-up races a script ending.
+
+    At start-up it stops a control script left running by an earlier client through the
+    dashboard; when that script ends on its own in between, "stop" fails ("Failed to
+    execute: stop") and the constructor throws, though a second try finds nothing to stop.
+    """
+    for attempt in range(attempts):
+        try:
+            return module.RTDEControlInterface(host)
+        except RuntimeError as exc:
+            if "stop" not in str(exc) or attempt == attempts - 1:
+                raise
+            _log.info("RTDEControlInterface start-up raced a script ending: %s", exc)
+            time.sleep(0.2)
+    raise AssertionError("unreachable")
 
 
 _POLL: Callable[[], None] = lambda: None  # noqa: E731  (marks a poll turn of the loop)

@@ -1,4 +1,5 @@
-"""Digital I/O of a UR cell: a suction cup switched by a digital output (SuctionBackend).
+"""Digital I/O of a UR cell: a suction cup switched by a digital output (SuctionBackend), and
+digital inputs and the pendant's teach button read as operator buttons (a foot pedal).
 
 Outputs are set through ur_rtde's RTDEIOInterface on the connection's I/O thread; what the
 outputs and inputs are is read from the controller's state (``actual_digital_output_bits``:
@@ -16,7 +17,7 @@ from capabilities.ur.connection import URConnection, fault_reason
 from capabilities.ur.errors import URError
 from engine.types import Pose
 
-__all__ = ["DigitalPin", "URSuctionCup"]
+__all__ = ["DigitalPin", "TeachButtonReleased", "URDigitalInput", "URSuctionCup"]
 
 _BANK_SHIFT = {"standard": 0, "configurable": 8, "tool": 16}
 _SETTERS = {
@@ -118,6 +119,48 @@ class URSuctionCup:
 
     def holstered_tip_pose(self) -> Pose:
         raise URError("this cell's suction cup is mounted on the flange: it has no holster")
+
+
+class URDigitalInput:
+    """One digital input of the controller (a DigitalInputSource: a foot pedal).
+
+    It reads the state snapshot the connection's I/O thread keeps: never a call into ur_rtde.
+    """
+
+    def __init__(self, connection: URConnection, pin: DigitalPin) -> None:
+        self._conn = connection
+        self.pin = pin
+
+    def read(self) -> bool:
+        return bool(self._conn.state.digital_inputs & self.pin.bit)
+
+
+class TeachButtonReleased:
+    """High while the pendant's teach button is not held: its rising edge is the release that
+    ends a hand-guided move, when the operator wants the waypoint recorded.
+
+    A monitor on the I/O thread latches every state that shows the button held, so a short
+    press between two reads of the button's poller still reads low once.
+    """
+
+    def __init__(self, connection: URConnection) -> None:
+        self._conn = connection
+        self._held_seen = False
+        connection.watch(self._watch)
+
+    def _watch(self, conn: URConnection) -> bool:
+        if conn.state.teach_button:
+            self._held_seen = True
+        return False  # for the connection's lifetime
+
+    def read(self) -> bool:
+        state = self._conn.state
+        if state.teach_button:
+            return False
+        if self._held_seen:
+            self._held_seen = False
+            return False
+        return state.connected
 
 
 if TYPE_CHECKING:

@@ -24,8 +24,9 @@ __all__ = ["CanvasActions", "NodeFactory", "default_node_factory", "LOGIC_KINDS"
 
 NodeFactory = Callable[[NodeKind, "str | None"], NodeSpec]
 
-# What "Add child" offers first: every kind but operations (those follow, by capability).
-LOGIC_KINDS = tuple(kind for kind in NodeKind if kind is not NodeKind.OPERATION)
+# What "Add child" offers first: every kind but operations (those follow, by capability) and
+# subtree instances (those come from the library).
+LOGIC_KINDS = tuple(kind for kind in NodeKind if kind not in (NodeKind.OPERATION, NodeKind.SUBTREE))
 
 _SHORTCUTS: dict[str, tuple[str, QKeySequence | QKeySequence.StandardKey | str]] = {
     "delete": ("Delete", QKeySequence.StandardKey.Delete),

@@ -43,6 +43,8 @@ _OPERATION_FILL: dict[OperationKind, RGB] = {
     OperationKind.CONDITION: (170, 226, 220),
 }
 
+_SUBTREE_FILL: RGB = (246, 214, 160)  # an instance of a library subtree: one node
+
 _SYMBOLS: dict[NodeKind, str] = {
     NodeKind.SEQUENCE: "->",
     NodeKind.SELECTOR: "?",
@@ -136,6 +138,12 @@ def look_of(
         return NodeLook(title, "", subtitle, (), _DECORATOR_FILL, (120, 120, 120), False)
     if node.kind is NodeKind.WAIT:
         return NodeLook(title, "", _config_text(node), (), _WAIT_FILL, _WAIT_FILL, True)
+    if node.kind is NodeKind.SUBTREE:
+        version = f"version {node.subtree.version}" if node.subtree else "no subtree"
+        return NodeLook(
+            title, "[ ]", f"subtree, {version}", _param_lines(node), _SUBTREE_FILL,
+            (200, 140, 60), True,
+        )  # fmt: skip
     fill = _OPERATION_FILL.get(
         op_kind or OperationKind.ACTION, _OPERATION_FILL[OperationKind.ACTION]
     )

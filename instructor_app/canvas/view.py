@@ -8,7 +8,7 @@ so undo and redo are the document's.
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 
 from PySide6.QtCore import QMimeData, QPoint, QPointF, QRectF, Signal
 from PySide6.QtGui import QAction
@@ -81,6 +81,9 @@ class CanvasView(QWidget):
         self.commands.message.connect(self.message)
 
     # ------------------------------------------------------------------ public API
+
+    # (subtree id, parent id or None) -> the new instance's id; set by the library's wiring.
+    instance_inserter: Callable[[str, str | None], str] | None = None
 
     def set_node_factory(self, factory: NodeFactory | None) -> None:
         """How palette drops and "Add child" make nodes: ``factory(kind, op) -> NodeSpec``."""
@@ -289,7 +292,13 @@ class CanvasView(QWidget):
             return
         target = self.viewer.node_item_at(scene_pos)
         try:
-            if target is not None:
+            if kind is NodeKind.SUBTREE:  # a library subtree: its instance comes with it
+                if self.instance_inserter is None or not op:
+                    raise DocumentError("this canvas has no subtree library")
+                if target is None and self.document.plan.tree is not None:
+                    raise DocumentError("drop the subtree onto the node that should hold it")
+                self.select(self.instance_inserter(op, target.id if target else None))
+            elif target is not None:
                 if not can_have_child(self.document.node(target.id)):
                     raise DocumentError(
                         f"{self.document.node(target.id).label!r} cannot take a child"

@@ -23,6 +23,7 @@ __all__ = [
     "RenameCommand",
     "SetLayoutCommand",
     "SetPlanFieldCommand",
+    "ReplaceNodeCommand",
 ]
 
 
@@ -160,6 +161,7 @@ class SetPlanFieldCommand(_Command):
         "parameters",
         "waypoints",
         "objects",
+        "subtrees",
     )
 
     def __init__(self, document: PlanModel, field: str, value: Any) -> None:
@@ -175,3 +177,33 @@ class SetPlanFieldCommand(_Command):
 
     def undo(self) -> None:
         self.document.apply_plan_field(self.field, copy.deepcopy(self.old))
+
+
+class ReplaceNodeCommand(_Command):
+    """Put another node (with its subtree) where a node is: nodes <-> a subtree instance."""
+
+    def __init__(
+        self,
+        document: PlanModel,
+        node_id: str,
+        node: NodeSpec,
+        layout: dict[str, NodeLayout] | None = None,
+        text: str = "",
+    ) -> None:
+        _, _, old = document.locate(node_id)
+        super().__init__(document, text or f"Replace {old.label}")
+        self.old_id = node_id
+        self.node = node
+        ids = {n.id for _, n in node.walk()}
+        self.layout = {k: v for k, v in (layout or {}).items() if k in ids}
+        self.saved: NodeSpec | None = None
+        self.saved_layout: dict[str, NodeLayout] = {}
+
+    def redo(self) -> None:
+        self.saved, self.saved_layout = self.document.replace_node(
+            self.old_id, copy.deepcopy(self.node), self.layout
+        )
+
+    def undo(self) -> None:
+        assert self.saved is not None
+        self.document.replace_node(self.node.id, self.saved, self.saved_layout)

@@ -15,6 +15,7 @@ from PySide6.QtGui import QUndoStack
 
 from engine.files import PlanFileError, load_plan, loads_plan, save_plan
 from engine.spec import Binding, NodeLayout, NodeSpec, PlanSpec
+from engine.types import ParamType, Waypoint
 from instructor_app.document import tree_ops
 from instructor_app.document.commands import (
     AddNodeCommand,
@@ -113,6 +114,41 @@ class PlanDocument(PlanModel):
     def set_plan_field(self, field: str, value: Any) -> None:
         self._push(SetPlanFieldCommand(self, field, value))
 
+    def replace_waypoint(
+        self, old_name: str, new: Waypoint, text: str = "", bind: tuple[str, str] | None = None
+    ) -> None:
+        """Put ``new`` in place of the plan's waypoint ``old_name`` (appended when there is
+        none) and into every fixed binding that holds that waypoint, and bind it to the
+        port ``bind`` = (node id, port) if given: one undo step."""
+        waypoints = list(self.plan.waypoints)
+        names = [w.name for w in waypoints]
+        if new.name != old_name and new.name in names:
+            raise DocumentError(f"there is already a waypoint {new.name!r}")
+        if old_name in names:
+            waypoints[names.index(old_name)] = new
+        else:
+            waypoints.append(new)
+        bound = [
+            (node.id, port, binding)
+            for _, node in self.plan.walk()
+            for port, binding in node.params.items()
+            if not binding.is_ref
+            and isinstance(binding.value, Waypoint)
+            and binding.value.name == old_name
+            and (node.id, port) != bind
+        ]
+        if bind is not None:
+            bound.append((bind[0], bind[1], Binding.fixed(new, ParamType.WAYPOINT)))
+        self.undo_stack.beginMacro(text or f"Change the waypoint {old_name!r}")
+        try:
+            self.set_plan_field("waypoints", waypoints)
+            for node_id, port, binding in bound:
+                self.set_param(
+                    node_id, port, Binding.fixed(new, binding.type or ParamType.WAYPOINT)
+                )
+        finally:
+            self.undo_stack.endMacro()
+
     def paste(self, text: str, parent_id: str | None, index: int | None = None) -> str:
         """Insert clipboard text (from :meth:`subtree_json`) with fresh ids; returns the new id."""
         try:
@@ -122,7 +158,15 @@ class PlanDocument(PlanModel):
         if fragment.tree is None:
             raise DocumentError("the clipboard holds no plan nodes")
         clone, layout = tree_ops.fresh_copy(fragment.tree, fragment.layout)
-        return self.add_node(clone, parent_id, index, layout)
+        missing = [s for s in fragment.subtrees if self.plan.subtree(s.ref) is None]
+        if not missing:
+            return self.add_node(clone, parent_id, index, layout)
+        self.undo_stack.beginMacro(f"Paste {clone.label}")  # its instances' subtrees come too
+        try:
+            self._push(SetPlanFieldCommand(self, "subtrees", [*self.plan.subtrees, *missing]))
+            return self.add_node(clone, parent_id, index, layout)
+        finally:
+            self.undo_stack.endMacro()
 
     def duplicate(self, node_id: str) -> str:
         """A copy of the node placed right after it."""

@@ -16,6 +16,7 @@ from PySide6.QtCore import QObject, Signal
 
 from engine.files import dump_plan
 from engine.spec import Binding, NodeLayout, NodeSpec, PlanSpec
+from engine.subtree_ops import subtrees_in_use
 from instructor_app.document import tree_ops
 from instructor_app.errors import InstructorError
 
@@ -91,6 +92,7 @@ class PlanModel(QObject):
         fragment = PlanSpec(
             tree=node, name=SUBTREE_FORMAT,
             layout={k: v for k, v in self.plan.layout.items() if k in ids},
+            subtrees=subtrees_in_use(node, self.plan.subtrees),  # what its instances run
         )  # fmt: skip
         return dump_plan(fragment)
 
@@ -114,6 +116,15 @@ class PlanModel(QObject):
         self.node_removed.emit(parent_id or "", index, ids)
         self.plan_changed.emit()
         return node, layout
+
+    def replace_node(
+        self, node_id: str, node: NodeSpec, layout: dict[str, NodeLayout]
+    ) -> tuple[NodeSpec, dict[str, NodeLayout]]:
+        """Put ``node`` where ``node_id`` is; returns the old node and its layout."""
+        parent_id, index, _ = self.locate(node_id)
+        old, old_layout = self.detach_node(node_id)
+        self.insert_node(node, parent_id, index, layout)
+        return old, old_layout
 
     def relocate_node(self, node_id: str, parent_id: str | None, index: int) -> None:
         """Move a node to ``index`` under ``parent_id`` (None: as the root)."""

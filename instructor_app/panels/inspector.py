@@ -9,6 +9,7 @@ The panel follows the document: a change of the shown node refreshes the rows in
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 from PySide6.QtCore import QStringListModel, Qt
 from PySide6.QtWidgets import (
@@ -21,6 +22,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from engine.instances import instance_manifest
 from engine.kinds import KIND_DOC, KIND_PORTS
 from engine.operations import Direction, OperationSource, PortSpec
 from engine.spec import Binding, NodeKind, NodeSpec
@@ -30,7 +32,14 @@ from instructor_app.document import DocumentError, PlanDocument
 from instructor_app.inspectors.base import EditorContext
 from instructor_app.inspectors.factory import type_names
 from instructor_app.inspectors.rows import MODE_REFERENCE, PortRow
+from instructor_app.inspectors.teach_buttons import (
+    TeachButtons,
+    is_teachable,
+    move_target,
+    taught_value,
+)
 from instructor_app.node_factory import manifest_or_none, readable
+from instructor_app.runtime.waypoint_teach import TeachError
 
 __all__ = ["InspectorPanel"]
 
@@ -57,6 +66,8 @@ class InspectorPanel(QWidget):
         self._last_context = EditorContext()
         self._problems: list[Problem] = []
         self._field_labels: dict[str, QLabel] = {}
+        self._teacher: Any = None  # RobotTeacher: Teach and Move here under Pose/Waypoint ports
+        self.teach_buttons: dict[str, TeachButtons] = {}
         self._build()
         document.node_changed.connect(self._node_changed)
         document.node_removed.connect(self._node_removed)
@@ -112,6 +123,11 @@ class InspectorPanel(QWidget):
         self._registry = registry
         self.show_node(self._node_id)
 
+    def set_teacher(self, teacher: Any) -> None:
+        """The robot that Teach reads and Move here drives (None: no such buttons)."""
+        self._teacher = teacher
+        self.show_node(self._node_id)
+
     def set_object_names(self, names: Sequence[str]) -> None:
         """Names the ObjectModel fields offer (e.g. ``ObjectLibrary().names()``)."""
         self._object_names = list(names)
@@ -165,6 +181,7 @@ class InspectorPanel(QWidget):
             self.form.removeRow(0)
         self._port_rows.clear()
         self._field_labels.clear()
+        self.teach_buttons.clear()
 
     def _add_row(self, name: str, text: str, tip: str, row: QWidget) -> None:
         label = QLabel(text)
@@ -201,6 +218,8 @@ class InspectorPanel(QWidget):
         self._names.setStringList(self.parameter_names())
         if node.kind is NodeKind.OPERATION:
             self._layout_operation(node)
+        elif node.kind is NodeKind.SUBTREE:
+            self._layout_instance(node)
         else:
             self.kind_label.setText(f"<b>{readable(node.kind.value)}</b>")
             self.doc_label.setText(KIND_DOC.get(node.kind, ""))
@@ -222,6 +241,17 @@ class InspectorPanel(QWidget):
         self.doc_label.setText(manifest.doc)
         self._add_port_rows(manifest.ports)
 
+    def _layout_instance(self, node: NodeSpec) -> None:
+        """An instance's binding form: its subtree's inputs and outputs are its ports."""
+        subtree = self.document.plan.subtree(node.subtree) if node.subtree else None
+        if subtree is None:
+            self.kind_label.setText("<b>Subtree missing</b>")
+            self.doc_label.setText("This plan does not hold the subtree this instance runs.")
+            return
+        self.kind_label.setText(f"<b>Subtree {subtree.name}</b> (version {subtree.version})")
+        self.doc_label.setText(subtree.description)
+        self._add_port_rows(instance_manifest(subtree).ports)
+
     def _add_port_rows(self, ports: tuple[PortSpec, ...]) -> None:
         """One row per port, of an operation or of a logic node kind: one row type for both."""
         context = self._last_context = self._context()
@@ -234,6 +264,8 @@ class InspectorPanel(QWidget):
             text = f"{arrow}{port.name}" + (f" [{unit}]" if unit else "")
             tip = f"{port.doc}\n{type_names(port.types)}" + (f", in {unit}" if unit else "")
             self._add_row(port.name, text, tip, row)
+            if self._teacher is not None and is_teachable(port):
+                self._add_teach_buttons(port)
 
     def _refresh(self, node: NodeSpec) -> None:
         """Show the node's current values in the existing rows."""
@@ -241,6 +273,8 @@ class InspectorPanel(QWidget):
             self.name_field.setText(node.name)
         for port, row in self._port_rows.items():
             row.load(node.params.get(port))
+        for buttons in self.teach_buttons.values():
+            buttons.update_enabled()
 
     def _update_context(self) -> None:
         context = self._context()
@@ -249,6 +283,46 @@ class InspectorPanel(QWidget):
         self._last_context = context
         for row in self._port_rows.values():
             row.set_context(context)
+
+    def _add_teach_buttons(self, port: PortSpec) -> None:
+        def target() -> tuple[Any, Any] | None:
+            node = self._find(self._node_id)
+            params = node.params if node is not None else {}
+            return move_target(params.get(port.name), params.get("reference"))
+
+        def by_name() -> bool:
+            node = self._find(self._node_id)
+            binding = node.params.get(port.name) if node is not None else None
+            return binding is not None and binding.is_ref
+
+        buttons = TeachButtons(self._teacher, lambda: self.teach(port.name), target, by_name)
+        self.teach_buttons[port.name] = buttons
+        self.form.addRow("", buttons)
+
+    def teach(self, port: str) -> bool:
+        """Fill ``port`` of the shown node from where the robot is now (one undo step)."""
+        node = self._find(self._node_id)
+        row = self._port_rows.get(port)
+        if node is None or row is None or self._teacher is None:
+            return False
+        names = [w.name for w in self.document.plan.waypoints]
+        interfaces = {name: self._teacher.interface(name) for name in ("arm", "world")}
+        try:
+            waypoint, binding = taught_value(
+                interfaces, row.port, node.params.get(port), node.name, names, row.value_type
+            )
+        except TeachError as exc:
+            self._teacher.message.emit(f"Cannot teach {port}: {exc}.")
+            return False
+        if waypoint is None:
+            self.document.set_param(node.id, port, binding)
+        else:
+            old = node.params.get(port)
+            old_name = old.value.name if old is not None and not old.is_ref else waypoint.name
+            self.document.replace_waypoint(
+                old_name, waypoint, f"Teach {waypoint.name!r}", bind=(node.id, port)
+            )
+        return True
 
     # ------------------------------------------------------------------ document -> view
 

@@ -184,6 +184,8 @@ class PalettePanel(QWidget):
         layout.addWidget(self.tree)
         layout.addWidget(self.hits)
         self._items: list[PaletteItem] = []
+        self._extra: list[PaletteItem] = []
+        self._registry: OperationSource | None = None
         if registry is not None:
             self.set_registry(registry)
 
@@ -191,7 +193,8 @@ class PalettePanel(QWidget):
 
     def set_registry(self, registry: OperationSource) -> None:
         """Rebuild the list from a (new) cell's registry, keeping the search text."""
-        self._items = palette_items(registry)
+        self._registry = registry
+        self._items = palette_items(registry) + self._extra
         docs = {c.name: c.doc for c in getattr(registry, "capabilities", [])}
         self.tree.clear()
         groups: dict[str, QTreeWidgetItem] = {}
@@ -201,6 +204,12 @@ class PalettePanel(QWidget):
             groups[item.group].addChild(self._item_row(item))
         self.tree.expandAll()
         self._filter(self.search_field.text())
+
+    def set_extra_items(self, items: list[PaletteItem]) -> None:
+        """Entries beyond the registry's (the library's subtrees), listed after them."""
+        self._extra = list(items)
+        if self._registry is not None:
+            self.set_registry(self._registry)
 
     def items(self) -> list[PaletteItem]:
         """Every item, shown or filtered out."""

@@ -8,7 +8,7 @@ come from the world model, the point cloud from the camera panel's latest frame,
 simulation's ground truth (a labelled toggle, for checking perception by eye) is fetched on a
 worker thread.
 
-API for other panels (see /work/issues/COORD-scene3d.md): :meth:`Scene3DPanel.show_ghost`,
+API for other panels: :meth:`Scene3DPanel.show_ghost`,
 :meth:`Scene3DPanel.set_gizmo` and the signals ``gizmo_dragged``, ``gizmo_released``,
 ``point_picked`` and ``region_drawn``.
 """

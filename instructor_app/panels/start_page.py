@@ -13,11 +13,13 @@ from pathlib import Path
 from PySide6.QtCore import QPointF, QRectF, QSize, Qt, Signal
 from PySide6.QtGui import QColor, QIcon, QPainter, QPen, QPixmap
 from PySide6.QtWidgets import (
+    QFrame,
     QHBoxLayout,
     QLabel,
     QListWidget,
     QListWidgetItem,
     QPushButton,
+    QScrollArea,
     QToolButton,
     QVBoxLayout,
     QWidget,
@@ -140,17 +142,27 @@ class StartPage(QWidget):
         self.recent_list.itemActivated.connect(self._open_item)
         self.recent_list.itemDoubleClicked.connect(self._open_item)
         self.example_buttons: list[QToolButton] = []
-        examples_row = QHBoxLayout()
+        # One row that scrolls sideways: more examples must not widen the window.
+        strip = QWidget()
+        examples_row = QHBoxLayout(strip)
+        examples_row.setContentsMargins(0, 0, 0, 0)
         for example in examples:
             examples_row.addWidget(self._example_button(example))
         examples_row.addStretch(1)
+        self.examples_area = QScrollArea()
+        self.examples_area.setWidget(strip)
+        self.examples_area.setWidgetResizable(True)
+        self.examples_area.setFrameShape(QFrame.Shape.NoFrame)
+        self.examples_area.setVerticalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        bar = self.examples_area.horizontalScrollBar().sizeHint().height()
+        self.examples_area.setFixedHeight(strip.sizeHint().height() + bar + 4)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(40, 30, 40, 30)
         layout.addWidget(title)
         layout.addLayout(buttons)
         layout.addSpacing(16)
         layout.addWidget(QLabel("<b>Examples</b>"))
-        layout.addLayout(examples_row)
+        layout.addWidget(self.examples_area)
         layout.addSpacing(16)
         self.recent_title = QLabel("<b>Recent plans</b>")
         layout.addWidget(self.recent_title)

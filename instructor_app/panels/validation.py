@@ -11,7 +11,7 @@ from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtWidgets import QStyle, QTreeWidget, QTreeWidgetItem, QVBoxLayout, QWidget
 
 from engine.operations import OperationSource
-from engine.validation import ERROR, Problem, validate_plan
+from engine.validation import ERROR, Problem, SubtreeSource, validate_plan
 from instructor_app.document import PlanDocument
 
 __all__ = ["ValidationPanel", "DEBOUNCE_MS"]
@@ -57,6 +57,13 @@ class ValidationPanel(QWidget):
         document.plan_changed.connect(self._timer.start)
         self.revalidate()
 
+    _library: SubtreeSource | None = None
+
+    def set_library(self, library: SubtreeSource | None) -> None:
+        """The subtree library: instances of subtrees it has newer versions of are shown."""
+        self._library = library
+        self.revalidate()
+
     def set_registry(self, registry: OperationSource) -> None:
         """Validate against another cell's operations (at once)."""
         self._registry = registry
@@ -73,7 +80,7 @@ class ValidationPanel(QWidget):
     def revalidate(self) -> None:
         """Validate now (the timer calls this after edits pause)."""
         self._timer.stop()
-        self._problems = validate_plan(self.document.plan, self._registry)
+        self._problems = validate_plan(self.document.plan, self._registry, self._library)
         self._show()
         errors = sum(1 for p in self._problems if p.severity == ERROR)
         self.summary_changed.emit(errors, len(self._problems) - errors)

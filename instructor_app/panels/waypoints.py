@@ -1,10 +1,13 @@
 """The plan's waypoints (``PlanSpec.waypoints``): the list the inspector's waypoint fields offer.
 
-A worker teaches a waypoint by moving the arm (freedrive) and pressing Record: the panel
-reads the arm's measured joints or tool pose from the cell, or, for a "smart waypoint", the
-tool pose in the frame of an object the cell has seen. Waypoints taught earlier come in from
-a waypoint file (``*.waypoints.json``, :class:`capabilities.waypoints.WaypointLibrary`).
-Every change of the list is one document command (``set_plan_field("waypoints", ...)``).
+A worker teaches a waypoint by moving the arm (freedrive, jogging) and pressing Record: the
+panel reads the arm's measured joints or tool pose from the cell, or, for a "smart waypoint",
+the tool pose in the frame of the object or marker the cell recognised nearest to the tool
+(or the one named). The selected waypoint can be renamed, its numbers edited, taught again
+where the arm is now, previewed, and driven to with the held Move here button (at reduced
+speed; let go and the arm stops, as on PolyScope). Waypoints taught earlier come in from a
+waypoint file (``*.waypoints.json``, :class:`capabilities.waypoints.WaypointLibrary`).
+Every change is one document command; a changed waypoint also changes the nodes using it.
 """
 
 from __future__ import annotations
@@ -26,13 +29,15 @@ from PySide6.QtWidgets import (
 )
 
 from capabilities.waypoints import WaypointFileError, WaypointLibrary
-from engine.types import JointConfig, Waypoint, WaypointFrame
-from instructor_app.document import PlanDocument
+from engine.types import Waypoint, WaypointFrame
+from instructor_app.document import DocumentError, PlanDocument
+from instructor_app.panels.waypoint_details import WaypointDetails
+from instructor_app.runtime.waypoint_teach import TeachError, teach_like, teach_waypoint
 
 __all__ = ["WaypointsPanel", "WAYPOINT_FILTER", "PathAsker"]
 
 WAYPOINT_FILTER = "CoSTAR waypoints (*.waypoints.json);;JSON files (*.json);;All files (*)"
-RECORD_FRAMES = ("joints", "world", "object")
+RECORD_FRAMES = ("joints", "world", "object", "marker")
 
 PathAsker = Callable[[QWidget], str]
 
@@ -46,14 +51,23 @@ def _describe(waypoint: Waypoint) -> str:
     return f"{waypoint.name} ({waypoint.frame.value}{where})"
 
 
+def _button(text: str, tip: str, name: str = "") -> QPushButton:
+    button = QPushButton(text)
+    button.setToolTip(tip)
+    if name:
+        button.setObjectName(name)
+    return button
+
+
 class WaypointsPanel(QWidget):
-    """Lists, records, imports and removes the plan's waypoints.
+    """Lists, records, edits, imports, removes and drives to the plan's waypoints.
 
     Args:
         document: the plan being edited.
         registry: the cell's registry; its cell's ``arm`` interface is what Record reads
-            (Record is disabled without one), ``world`` gives object poses.
+            (Record is disabled without one), ``world`` gives recognised objects and markers.
         ask_path: asks for the waypoint file to import ("" = cancelled); tests replace it.
+        teacher: moves the robot (Move here); None: no Move here.
 
     Signals:
         message(str): what happened, or why not (for the status bar).
@@ -67,52 +81,81 @@ class WaypointsPanel(QWidget):
         registry: Any = None,
         parent: QWidget | None = None,
         ask_path: PathAsker = _ask_waypoint_file,
+        teacher: Any = None,
     ) -> None:
         super().__init__(parent)
         self.document = document
         self.ask_path = ask_path
+        self.teacher = teacher
+        self.scene: Any = None  # the 3D scene that previews (a ghost arm), when there is one
         self._interfaces: dict[str, Any] = {}
         self._build()
         document.plan_changed.connect(self._refresh)
         document.plan_reset.connect(self._refresh)
+        if teacher is not None:
+            teacher.availability_changed.connect(self._update_enabled)
+            teacher.preview_ready.connect(self._show_ghost)
         self.set_registry(registry)
         self._refresh()
 
     def _build(self) -> None:
         self.list = QListWidget()
-        self.list.currentRowChanged.connect(lambda _row: self._update_enabled())
+        self.list.currentRowChanged.connect(lambda _row: self._selection_changed())
+        self.list.itemDoubleClicked.connect(self._focus_name)
         self.name_field = QLineEdit()
         self.name_field.setPlaceholderText("new waypoint's name")
         self.name_field.returnPressed.connect(self.record_from_fields)
         self.frame_combo = QComboBox()
         self.frame_combo.addItems(list(RECORD_FRAMES))
         self.frame_combo.setToolTip(
-            "joints: the joint positions; world: the tool pose; object: the tool pose "
-            "relative to the object named below, where the cell last saw it"
+            "joints: the joint positions; world: the tool pose; object / marker: the tool "
+            "pose relative to the recognised object (marker) nearest the tool, or the one named"
         )
         self.frame_combo.currentTextChanged.connect(lambda _t: self._update_enabled())
         self.object_field = QLineEdit()
-        self.object_field.setPlaceholderText("object, e.g. cup")
-        self.record_button = QPushButton("Record")
-        self.record_button.setToolTip("Record where the arm is now (move it by hand first)")
+        self.object_field.setPlaceholderText("nearest recognised")
+        self.object_field.setToolTip("An object class (cup) or marker id; empty: the nearest")
+        self.record_button = _button("Record", "Record where the arm is now (move it first)")
         self.record_button.clicked.connect(self.record_from_fields)
-        self.import_button = QPushButton("Import…")
-        self.import_button.setToolTip("Add the waypoints of a *.waypoints.json file")
+        self.details = WaypointDetails()
+        self.details.edited.connect(self._details_edited)
+        self.teach_button = _button("Teach", "Teach the selected waypoint again, here")
+        self.teach_button.clicked.connect(self.teach_selected)
+        self.move_button = _button(
+            "Move here",
+            "Hold down to drive the arm to the selected waypoint at reduced speed; "
+            "let go and it stops",
+            "WaypointMoveHere",
+        )
+        self.move_button.pressed.connect(self._move_pressed)
+        self.move_button.released.connect(self._move_released)
+        self.preview_button = _button("Preview", "Show the arm at the waypoint in the 3D scene")
+        self.preview_button.setCheckable(True)
+        self.preview_button.toggled.connect(lambda _on: self._preview())
+        self.import_button = _button("Import…", "Add the waypoints of a *.waypoints.json file")
         self.import_button.clicked.connect(self._import_asked)
-        self.remove_button = QPushButton("Remove")
+        self.remove_button = _button("Remove", "Remove the selected waypoint")
         self.remove_button.clicked.connect(self.remove_selected)
-        record_row = QHBoxLayout()
-        for widget in (self.frame_combo, self.object_field, self.record_button):
-            record_row.addWidget(widget)
-        buttons = QHBoxLayout()
-        buttons.addWidget(self.import_button)
-        buttons.addWidget(self.remove_button)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(2, 2, 2, 2)
+        # What a worker uses most comes first: record, the list, drive there; then details.
+        layout.addLayout(self._row(self.name_field, self.record_button))
+        layout.addLayout(self._row(self.frame_combo, self.object_field))
         layout.addWidget(self.list, 1)
-        layout.addWidget(self.name_field)
-        layout.addLayout(record_row)
-        layout.addLayout(buttons)
+        layout.addLayout(self._row(self.move_button, self.teach_button, self.preview_button))
+        layout.addWidget(self.details)
+        layout.addLayout(self._row(self.import_button, self.remove_button))
+
+    def _focus_name(self, _item: object) -> None:
+        self.details.name_edit.setFocus()
+        self.details.name_edit.selectAll()
+
+    @staticmethod
+    def _row(*widgets: QWidget) -> QHBoxLayout:
+        row = QHBoxLayout()
+        for widget in widgets:
+            row.addWidget(widget)
+        return row
 
     # ------------------------------------------------------------------ public
 
@@ -122,22 +165,33 @@ class WaypointsPanel(QWidget):
         self._interfaces = dict(cell.interfaces()) if cell is not None else {}
         self._update_enabled()
 
+    def set_scene(self, scene: Any) -> None:
+        """The 3D scene whose ghost arm (``show_ghost(joints | None)``) previews the selected
+        waypoint; None or a scene without OpenGL: no preview."""
+        self.scene = scene if scene is not None and getattr(scene, "available", True) else None
+        self._update_enabled()
+
     def waypoint_names(self) -> list[str]:
         return [w.name for w in self.document.plan.waypoints]
 
+    def selected(self) -> Waypoint | None:
+        row = self.list.currentRow()
+        waypoints = self.document.plan.waypoints
+        return waypoints[row] if 0 <= row < len(waypoints) else None
+
+    def select(self, name: str) -> None:
+        if name in self.waypoint_names():
+            self.list.setCurrentRow(self.waypoint_names().index(name))
+
     def record(self, name: str, frame: str = "joints", reference: str = "") -> Waypoint | None:
         """Add (or replace) a waypoint where the arm is now; None with a message when not."""
-        name = name.strip()
-        if not name:
-            self.message.emit("Type a name for the waypoint first.")
+        try:
+            waypoint = teach_waypoint(self._interfaces, name, WaypointFrame(frame), reference)
+        except TeachError as exc:
+            self.message.emit(f"{str(exc)[:1].upper()}{str(exc)[1:]}.")
             return None
-        arm = self._interfaces.get("arm")
-        if arm is None:
-            self.message.emit("This cell has no arm to record from.")
-            return None
-        waypoint = self._waypoint_here(arm, name, WaypointFrame(frame), reference.strip())
-        if waypoint is not None:
-            self._store([waypoint], f"Recorded {_describe(waypoint)}")
+        self._store([waypoint], f"Recorded {_describe(waypoint)}")
+        self.select(waypoint.name)
         return waypoint
 
     def record_from_fields(self) -> None:
@@ -147,6 +201,19 @@ class WaypointsPanel(QWidget):
         )
         if done is not None:
             self.name_field.clear()
+
+    def teach_selected(self) -> Waypoint | None:
+        """Teach the selected waypoint again where the arm is now (same frame, reference)."""
+        current = self.selected()
+        if current is None:
+            return None
+        try:
+            taught = teach_like(self._interfaces, current)
+        except TeachError as exc:
+            self.message.emit(f"Cannot teach {current.name!r}: {exc}.")
+            return None
+        self._replace(current.name, taught, f"Taught {_describe(taught)} again")
+        return taught
 
     def import_file(self, path: str | Path) -> int:
         """Add a waypoint file's waypoints (same names are replaced); how many, 0 on error."""
@@ -171,23 +238,6 @@ class WaypointsPanel(QWidget):
 
     # ------------------------------------------------------------------ internals
 
-    def _waypoint_here(
-        self, arm: Any, name: str, frame: WaypointFrame, reference: str
-    ) -> Waypoint | None:
-        if frame is WaypointFrame.JOINTS:
-            return Waypoint(name, frame, joints=JointConfig(tuple(arm.joint_positions())))
-        tool = arm.tcp_pose()
-        if frame is WaypointFrame.WORLD:
-            return Waypoint(name, frame, pose=tool)
-        world = self._interfaces.get("world")
-        seen = world.best(reference) if world is not None and reference else None
-        if seen is None:
-            self.message.emit(
-                f"The cell has not seen {reference or 'that object'}: detect it first."
-            )
-            return None
-        return Waypoint(name, frame, pose=seen.pose.inverse().compose(tool), reference=reference)
-
     def _store(self, waypoints: Sequence[Waypoint], text: str) -> None:
         """Replace same-named waypoints in place, append the others: one command."""
         by_name = {w.name: w for w in waypoints}
@@ -197,10 +247,54 @@ class WaypointsPanel(QWidget):
             self.document.set_plan_field("waypoints", merged)
         self.message.emit(text)
 
+    def _replace(self, old_name: str, new: Waypoint, text: str) -> bool:
+        try:
+            self.document.replace_waypoint(old_name, new, text)
+        except DocumentError as exc:
+            self.message.emit(f"Cannot change {old_name!r}: {exc}")
+            self.details.show_waypoint(self.selected())
+            return False
+        self.select(new.name)
+        self.message.emit(text)
+        return True
+
+    def _details_edited(self, waypoint: object) -> None:
+        current = self.selected()
+        if current is not None and isinstance(waypoint, Waypoint):
+            self._replace(current.name, waypoint, f"Changed {_describe(waypoint)}")
+
+    def _move_pressed(self) -> None:
+        waypoint = self.selected()
+        if waypoint is not None and self.teacher is not None:
+            self.teacher.hold_move_to(waypoint, "", f"move to {waypoint.name}")
+
+    def _move_released(self) -> None:
+        if self.teacher is not None:
+            self.teacher.release()
+
+    def _preview(self) -> None:
+        """The ghost arm at the selected waypoint (worked out on the teacher's worker)."""
+        if self.scene is None or self.teacher is None:
+            return
+        waypoint = self.selected() if self.preview_button.isChecked() else None
+        if waypoint is None:
+            self.scene.show_ghost(None)
+        else:
+            self.teacher.preview(waypoint)
+
+    def _show_ghost(self, joints: object) -> None:
+        if self.scene is not None and self.preview_button.isChecked():
+            self.scene.show_ghost(joints)
+
     def _import_asked(self) -> None:
         path = self.ask_path(self)
         if path:
             self.import_file(path)
+
+    def _selection_changed(self) -> None:
+        self.details.show_waypoint(self.selected())
+        self._preview()
+        self._update_enabled()
 
     def _refresh(self) -> None:
         shown = [_describe(w) for w in self.document.plan.waypoints]
@@ -209,9 +303,18 @@ class WaypointsPanel(QWidget):
             self.list.clear()
             self.list.addItems(shown)
             self.list.setCurrentRow(min(row, len(shown) - 1))
+        self.details.show_waypoint(self.selected())
         self._update_enabled()
 
     def _update_enabled(self) -> None:
+        chosen = self.selected() is not None
         self.record_button.setEnabled("arm" in self._interfaces)
-        self.object_field.setEnabled(self.frame_combo.currentText() == "object")
-        self.remove_button.setEnabled(self.list.currentRow() >= 0)
+        self.object_field.setEnabled(self.frame_combo.currentText() in ("object", "marker"))
+        self.remove_button.setEnabled(chosen)
+        self.teach_button.setEnabled(chosen and "arm" in self._interfaces)
+        reason = self.teacher.unavailable_reason("arm") if self.teacher else "no robot to move"
+        self.move_button.setEnabled(chosen and not reason)
+        self.move_button.setToolTip(
+            reason.capitalize() if reason else "Hold down to drive the arm to the waypoint"
+        )
+        self.preview_button.setEnabled(chosen and self.scene is not None)

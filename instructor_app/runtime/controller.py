@@ -66,6 +66,8 @@ class RunController(QObject):
         run_finished(object): a :class:`RunOutcome`.
         run_refused(list): the validation problems (or a build error) that kept it from starting.
         failure_changed(str, str): the deepest failing node and its message ("" "": none).
+        inner_statuses_changed(object): runtime id ("instance/inner") -> Status inside subtree
+            instances; None when a new run starts.
     """
 
     # object, not dict: a dict signal goes through QVariantMap and turns Status into str.
@@ -76,6 +78,8 @@ class RunController(QObject):
     running_nodes_changed = Signal(list)
     run_finished = Signal(object)
     run_refused = Signal(list)
+    # runtime id ("instance/inner") -> Status of nodes inside subtree instances; None: a new run
+    inner_statuses_changed = Signal(object)
     failure_changed = Signal(str, str)
 
     def __init__(
@@ -174,10 +178,13 @@ class RunController(QObject):
 
     # ------------------------------------------------------------------ starting
 
-    def reset_cell(self) -> bool:
-        """Put the cell back to its start (see CellSession.reset); False while a plan runs."""
+    def reset_cell(self, scene: str = "") -> bool:
+        """Put the cell back to its start (see CellSession.reset); False while a plan runs.
+        ``scene``: the simulated scene to start from instead (the plan's own)."""
         if self.is_running:
             return False
+        if scene and self.session.name == "sim":
+            self.session.scene = scene
         self.session.reset()
         self.log_message.emit(f"The {self.session.name} cell was reset", "info")
         return True
@@ -185,7 +192,7 @@ class RunController(QObject):
     def _start(self, paused: bool) -> bool:
         plan = copy.deepcopy(self.document.plan)  # edits during the run do not reach it
         if plan.reset_cell:
-            self.reset_cell()
+            self.reset_cell(plan.scene)
         registry = self.session.registry
         problems = validate_plan(plan, registry)
         if has_errors(problems):
@@ -199,7 +206,10 @@ class RunController(QObject):
         for problem in problems:
             self.log_message.emit(str(problem), "warning")
         self._reset_run(plan)
-        self._executor = Executor(tree, self.rate_hz, [self._pump.put], plan_name=plan.name)
+        hold = getattr(self.session.cell, "hold_reason", None)  # a real robot's stops
+        self._executor = Executor(
+            tree, self.rate_hz, [self._pump.put], plan_name=plan.name, hold=hold
+        )
         self._executor.start(paused=paused)
         self._timer.start()
         self._set_state(ExecutorState.PAUSED if paused else ExecutorState.RUNNING)
@@ -217,6 +227,7 @@ class RunController(QObject):
         self._stopping = False
         self._set_failure("", "")
         self._statuses.update({node_id: Status.IDLE for node_id in self._order})
+        self.inner_statuses_changed.emit(None)
 
     # ------------------------------------------------------------------ GUI thread
 
@@ -230,6 +241,9 @@ class RunController(QObject):
             if k in self._order and not (self._stopping and v is Status.IDLE)
         }
         self._statuses.update(changed)
+        inside = {k: v for k, v in batch.statuses.items() if "/" in k}  # inside instances
+        if inside:
+            self.inner_statuses_changed.emit(inside)
         self._messages.update({k: v for k, v in batch.messages.items() if k in self._order})
         if changed:
             self.statuses_changed.emit(changed)
@@ -243,6 +257,11 @@ class RunController(QObject):
             self._finish(batch.finished)
 
     def _emit_logs(self, batch: Batch) -> None:
+        for reason in batch.holds:
+            if reason:
+                self.log_message.emit(f"The robot stopped the run: {reason}", "error")
+            else:
+                self.log_message.emit("The robot is ready again: the run goes on", "info")
         for node_id, message in batch.logs:
             self.log_message.emit(f"{self._label(node_id)}: {message}", "info")
         for node_id, message in batch.failures:

@@ -18,6 +18,7 @@ from engine.events import (
     Event,
     LogMessage,
     RunFinished,
+    RunHeld,
     RunStarted,
     StatusChanged,
 )
@@ -39,6 +40,7 @@ class Batch:
         logs: (node id, message) in order.
         finished: the RunFinished event, if the run ended.
         started: whether a RunStarted event arrived.
+        holds: why the cell held the run, in order ("" when it went on again).
     """
 
     statuses: dict[str, Status] = field(default_factory=dict)
@@ -48,10 +50,14 @@ class Batch:
     logs: list[tuple[str, str]] = field(default_factory=list)
     finished: RunFinished | None = None
     started: bool = False
+    holds: list[str] = field(default_factory=list)
 
     @property
     def empty(self) -> bool:
-        return not (self.statuses or self.writes or self.logs or self.finished or self.started)
+        return not (
+            self.statuses or self.writes or self.logs or self.finished or self.started
+            or self.holds
+        )  # fmt: skip
 
 
 class EventPump:
@@ -92,3 +98,5 @@ def _merge(batch: Batch, event: Event) -> None:
         batch.finished = event
     elif isinstance(event, RunStarted):
         batch.started = True
+    elif isinstance(event, RunHeld):
+        batch.holds.append(event.reason)

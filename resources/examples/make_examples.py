@@ -13,7 +13,16 @@ from typing import Any
 
 from engine.files import save_plan
 from engine.kinds import setting
-from engine.spec import Binding, NodeKind, NodeSpec, ParameterDecl, PlanSpec, RunPolicy
+from engine.spec import (
+    Binding,
+    NodeKind,
+    NodeSpec,
+    ParameterDecl,
+    PlanSpec,
+    RunPolicy,
+    SubtreePort,
+    SubtreeSpec,
+)
 from engine.types import ParamType, Pose
 
 HERE = Path(__file__).resolve().parent
@@ -144,6 +153,40 @@ def _one(
         parameters=parameters or [],
         id=uuid.uuid5(_NAMESPACE, example).hex,
     )
+
+
+def _subtree_example() -> PlanSpec:
+    """Two instances of one subtree, each with its own target, each keeping its own GOAL."""
+    inner = _Maker("subtree/inside")
+    go_to = SubtreeSpec(
+        "examples.go_to", "Go to",
+        inner.node(
+            NodeKind.SEQUENCE, "Go to",
+            inner.op("query", "find", value=Binding.reference("TARGET"), result=Binding.reference("GOAL")),
+            inner.op("pretend_move", "go", target=Binding.reference("GOAL")),
+            inner.op("set_param", "report", value=Binding.reference("GOAL"), name=Binding.reference("REACHED")),
+        ),
+        version=1, date="2026-11-24T00:00:00Z",
+        description="Finds where to go (a private GOAL) and goes there.",
+        inputs=[SubtreePort("TARGET", ParamType.POSE, "where to go")],
+        outputs=[SubtreePort("REACHED", ParamType.ANY, "where it went")],
+    )  # fmt: skip
+    m = _Maker("subtree")
+
+    def visit(name: str, x: float, out: str) -> NodeSpec:
+        params = {"TARGET": _fixed(Pose((x, 0.1, 0.2)), ParamType.POSE),
+                  "REACHED": Binding.reference(out)}  # fmt: skip
+        return NodeSpec(NodeKind.SUBTREE, name, m.ids(), params=params, subtree=go_to.ref)
+
+    tree = m.node(
+        NodeKind.SEQUENCE, "two visits", visit("left", 0.3, "LEFT"), visit("right", 0.5, "RIGHT")
+    )
+    return PlanSpec(
+        tree, "Subtree instances",
+        "One subtree used twice with different targets: each instance keeps its own GOAL and "
+        "passes out where it went. Runs to SUCCESS.",
+        RunPolicy.ONCE, id=uuid.uuid5(_NAMESPACE, "subtree").hex, subtrees=[go_to],
+    )  # fmt: skip
 
 
 def node_examples() -> dict[str, PlanSpec]:
@@ -351,6 +394,7 @@ def node_examples() -> dict[str, PlanSpec]:
             "A predicate that is false. Runs to FAILURE.",
             lambda m: m.op("condition", "door closed", result=_fixed(False, ParamType.BOOL)),
         ),
+        "subtree": _subtree_example(),
     }
 
 

@@ -155,9 +155,11 @@ def test_unknown_command_exits_2() -> None:
     assert code == 2
 
 
-def test_ctrl_c_halts_cleanly_and_exits_3(tmp_path: Path) -> None:
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
+def test_ctrl_c_sigterm_and_sighup_halt_cleanly_and_exit_3(tmp_path: Path, signum: int) -> None:
     tree = _op("debug.running", ticks=Binding.fixed(100_000, ParamType.NUMBER))
     plan = _save(tmp_path, tree)
+    trace = tmp_path / "run.trace.jsonl"
     proc = subprocess.Popen(
         [
             sys.executable,
@@ -170,6 +172,8 @@ def test_ctrl_c_halts_cleanly_and_exits_3(tmp_path: Path) -> None:
             "--verbose",
             "--rate",
             "50",
+            "--trace",
+            str(trace),
         ],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
@@ -179,7 +183,8 @@ def test_ctrl_c_halts_cleanly_and_exits_3(tmp_path: Path) -> None:
         assert proc.stdout is not None
         first = proc.stdout.readline()  # the run has started once a status line is printed
         assert "RUNNING" in first
-        proc.send_signal(signal.SIGINT)
+        assert "RUNNING" in trace.read_text()  # written as the run goes, not at its end
+        proc.send_signal(signum)
         rest, err = proc.communicate(timeout=20)
     finally:
         if proc.poll() is None:

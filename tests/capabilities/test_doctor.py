@@ -77,3 +77,18 @@ def test_costar_doctor_exits_0_on_this_machine() -> None:
     lines = done.stdout.splitlines()
     assert len(lines) == 6 and all(line.startswith("ok   ") for line in lines[:5])
     assert "OpenGL" in done.stdout and lines[-1] == "doctor: all ok"
+
+
+def test_doctor_cell_adds_the_cell_files_checks_after_the_computers(tmp_path) -> None:
+    from capabilities.doctor import cell_checks
+
+    bad = tmp_path / "broken.cell.json"
+    bad.write_text('{"format_version": 2, "robot": {"kind": "ur"}}', encoding="utf-8")
+    args = type("Args", (), {"cell": str(bad)})()
+    (cell_check,) = cell_checks(args)
+    out = io.StringIO()
+    assert run_checks([cell_check], out) == 1
+    (line, verdict) = out.getvalue().splitlines()
+    assert line.startswith("FIX  cell file: ") and "broken.cell.json" in line
+    assert verdict == "doctor: 1 to fix"
+    assert cell_checks(type("Args", (), {"cell": None})()) == []

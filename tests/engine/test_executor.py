@@ -259,3 +259,50 @@ def test_a_slow_listener_does_not_hold_up_the_run() -> None:
     assert executor.wait(5.0) == executor.result
     assert recorder.events[-1] == executor.result
     assert recorder.statuses("a") == [RUNNING, SUCCESS]
+
+
+# ---------------------------------------------------------------------- hold (a cell stops)
+
+
+def test_a_hold_halts_the_running_leaf_within_a_tick_and_the_run_goes_on_after() -> None:
+    from engine.composites import Sequence
+    from engine.events import RunHeld
+
+    ctx = TreeContext()
+    first, second = JobOperation(), JobOperation()
+    seq = with_children(
+        Sequence(ctx, "seq"), [leaf(ctx, first, "first"), leaf(ctx, second, "second")]
+    )
+    tree = rooted(ctx, seq)
+    reason = [""]
+    recorder = Recorder()
+    executor = started(Executor(tree, rate_hz=200.0, listeners=[recorder], hold=lambda: reason[0]))
+    assert first.started.wait(5.0)
+    first.jobs[0].succeed()
+    assert second.started.wait(5.0)
+    tick = tree.ctx.tick_count
+    reason[0] = "protective stop"
+    assert wait_until(lambda: executor.held == "protective stop")
+    assert tree.ctx.tick_count <= tick + 1  # held before the next tick evaluated anything
+    assert second.jobs[0].cancels == 1  # the running leaf was halted
+    assert tree.nodes["seq"].status is RUNNING  # the sequence keeps its place
+    reason[0] = ""
+    assert wait_until(lambda: len(second.jobs) == 2)  # the halted leaf starts afresh
+    assert len(first.jobs) == 1  # the finished one is not run again
+    second.jobs[1].succeed()
+    result = executor.wait(5.0)
+    assert result is not None and result.status is SUCCESS
+    assert [e.reason for e in recorder.of(RunHeld)] == ["protective stop", ""]
+
+
+def test_a_hold_check_that_raises_holds_the_run_with_its_message() -> None:
+    tree, node = forever_running()
+
+    def broken() -> str:
+        raise RuntimeError("no state")
+
+    executor = started(Executor(tree, rate_hz=200.0, hold=broken))
+    assert wait_until(lambda: "no state" in executor.held)
+    assert node.updates == 0
+    executor.stop()
+    assert executor.wait(5.0) is not None

@@ -247,7 +247,7 @@ BAD: list[tuple[str, Any, str, str]] = [
     ("not an object", [], "$", "costar-plan object"),
     ("other format", {"format": "word", "format_version": 1}, "$.format", "'costar-plan'"),
     ("no version", {"format": "costar-plan"}, "$.format_version", "versions 1"),
-    ("newer version", plan_doc(format_version=3), "$.format_version", "newer CoSTAR Instructor"),
+    ("newer version", plan_doc(format_version=4), "$.format_version", "newer CoSTAR Instructor"),
     ("version as text", plan_doc(format_version="1"), "$.format_version", "versions 1"),
     ("unknown top field", plan_doc(trea=None), "$.trea", "one of the fields format"),
     ("name a number", plan_doc(name=3), "$.name", "a text"),
@@ -342,7 +342,7 @@ def test_invalid_json_gives_line_and_column(name: str, line: int, column: int, g
 
 def test_data_files_of_newer_version_and_duplicate_keys() -> None:
     with pytest.raises(
-        PlanFileError, match=r"newer_version.costar.json: \$.format_version: .*reads \(1, 2\)"
+        PlanFileError, match=r"newer_version.costar.json: \$.format_version: .*reads \(1, 2, 3\)"
     ):
         load_plan(DATA / "newer_version.costar.json")
     with pytest.raises(PlanFileError) as info:
@@ -484,3 +484,17 @@ SCHEMA_BAD = [
 )
 def test_schema_refuses_what_the_reader_refuses(doc: Any, path: str) -> None:
     assert schema_errors(doc), f"the schema accepts a document the reader refuses at {path}"
+
+
+def test_the_scene_a_plan_was_taught_on_round_trips(tmp_path: Path) -> None:
+    plan = PlanSpec(
+        NodeSpec(NodeKind.WAIT, params={"seconds": Binding.fixed(1.0, ParamType.DURATION)})
+    )
+    plan.scene = "kitting_handoff"
+    path = tmp_path / "scene.costar.json"
+    save_plan(plan, path)
+    assert '"scene": "kitting_handoff"' in path.read_text(encoding="utf-8")
+    assert load_plan(path).scene == "kitting_handoff"
+    plan.scene = ""
+    save_plan(plan, path)
+    assert '"scene"' not in path.read_text(encoding="utf-8")

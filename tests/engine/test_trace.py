@@ -86,6 +86,21 @@ def test_the_recorder_closes_at_the_end_of_the_run(tmp_path: Path) -> None:
     assert trace.final_status is FAILURE
 
 
+def test_each_event_is_on_disk_as_it_is_written_and_a_hold_reads_back(tmp_path: Path) -> None:
+    from engine.events import RunHeld
+
+    path = tmp_path / "t.trace.jsonl"
+    recorder = TraceRecorder(path)
+    recorder(RunHeld(2, "protective stop", 1.0))
+    recorder(RunHeld(5, "", 2.0))
+    # Not closed: what a killed run leaves behind is already in the file.
+    trace = read_trace(path)
+    assert [e["reason"] for e in trace.events] == ["protective stop", ""]
+    lines = list(format_timeline(trace))
+    assert "run held: protective stop" in lines[0] and "run resumed" in lines[1]
+    recorder.close()
+
+
 def write(tmp_path: Path, text: str) -> Path:
     path = tmp_path / "bad.trace.jsonl"
     path.write_text(text, encoding="utf-8")

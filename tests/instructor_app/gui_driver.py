@@ -70,7 +70,7 @@ class ScriptedDialogs(Dialogs):
         save_answers: answers to "save the changes?" ("save", "discard", "cancel"); when
             empty, "discard".
         restore_answers: answers to "restore the unsaved plan?"; when empty, False.
-        open_paths / save_paths: what the file dialogs return ("" = cancelled).
+        open_paths / save_paths / cell_paths: what the file dialogs return ("" = cancelled).
         asked: ("save" | "restore", text) in order; errors: (title, text) in order.
     """
 
@@ -79,6 +79,7 @@ class ScriptedDialogs(Dialogs):
         self.restore_answers: list[bool] = []
         self.open_paths: list[str] = []
         self.save_paths: list[str] = []
+        self.cell_paths: list[str] = []
         self.asked: list[tuple[str, str]] = []
         self.errors: list[tuple[str, str]] = []
 
@@ -95,6 +96,9 @@ class ScriptedDialogs(Dialogs):
 
     def open_path(self, parent: QWidget, folder: str) -> str:
         return self.open_paths.pop(0) if self.open_paths else ""
+
+    def open_cell_path(self, parent: QWidget, folder: str) -> str:
+        return self.cell_paths.pop(0) if self.cell_paths else ""
 
     def save_path(self, parent: QWidget, suggested: str) -> str:
         return self.save_paths.pop(0) if self.save_paths else ""

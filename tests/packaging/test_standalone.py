@@ -54,7 +54,7 @@ def test_no_file_reads_a_path_outside_the_repository() -> None:
         text=True,
         check=True,
     ).stdout.split()
-    outside = ("../shared", "/work/", '"shared"', "parents[1].parent", "parents[2].parent")
+    outside = ("../shared", "/work/", '/ "shared"', "parents[1].parent", "parents[2].parent")
     offenders = []
     for name in tracked:
         if name.startswith("tests/packaging/"):

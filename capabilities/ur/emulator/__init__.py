@@ -1,7 +1,7 @@
 """A loopback UR controller backed by the simulated cell, for ur_rtde without a robot.
 
-It serves the dashboard (29999), the script port (30003) and RTDE (30004) on a loopback
-address, speaks ur_rtde's register handshake (the command registers are interpreted, the
+It serves the dashboard (29999), the script port (30003), RTDE (30004) and the Robotiq
+gripper URCap's socket (63352) on a loopback address, speaks ur_rtde's register handshake (the command registers are interpreted, the
 URScript is not) and moves the simulated arm. Faults can be injected from a test or the
 command line. Example::
 
@@ -13,10 +13,14 @@ command line. Example::
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from types import TracebackType
 
+from capabilities.camera_source import CameraSource
 from capabilities.sim.cell import SimCell
+from capabilities.stream_camera import FRAME_PORT, serve_frames
 from capabilities.ur.emulator.controller import VERSIONS, EmulatedController
+from capabilities.ur.emulator.robotiq import ROBOTIQ_PORT, robotiq_client
 from capabilities.ur.emulator.servers import (
     Server,
     check_loopback,
@@ -24,14 +28,15 @@ from capabilities.ur.emulator.servers import (
     rtde_client,
     script_client,
 )
+from engine.types import Pose
 
-__all__ = ["UREmulator", "VERSIONS", "DASHBOARD_PORT", "SCRIPT_PORT", "RTDE_PORT"]
+__all__ = ["UREmulator", "VERSIONS", "DASHBOARD_PORT", "SCRIPT_PORT", "RTDE_PORT", "ROBOTIQ_PORT"]
 
 DASHBOARD_PORT, SCRIPT_PORT, RTDE_PORT = 29999, 30003, 30004
 
 
 class UREmulator:
-    """The loopback UR controller; a context manager.
+    """The loopback UR controller (with a Robotiq gripper's URCap); a context manager.
 
     Args:
         host: a loopback address (127.0.0.0/8); anything else is refused.
@@ -39,6 +44,8 @@ class UREmulator:
         cell: the simulated cell to drive (default: a new one, closed with the emulator).
         speed: real-time factor of a new cell (1.0: a real robot's pace).
         unlock_delay: seconds after a protective stop before the dashboard unlocks it.
+        cameras: the simulated cell's cameras, served on ``FRAME_PORT`` (none: no server).
+        truth: GROUND TRUTH of an object's pose by name (a scene's), for tests only.
     """
 
     def __init__(
@@ -48,8 +55,12 @@ class UREmulator:
         cell: SimCell | None = None,
         speed: float | None = 1.0,
         unlock_delay: float = 5.0,
+        cameras: Mapping[str, CameraSource] | None = None,
+        truth: Callable[[str], Pose] | None = None,
     ) -> None:
         self.host = check_loopback(host)
+        self._cameras = dict(cameras or {})
+        self.truth = truth
         if version not in VERSIONS:
             raise ValueError(f"version must be one of {sorted(VERSIONS)}, got {version!r}")
         self._own_cell = cell is None
@@ -72,8 +83,12 @@ class UREmulator:
                 (DASHBOARD_PORT, dashboard_client),
                 (SCRIPT_PORT, script_client),
                 (RTDE_PORT, rtde_client),
+                (ROBOTIQ_PORT, robotiq_client),
             ):
                 self._servers.append(Server(self.host, port, self.controller, handler))
+            if self._cameras:
+                frames = serve_frames(self._cameras)
+                self._servers.append(Server(self.host, FRAME_PORT, self.controller, frames))
         except BaseException:
             self.close()
             raise

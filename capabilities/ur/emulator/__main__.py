@@ -1,4 +1,8 @@
-"""``python -m capabilities.ur.emulator --host 127.0.0.2 --version 5.12``: run the emulator.
+"""``costar ur-emulator`` (or ``python -m capabilities.ur.emulator``): run the emulator.
+
+``--scene NAME --seed N`` loads a scene of the simulated cell around the emulated arm;
+``--write-cell FILE`` writes a cell file whose robot is this emulator, so that
+``costar run PLAN --cell FILE`` takes the real-robot path without a robot.
 
 With ``--control stdin`` it reads fault commands from standard input, one a line, and answers
 each with one JSON line (see :mod:`capabilities.ur.emulator.process`, which drives it so).
@@ -13,9 +17,13 @@ import json
 import signal
 import sys
 import threading
+from dataclasses import replace
+from pathlib import Path
 from typing import Any
 
+from capabilities.stream_camera import FRAME_PORT
 from capabilities.ur.emulator import VERSIONS, UREmulator
+from capabilities.ur.emulator.servers import check_loopback
 from capabilities.ur.errors import EmulatorError
 
 __all__ = ["main", "run_command"]
@@ -45,8 +53,19 @@ def run_command(emulator: UREmulator, line: str) -> dict[str, Any]:
             "program_running": ctl.program_running(), "q": list(snap["actual_q"]),
             "digital_outputs": ctl.digital_outputs(), "freedrive": ctl.freedrive_on,
             "speed_fraction": ctl.speed_fraction, "sim_time": emulator.cell.time(),
+            "gripper_closed": emulator.cell.gripper.is_closed(),
             "moving": ctl.arm_moving(), "messages": ctl.messages[-5:],
         }  # fmt: skip
+    elif name == "input":  # input BANK INDEX 0|1: a digital input (a foot pedal)
+        shift = {"standard": 0, "configurable": 8, "tool": 16}[args[0]]
+        ctl.set_digital_input(shift + int(args[1]), args[2] == "1")
+    elif name == "teach_button":  # teach_button 0|1: the pendant's freedrive button
+        ctl.press_teach_button(args[0] == "1")
+    elif name == "truth":  # GROUND TRUTH of a scene object, for tests that score a run
+        if emulator.truth is None or not args:
+            return {"ok": False, "error": "truth needs a scene (--scene) and an object name"}
+        pose = emulator.truth(args[0])
+        return {"ok": True, "position": list(pose.position), "orientation": list(pose.orientation)}
     elif name != "quit":
         return {"ok": False, "error": f"unknown command {name!r}"}
     return {"ok": True}
@@ -64,9 +83,67 @@ def _serve_stdin(emulator: UREmulator, done: threading.Event) -> None:
     done.set()
 
 
-def main(argv: list[str] | None = None) -> int:
+def _serve(emulator: UREmulator, args: argparse.Namespace, done: threading.Event) -> None:
+    if args.protective_stop_at is not None:
+        emulator.protective_stop(at=args.protective_stop_at)
+    if args.protective_stop_on_contact:
+        emulator.protective_stop(on_contact=True)
+    if args.control == "stdin":
+        print(json.dumps({"ok": True, "ready": args.host}), flush=True)
+        threading.Thread(target=_serve_stdin, args=(emulator, done), daemon=True).start()
+    else:
+        where = f" with {args.write_cell}" if args.write_cell else ""
+        print(f"UR emulator (PolyScope {args.version}) on {args.host}{where}; Ctrl+C stops it")
+        sys.stdout.flush()
+    with contextlib.suppress(KeyboardInterrupt):
+        done.wait()
+
+
+def write_cell_file(
+    path: str | Path, host: str, version: str, config: Any, cameras: bool = False
+) -> None:
+    """Write a cell file (atomically) whose robot is the emulator at ``host``; with
+    ``cameras``, its cameras are the emulator's frame streams.
+
+    Raises:
+        EmulatorError: the file cannot be written.
+    """
+    from capabilities.cell_robot import RobotSettings, ToolSettings
+    from engine.plan_writer import write_atomic
+
+    model = "UR5 CB3" if version.startswith("3.") else "UR5e"
+    robot = RobotSettings(kind="ur", host=host, model=model, tool=ToolSettings("robotiq"))
+    # The emulated cell's gripper answers as a Robotiq; its cameras (with a scene) are served
+    # from the emulator's process. A UR cell ignores cameras whose source is "sim".
+    streams = {
+        name: replace(c, source="stream", where=f"{host}:{FRAME_PORT}")
+        for name, c in config.cameras.items()
+    }
+    cell = replace(config, robot=robot, cameras=streams if cameras else config.cameras)
+    data = json.dumps(cell.to_json(), indent=2) + "\n"
+    try:
+        write_atomic(Path(path), data.encode("utf-8"))
+    except Exception as exc:
+        raise EmulatorError(f"{path}: cannot write the cell file: {exc}") from exc
+
+
+def _emulator(args: argparse.Namespace, stack: contextlib.ExitStack) -> UREmulator:
+    """The emulator the arguments ask for; a scene's session is closed by ``stack``."""
+    if args.scene is None:
+        return UREmulator(args.host, args.version, speed=args.speed, unlock_delay=args.unlock_delay)
+    from capabilities.sim.session import SimCellSession
+
+    check_loopback(args.host)  # refuse a bad host before building a scene
+    session = stack.enter_context(SimCellSession(args.scene, args.seed, args.speed))
+    return UREmulator(
+        args.host, args.version, cell=session.sim, unlock_delay=args.unlock_delay,
+        cameras=session.cameras, truth=session.truth_pose,
+    )  # fmt: skip
+
+
+def main(argv: list[str] | None = None, prog: str = "python -m capabilities.ur.emulator") -> int:
     parser = argparse.ArgumentParser(
-        prog="python -m capabilities.ur.emulator",
+        prog=prog,
         description="A loopback UR controller (dashboard, script port, RTDE) backed by the "
         "simulated cell.",
     )
@@ -87,6 +164,11 @@ def main(argv: list[str] | None = None) -> int:
         "--protective-stop-on-contact", action="store_true",
         help="a protective stop when the arm touches something",
     )  # fmt: skip
+    parser.add_argument("--scene", help="a scene of the simulated cell around the arm")
+    parser.add_argument("--seed", type=int, default=0, help="scene seed (default 0)")
+    parser.add_argument(
+        "--write-cell", metavar="FILE", help="write a cell file whose robot is this emulator"
+    )
     parser.add_argument(
         "--control", choices=("none", "stdin"), default="none",
         help="stdin: read fault commands from standard input (for tests)",
@@ -95,22 +177,14 @@ def main(argv: list[str] | None = None) -> int:
     done = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: done.set())
     try:
-        emulator = UREmulator(
-            args.host, args.version, speed=args.speed, unlock_delay=args.unlock_delay
-        )
-        with emulator:
-            if args.protective_stop_at is not None:
-                emulator.protective_stop(at=args.protective_stop_at)
-            if args.protective_stop_on_contact:
-                emulator.protective_stop(on_contact=True)
-            if args.control == "stdin":
-                print(json.dumps({"ok": True, "ready": args.host}), flush=True)
-                threading.Thread(target=_serve_stdin, args=(emulator, done), daemon=True).start()
-            else:
-                print(f"UR emulator (PolyScope {args.version}) on {args.host}; Ctrl+C stops it")
-                sys.stdout.flush()
-            with contextlib.suppress(KeyboardInterrupt):
-                done.wait()
+        with contextlib.ExitStack() as stack:
+            emulator = stack.enter_context(_emulator(args, stack))
+            if args.write_cell:
+                write_cell_file(
+                    args.write_cell, args.host, args.version, emulator.cell.config,
+                    cameras=args.scene is not None,
+                )  # fmt: skip
+            _serve(emulator, args, done)
     except EmulatorError as exc:
         print(f"error: {exc}", file=sys.stderr, flush=True)
         return 2

@@ -22,6 +22,7 @@ from capabilities.sim.cell import SimCell
 from capabilities.sim.commands import CommandHandle
 from capabilities.ur.emulator.faults import ContactWatch
 from capabilities.ur.emulator.program import ControlProgram
+from capabilities.ur.emulator.robotiq import RobotiqURCap
 from capabilities.ur.emulator.wire import OUTPUT_TYPES, output_type
 from capabilities.ur.frames import matrix_from_rotvec_pose, rotvec_pose_from_matrix
 from capabilities.ur.modes import RobotMode, RuntimeState, SafetyMode
@@ -73,12 +74,15 @@ class EmulatedController:
         self.freedrive_on = False
         self._tcp = np.eye(4)
         self._digital_out = 0  # bits 0-7 standard, 8-15 configurable, 16-17 tool
+        self._digital_in = 0  # likewise, set by the test or the command line (a pedal)
+        self.teach_button = False
         self.speed_fraction = 1.0
         self.messages: list[str] = []
         self._started = time.monotonic()
         self._base = pose_to_matrix(cell.config.robot_base)
         self._base_inv = np.linalg.inv(self._base)
         self.faults = ContactWatch(cell, self)
+        self.robotiq = RobotiqURCap(self)
         self._snapshot: dict[str, Any] = {}
         self._stop_event = threading.Event()
         self._thread = threading.Thread(target=self._run, name="ur-emulator-ctl", daemon=True)
@@ -135,6 +139,7 @@ class EmulatedController:
         tcp = rotvec_pose_from_matrix(self._tcp_base(q)) if arm_on else list(_ZEROS6)
         running = self._program is not None
         status = (1 if self.robot_mode >= RobotMode.POWER_ON else 0) | (2 if running else 0)
+        status |= 4 if self.teach_button else 0
         safety_bits = 1 << _SAFETY_BIT.get(self.safety_mode, 9)
         if self.safety_mode in _EMERGENCY:
             safety_bits |= 1 << 7
@@ -151,6 +156,7 @@ class EmulatedController:
             "speed_scaling": 1.0 if running else 0.0,
             "target_speed_fraction": self.speed_fraction,
             "actual_digital_output_bits": self._digital_out,
+            "actual_digital_input_bits": self._digital_in,
             "joint_mode": (253 if arm_on else 236,) * 6,
             "actual_main_voltage": 48.0 if arm_on else 0.0,
         }  # fmt: skip
@@ -198,6 +204,22 @@ class EmulatedController:
     def set_output_double(self, index: int, value: float) -> None:
         with self._lock:
             self._out_double[index] = float(value)
+
+    def set_digital_input(self, bit: int, level: bool) -> None:
+        """Set one digital input (bit 0-7 standard, 8-15 configurable, 16-17 tool)."""
+        with self._lock:
+            self._digital_in = (self._digital_in | (1 << bit)) if level else (
+                self._digital_in & ~(1 << bit)
+            )  # fmt: skip
+
+    def press_teach_button(self, down: bool) -> None:
+        """The pendant's teach button: held down, the arm is in freedrive, as on a UR."""
+        with self._lock:
+            if down and self._can_run() and not self.freedrive_on:
+                self.set_freedrive(True)
+            elif not down and self.teach_button:
+                self.set_freedrive(False)
+            self.teach_button = down
 
     def digital_outputs(self) -> int:
         """Bits 0-7 standard, 8-15 configurable, 16-17 tool digital outputs."""

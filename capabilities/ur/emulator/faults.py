@@ -6,7 +6,7 @@ import contextlib
 import threading
 from typing import TYPE_CHECKING
 
-import pybullet
+from capabilities.bullet import pybullet
 
 if TYPE_CHECKING:
     from capabilities.sim.cell import SimCell

@@ -18,6 +18,7 @@ from typing import Any
 
 from capabilities.ur.emulator.servers import check_loopback
 from capabilities.ur.errors import EmulatorError
+from engine.types import Pose
 
 __all__ = ["EmulatorProcess"]
 
@@ -33,6 +34,9 @@ class EmulatorProcess:
         speed: real-time factor of the simulated cell.
         unlock_delay: seconds before a protective stop can be unlocked.
         timeout: seconds to wait for the child to start and for each answer.
+        scene: a scene of the simulated cell around the arm (None: the arm alone).
+        seed: the scene's seed.
+        write_cell: write a cell file whose robot is this emulator.
     """
 
     def __init__(
@@ -42,6 +46,9 @@ class EmulatorProcess:
         speed: float = 1.0,
         unlock_delay: float = 5.0,
         timeout: float = 60.0,
+        scene: str | None = None,
+        seed: int = 0,
+        write_cell: str | Path | None = None,
     ) -> None:
         self.host = check_loopback(host)
         self.version = version
@@ -50,6 +57,10 @@ class EmulatorProcess:
             "--version", version, "--speed", str(speed), "--unlock-delay", str(unlock_delay),
             "--control", "stdin",
         ]  # fmt: skip
+        if scene is not None:
+            self._args += ["--scene", scene, "--seed", str(seed)]
+        if write_cell is not None:
+            self._args += ["--write-cell", str(write_cell)]
         self._timeout = timeout
         self._proc: subprocess.Popen[str] | None = None
         self._lock = threading.Lock()
@@ -107,6 +118,19 @@ class EmulatorProcess:
     def state(self) -> dict[str, Any]:
         """Robot mode, safety mode, program, joints, outputs, freedrive, sim time."""
         return self.command("state")
+
+    def set_input(self, bank: str, index: int, level: bool) -> None:
+        """Set a digital input ("standard", "configurable" or "tool"; a foot pedal)."""
+        self.command(f"input {bank} {index} {int(level)}")
+
+    def teach_button(self, down: bool) -> None:
+        """Press (True) or release the pendant's teach button."""
+        self.command(f"teach_button {int(down)}")
+
+    def truth_pose(self, name: str) -> Pose:
+        """GROUND TRUTH of a scene object's pose (tests and scores only)."""
+        answer = self.command(f"truth {name}")
+        return Pose(tuple(answer["position"]), tuple(answer["orientation"]))
 
     def protective_stop(self, at: float | None = None, on_contact: bool = False) -> None:
         arg = " on_contact" if on_contact else (f" at={at}" if at is not None else "")

@@ -19,7 +19,7 @@ import pytest
 
 from capabilities.sim.live_view import LiveViewError
 from capabilities.sim.scene import yaw_pose
-from capabilities.sim.session import SimCellSession
+from capabilities.sim.session import SimCameraDevice, SimCellSession
 
 SIZE = (320, 240)
 
@@ -42,8 +42,15 @@ def _wait_gone(pid: int, timeout: float = 10.0) -> bool:
     return _gone(pid)
 
 
+def _rendered(cell: SimCellSession, name: str) -> SimCameraDevice:
+    """A camera of the cell rendered in simulation (the default cell's cameras are)."""
+    device = cell.cameras[name]
+    assert isinstance(device, SimCameraDevice)
+    return device
+
+
 def _assert_same_picture(cell: SimCellSession, camera: str) -> None:
-    device = cell.cameras[camera]
+    device = _rendered(cell, camera)
     live, exact = device.preview(SIZE), device.capture(SIZE)
     assert live.rgb.shape == exact.rgb.shape == (240, 320, 3)
     rgb_difference = np.abs(live.rgb.astype(int) - exact.rgb.astype(int)).mean()
@@ -67,10 +74,10 @@ def test_the_mirror_shows_what_the_physics_thread_renders_as_the_cell_changes(
 ) -> None:
     _assert_same_picture(cell, "shoulder")
     _assert_same_picture(cell, "wrist")
-    before = cell.cameras["shoulder"].preview(SIZE).rgb
+    before = _rendered(cell, "shoulder").preview(SIZE).rgb
     home = cell.sim.config.home_joints
     assert cell.sim.robot.move_joints([home[0] + 0.6, *home[1:]]).wait(30)
-    after = cell.cameras["shoulder"].preview(SIZE).rgb
+    after = _rendered(cell, "shoulder").preview(SIZE).rgb
     assert np.abs(after.astype(int) - before.astype(int)).mean() > 0.5  # the arm moved
     _assert_same_picture(cell, "shoulder")
     _assert_same_picture(cell, "wrist")
@@ -80,19 +87,19 @@ def test_the_mirror_shows_what_the_physics_thread_renders_as_the_cell_changes(
     _assert_same_picture(cell, "shoulder")  # an object added after the mirror was built
     cell.sim.call(lambda c: cell.scene.remove(c, "handed_over"))
     _assert_same_picture(cell, "shoulder")
-    frame = cell.cameras["shoulder"].preview(SIZE)
+    frame = _rendered(cell, "shoulder").preview(SIZE)
     assert 0.0 < frame.stamp <= cell.clock()  # stamped with the simulated time it shows
 
 
 def test_the_mirrors_end_with_the_cell() -> None:
     with SimCellSession("cup_to_bin", seed=0) as session:
-        session.cameras["shoulder"].preview(SIZE)
-        session.cameras["wrist"].preview(SIZE)
+        _rendered(session, "shoulder").preview(SIZE)
+        _rendered(session, "wrist").preview(SIZE)
         pids = session.live_view.pids() if session.live_view else {}
         assert set(pids) == {"shoulder", "wrist"}
     assert all(_wait_gone(pid, 1.0) for pid in pids.values())
     with pytest.raises(LiveViewError, match="closed"):
-        session.cameras["shoulder"].preview(SIZE)
+        _rendered(session, "shoulder").preview(SIZE)
 
 
 def test_a_mirror_ends_when_the_cells_process_is_killed(tmp_path: Path) -> None:
@@ -124,7 +131,7 @@ def test_a_mirror_ends_when_the_cells_process_is_killed(tmp_path: Path) -> None:
 
 def test_a_crashed_mirror_fails_its_pictures_and_the_cell_goes_on() -> None:
     with SimCellSession("cup_to_bin", seed=0) as session:
-        camera = session.cameras["shoulder"]
+        camera = _rendered(session, "shoulder")
         camera.preview(SIZE)
         pid = session.live_view.pids()["shoulder"] if session.live_view else 0
         os.kill(pid, signal.SIGKILL)
@@ -144,7 +151,7 @@ def test_closing_the_cell_while_a_mirror_starts_ends_it() -> None:
 
     def watch() -> None:
         try:
-            session.cameras["shoulder"].preview(SIZE)
+            _rendered(session, "shoulder").preview(SIZE)
         except LiveViewError as exc:
             errors.append(exc)
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
+from typing import Any
 
 import pytest
 
@@ -18,8 +19,9 @@ def start_emulator() -> Iterator[Callable[..., EmulatorProcess]]:
     """Start emulators (version "5.12" unless asked); all are closed after the test."""
     started: list[EmulatorProcess] = []
 
-    def start(version: str = "5.12") -> EmulatorProcess:
-        emulator = EmulatorProcess(next_host(), version, unlock_delay=0.0).start()
+    def start(version: str = "5.12", **options: Any) -> EmulatorProcess:
+        options.setdefault("unlock_delay", 0.0)
+        emulator = EmulatorProcess(next_host(), version, **options).start()
         started.append(emulator)
         return emulator
 

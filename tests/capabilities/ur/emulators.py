@@ -1,7 +1,8 @@
 """Helpers for the UR cell tests: a loopback address per emulator, bounded waits.
 
 The controller ports are fixed (29999, 30003, 30004), so every emulator gets its own loopback
-address: 127.0.<20 + xdist worker>.<counter>.
+address: 127.<process>.<xdist worker>.<counter>, the process part keeping apart test sessions
+that run at the same time on one machine.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ def next_host() -> str:
     """A loopback address no other test of this session (or worker) uses."""
     worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0")
     index = int(worker[2:]) if worker[2:].isdigit() else 0
-    return f"127.0.{20 + index}.{next(_COUNTER) % 250 + 2}"
+    return f"127.{os.getpid() % 200 + 20}.{index}.{next(_COUNTER) % 250 + 2}"
 
 
 def wait_for(predicate: Callable[[], bool], timeout: float = 10.0) -> bool:

@@ -1,0 +1,160 @@
+"""The paper's case studies on the simulated cell: how often each shipped plan succeeds.
+
+Each case study runs its shipped plan through the engine on the simulated cell, one run per
+scene seed (the seed draws where the objects lie and when the worker acts), and scores the
+outcome with the simulator's ground truth (ground truth only scores; the plan perceives
+through the cameras). A run succeeded when the plan returned SUCCESS *and* the scorer agrees
+that the task was done.
+
+- ``kitting``: resources/examples/kitting.costar.json on scene ``kitting_handoff`` (Figure 7):
+  each of the three plates lies inside the kit bin and the bin stands at the return place.
+
+To add a case study (``tending``, ``cup_to_bin``), add a :class:`CaseStudy` to ``CASES``: its
+plan, scene and a scorer ``(session) -> str`` that returns "" when the task was done, else
+what is wrong. Run from the repository root::
+
+    .venv/bin/python bench/casestudies.py [--runs 100] [--only kitting] [--json]
+
+JSON: ``{"kitting": {"runs": 100, "succeeded": 99, "failures": {"seed": "why", ...},
+"wall_s_per_run": 17.2}}`` (wall seconds per run, divided by ``--jobs`` in effect).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import multiprocessing
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from capabilities.base import CapabilityRegistry  # noqa: E402
+from capabilities.sim.session import SimCellSession  # noqa: E402
+from engine.build import build_tree  # noqa: E402
+from engine.executor import run_to_end  # noqa: E402
+from engine.files import load_plan  # noqa: E402
+from engine.status import Status  # noqa: E402
+from engine.types import Pose  # noqa: E402
+from engine.validation import has_errors, validate_plan  # noqa: E402
+
+EXAMPLES = ROOT / "resources" / "examples"
+RUN_TIMEOUT = 600.0  # wall seconds: a run that takes longer counts as failed
+
+
+@dataclass(frozen=True)
+class CaseStudy:
+    """A shipped plan, the scene it runs in and how its outcome is scored."""
+
+    plan: Path
+    scene: str
+    score: Callable[[SimCellSession], str]
+
+
+def _in_frame(frame: Pose, pose: Pose) -> tuple[float, float, float]:
+    x, y, z = frame.inverse().compose(pose).position
+    return x, y, z
+
+
+BIN_INSIDE = (0.175, 0.1275)  # m: half the bin's inner length and width
+RETURN_AT = (0.5, -0.12)  # where the kitting plan puts the bin (make_kitting.RETURN_AT)
+PLATES = ("plate_3_holes", "plate_4_holes", "plate_8_holes")
+
+
+def score_kitting(session: SimCellSession) -> str:
+    """'' when every plate lies in the bin and the bin stands at the return place."""
+    session.sim.wait_sim(0.5)  # let what was let go settle
+    bin_pose = session.truth_pose("kit_bin")
+    problems = []
+    for plate in PLATES:
+        x, y, z = _in_frame(bin_pose, session.truth_pose(plate))
+        if abs(x) > BIN_INSIDE[0] or abs(y) > BIN_INSIDE[1] or not 0.0 < z < 0.03:
+            problems.append(f"{plate} not in the bin ({x:.3f}, {y:.3f}, {z:.3f}) m")
+    away = math.dist(bin_pose.position[:2], RETURN_AT)
+    if away > 0.03:
+        problems.append(f"bin {away * 1000:.0f} mm from the return place")
+    return "; ".join(problems)
+
+
+CASES: dict[str, CaseStudy] = {
+    "kitting": CaseStudy(EXAMPLES / "kitting.costar.json", "kitting_handoff", score_kitting),
+}
+
+
+def run_case(case: CaseStudy, seed: int) -> str:
+    """'' when the run of one seed succeeded, else why not."""
+    with SimCellSession(case.scene, seed) as session:
+        registry = CapabilityRegistry(cell=session)
+        plan = load_plan(case.plan, aliases=registry.aliases())
+        problems = validate_plan(plan, registry)
+        if has_errors(problems):
+            return "invalid: " + "; ".join(str(p) for p in problems if p.severity == "error")
+        tree = build_tree(plan, registry, clock=session.clock)
+        result = run_to_end(tree, 20.0, timeout=RUN_TIMEOUT)
+        if result.status is not Status.SUCCESS:
+            return f"{result.status.value}: {result.message or result.reason}"
+        return case.score(session)
+
+
+def _run_seed(job: tuple[str, int]) -> tuple[int, str]:
+    name, seed = job
+    try:
+        why = run_case(CASES[name], seed)
+    except Exception as exc:  # a crash of one run is a failed run, not the end of the bench
+        why = f"error: {type(exc).__name__}: {exc}"
+    print(f"{name} seed {seed}: {why or 'ok'}", file=sys.stderr, flush=True)
+    return seed, why
+
+
+def measure(name: str, runs: int, first_seed: int = 0, jobs: int = 1) -> dict[str, Any]:
+    """Run ``runs`` seeds of a case study, ``jobs`` cells at a time (each its own process)."""
+    seeds = [(name, seed) for seed in range(first_seed, first_seed + runs)]
+    start = time.perf_counter()
+    if jobs > 1:
+        with multiprocessing.get_context("spawn").Pool(jobs) as pool:
+            results = pool.map(_run_seed, seeds, chunksize=1)
+    else:
+        results = [_run_seed(job) for job in seeds]
+    failures = {str(seed): why for seed, why in results if why}
+    wall = (time.perf_counter() - start) / max(runs, 1)
+    return {
+        "runs": runs,
+        "succeeded": runs - len(failures),
+        "failures": failures,
+        "wall_s_per_run": round(wall, 1),
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run every case study (or ``--only`` one) and print the figures."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=100, help="seeds per case study")
+    parser.add_argument("--first-seed", type=int, default=0)
+    parser.add_argument("--only", choices=sorted(CASES), action="append")
+    parser.add_argument("--jobs", type=int, default=1, help="cells run at once (processes)")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    args = parser.parse_args(argv)
+    figures = {
+        name: measure(name, args.runs, args.first_seed, args.jobs) for name in args.only or CASES
+    }
+    if args.json:
+        print(json.dumps(figures))
+    else:
+        for name, fig in figures.items():
+            print(
+                f"{name}: {fig['succeeded']}/{fig['runs']} succeeded, {fig['wall_s_per_run']} s/run"
+            )
+            for seed, why in fig["failures"].items():
+                print(f"  seed {seed}: {why}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

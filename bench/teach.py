@@ -1,0 +1,159 @@
+"""Teaching by hand on the simulated cell (real time, as a worker uses it).
+
+Figures, through the Instructor's RobotTeacher (the Move panel's and the 3D scene's path):
+
+- ``drag_lag_mm`` / ``drag_lag_max_mm``: while a hand drags the tool gizmo 10 cm at 10 cm/s
+  (a new target 30 times a second), how far the TCP is behind the newest target, mean and
+  worst; ``drag_settle_ms``: from letting go until the TCP is within 1 mm of it.
+- the same three with ``_ik`` for the peer path: a cell without a freedrive drag, where the
+  teacher follows through IK and joint moves (each new target preempts the last move).
+- ``drag_commands_per_s``: drag targets the worker passed to the cell per second (the newest
+  wins; older ones are dropped, never queued).
+- ``jog_step_error_mm`` / ``jog_step_ms``: five 10 mm steps up (Move panel at 25 %): the worst
+  difference between the step and how far the arm's reported TCP moved, and the mean time
+  from the click to the end of the move.
+
+Run from the repository root::
+
+    .venv/bin/python bench/teach.py [--json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import statistics
+import threading
+import time
+from typing import Any
+
+from PySide6.QtCore import QCoreApplication, Qt
+
+from capabilities.base import CapabilityRegistry
+from capabilities.sim.session import SimCellSession
+from engine.types import Pose
+from instructor_app.runtime.teach import RobotTeacher
+
+_RATE_HZ = 30.0
+_SPEED = 0.10  # m/s of the hand
+_LENGTH = 0.10  # m
+
+
+class _NoDragCell:
+    """The simulated cell without its freedrive interface: the IK path of the teacher."""
+
+    def __init__(self, cell: SimCellSession) -> None:
+        self._cell = cell
+
+    def interfaces(self) -> dict[str, Any]:
+        return {k: v for k, v in self._cell.interfaces().items() if k != "freedrive"}
+
+    def clock(self) -> float:
+        return self._cell.clock()
+
+
+def _expect(teacher: RobotTeacher, what: str) -> threading.Event:
+    """An event set when the teacher says ``what`` ended (connect before the command)."""
+    done = threading.Event()
+
+    def seen(name: str, _problem: str) -> None:
+        if name == what:
+            done.set()
+
+    teacher.finished.connect(seen, Qt.ConnectionType.DirectConnection)  # no event loop here
+    return done
+
+
+def measure_drag(teacher: RobotTeacher, arm: Any, suffix: str) -> dict[str, Any]:
+    """Drag the gizmo along y and back to where it started; the TCP's lag behind it."""
+    start = arm.tcp_pose()
+    calls = 0
+    drive = teacher.interface("freedrive")
+    if drive is not None:  # count what reaches the cell
+        original = drive.freedrive_drag_to
+
+        def counted(pose: Pose) -> Any:
+            nonlocal calls
+            calls += 1
+            return original(pose)
+
+        drive.freedrive_drag_to = counted
+    lags: list[float] = []
+    steps = int(_LENGTH / _SPEED * _RATE_HZ)
+    t0 = time.perf_counter()
+    target = start
+    for k in range(1, steps + 1):
+        y = start.position[1] + _LENGTH * k / steps
+        target = Pose((start.position[0], y, start.position[2]), start.orientation)
+        teacher.drag_to(target)
+        time.sleep(max(0.0, t0 + k / _RATE_HZ - time.perf_counter()))
+        lags.append(math.dist(arm.tcp_pose().position, target.position) * 1000)
+    dragged = time.perf_counter() - t0
+    released = time.perf_counter()
+    while math.dist(arm.tcp_pose().position, target.position) > 0.001:
+        if time.perf_counter() - released > 10:
+            break
+        time.sleep(0.005)
+    settle = (time.perf_counter() - released) * 1000
+    ended = _expect(teacher, "drag end")
+    teacher.end_drag()
+    ended.wait(30)
+    if drive is not None:
+        del drive.freedrive_drag_to  # the class's method again
+    figures = {
+        f"drag_lag_mm{suffix}": round(statistics.fmean(lags), 1),
+        f"drag_lag_max_mm{suffix}": round(max(lags), 1),
+        f"drag_settle_ms{suffix}": round(settle),
+    }
+    if drive is not None:
+        figures["drag_commands_per_s"] = round(calls / dragged, 1)
+    return figures
+
+
+def measure_jog_steps(teacher: RobotTeacher, arm: Any) -> dict[str, Any]:
+    errors, times = [], []
+    for _ in range(5):
+        before = arm.tcp_pose().position[2]
+        t0 = time.perf_counter()
+        done = _expect(teacher, "jog base z")
+        teacher.jog_step("base", "z", 0.010)
+        done.wait(30)
+        times.append((time.perf_counter() - t0) * 1000)
+        errors.append(abs(arm.tcp_pose().position[2] - before - 0.010) * 1000)
+    return {
+        "jog_step_error_mm": round(max(errors), 3),
+        "jog_step_ms": round(statistics.fmean(times)),
+    }
+
+
+def measurements() -> dict[str, Any]:
+    app = QCoreApplication.instance() or QCoreApplication([])
+    del app
+    out: dict[str, Any] = {}
+    with SimCellSession("cup_to_bin", seed=0, speed=1.0) as cell:
+        arm = cell.interfaces()["arm"]
+        teacher = RobotTeacher(CapabilityRegistry(cell=cell))
+        out.update(measure_jog_steps(teacher, arm))
+        out.update(measure_drag(teacher, arm, ""))
+        teacher.shutdown()
+        peer = RobotTeacher(CapabilityRegistry(cell=_NoDragCell(cell)))
+        out.update(measure_drag(peer, arm, "_ik"))
+        peer.shutdown()
+    return out
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--json", action="store_true", help="print one JSON object at the end")
+    args = parser.parse_args()
+    figures = measurements()
+    if args.json:
+        print(json.dumps(figures))
+    else:
+        for key, value in figures.items():
+            print(f"{key:24s} {value}")
+
+
+if __name__ == "__main__":
+    main()

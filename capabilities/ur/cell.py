@@ -1,0 +1,257 @@
+"""A real UR cell as capabilities see it: the arm, its tool, and what the operator clears.
+
+``interfaces()`` gives ``arm`` and ``freedrive`` (the URArm), the tool (``suction``, a cup on
+a digital output, or ``gripper``, a Robotiq gripper through its URCap), ``rgbd:<name>`` (the cell file's cameras whose source is recorded frames or a RealSense: a
+real cell renders nothing), ``world``, ``workers``, ``objects`` (the cell file's object library),
+``scene_layout`` (marker sizes of the library) and ``operator``. :meth:`URCellSession.
+hold_reason` is the executor's hold check: it names a protective stop, an emergency stop, power
+off, a lost connection or a dead control script in words, so the run is held within one tick.
+Digital inputs named in the cell file (``inputs.pedal``) press the operator console's
+"continue" button on each rising edge, and releasing the pendant's teach button (after guiding
+the arm by hand) presses its "teach" button, so a plan waits for either with
+``collaboration.wait_for_button`` and records the waypoint with ``freedrive.record_waypoint``.
+A recovery monitor on the connection's I/O thread does the robot side of clearing it: once the
+operator has unlocked the stop (or released the button and powered on), it uploads the control
+script again, and it reconnects when the socket is really gone. A script that ended with no
+stop (stopped on the pendant, a script error) is uploaded again only on the operator's
+:meth:`URCellSession.clear`. Then the hold clears and the run
+goes on from the node that was running.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass
+from types import TracebackType
+from typing import Any
+
+from capabilities.camera_source import CameraSource
+from capabilities.camera_sources import open_source
+from capabilities.cell_robot import TCP_OF_TOOL
+from capabilities.collaboration.console import OperatorConsole
+from capabilities.collaboration.inputs import DigitalInputButton
+from capabilities.jobs import WorkerPool
+from capabilities.object_library import ObjectLibrary
+from capabilities.sim.config import CellConfig
+from capabilities.ur.arm import URArm
+from capabilities.ur.connection import NO_SCRIPT, URConnection, fault_reason
+from capabilities.ur.frames import URFrames
+from capabilities.ur.modes import RobotMode, SafetyMode
+from capabilities.ur.robotiq import RobotiqGripper
+from capabilities.ur.tool_io import (
+    DigitalPin,
+    TeachButtonReleased,
+    URDigitalInput,
+    URSuctionCup,
+)
+from capabilities.world_model import WorldModel
+from engine.types import Pose
+
+__all__ = ["CellStatus", "TEACH_BUTTON", "URCellSession"]
+
+_log = logging.getLogger(__name__)
+TEACH_BUTTON = "teach"  # the console button the pendant's teach button presses on release
+_RETRY_SCRIPT = 1.0  # s between uploads of the control script while it is not running
+_RETRY_CONNECT = 2.0  # s between reconnection attempts
+_LET_UR_RTDE_TRY = 5.0  # s of a lost connection before ours (see _Recovery)
+
+
+@dataclass(frozen=True)
+class CellStatus:
+    """What the toolbar shows of the robot: connection, robot mode, safety mode, program."""
+
+    connected: bool
+    robot_mode: str
+    safety_mode: str
+    program: str
+    problem: str  # "" when the robot can move
+
+
+class URCellSession:
+    """A UR controller at the cell file's host; a context manager.
+
+    Args:
+        config: the cell file (its ``robot`` block has kind "ur").
+        connect_timeout: seconds to wait for the controller at start.
+
+    Raises:
+        URConnectionLost: the controller does not answer.
+    """
+
+    name = "ur"
+
+    def __init__(self, config: CellConfig, connect_timeout: float = 30.0) -> None:
+        robot = config.robot
+        self.config = config
+        tool_tcp = config.tcp_offsets.get(TCP_OF_TOOL[robot.tool.kind], Pose())
+        self.connection = URConnection(
+            robot.host,
+            tcp=URFrames(Pose()).to_ur(tool_tcp),
+            payload=(robot.payload.mass, robot.payload.center_of_gravity),
+        )
+        self.world_model = WorldModel()
+        self.workers = WorkerPool(2, "costar-ur-worker")
+        self.operator = OperatorConsole(("continue", TEACH_BUTTON))
+        self._buttons: list[DigitalInputButton] = []
+        self.library = ObjectLibrary(config.objects_path())
+        try:
+            self.connection.open(connect_timeout)
+        except BaseException:
+            self.workers.close()
+            raise
+        self.arm = URArm(self.connection, config.robot_base, tool_tcp, config.home_joints)
+        self.tool: dict[str, Any] = {}
+        self.cameras: dict[str, CameraSource] = {}
+        try:
+            self.tool = self._tool()
+            self.cameras = {
+                name: open_source(name, c.source, c.where, config.folder())
+                for name, c in config.cameras.items()
+                if c.source != "sim"
+            }
+        except BaseException:
+            self.close()
+            raise
+        self.connection.watch(_Recovery())
+        self._start_buttons()
+
+    def _start_buttons(self) -> None:
+        """The pendant's teach button and the pedal press the operator console's buttons."""
+        teach = TeachButtonReleased(self.connection)
+        self._buttons = [DigitalInputButton(teach, self.operator, TEACH_BUTTON)]
+        pedal_pin = self.config.robot.inputs.get("pedal")
+        if pedal_pin is not None:
+            pedal = URDigitalInput(self.connection, DigitalPin(*pedal_pin))
+            self._buttons.append(DigitalInputButton(pedal, self.operator, "continue"))
+        for button in self._buttons:
+            button.start()
+
+    def _tool(self) -> dict[str, Any]:
+        tool = self.config.robot.tool
+        if tool.kind == "robotiq":
+            return {"gripper": RobotiqGripper(self.connection)}
+        sensor = DigitalPin(*tool.sensor) if tool.sensor else None
+        return {"suction": URSuctionCup(self.connection, DigitalPin(*tool.vacuum), sensor)}
+
+    # ---------------------------------------------------------------- what capabilities use
+
+    def interfaces(self) -> Mapping[str, Any]:
+        return {
+            "arm": self.arm,
+            "freedrive": self.arm,
+            **self.tool,
+            **{f"rgbd:{name}": camera for name, camera in self.cameras.items()},
+            "world": self.world_model,
+            "workers": self.workers,
+            "objects": self.library,
+            "scene_layout": self.scene_layout(),
+            "operator": self.operator,
+        }
+
+    def scene_layout(self) -> dict[str, Any]:
+        """Marker sizes of every model in the object library (no fixed markers known)."""
+        sizes: dict[int, float] = {}
+        for name in self.library.names():
+            sizes.update({m.marker_id: m.size for m in self.library.get(name).markers})
+        return {"marker_sizes": sizes, "fixed_markers": {}}
+
+    def clock(self) -> float:
+        return time.monotonic()
+
+    def capability_settings(self) -> tuple[Mapping[str, Any], str]:
+        return self.config.capabilities, self.config.source or "the UR cell's file"
+
+    # ---------------------------------------------------------------- safety
+
+    def hold_reason(self) -> str:
+        """Why the robot cannot act now, in words ("" when it can): the executor's hold check.
+
+        Reads the snapshot the I/O thread keeps: never a call into ur_rtde.
+        """
+        return fault_reason(self.connection.state)
+
+    def clear(self) -> None:
+        """The operator's clear of a control script that ended on its own (stopped on the
+        pendant, a script error): upload it again. Returns at once (the I/O thread does it);
+        the hold lifts when the script runs."""
+        self.connection.submit(self.connection.start_control)
+
+    def status(self) -> CellStatus:
+        """The robot's state for the toolbar (a snapshot; never blocks)."""
+        state = self.connection.state
+        if not state.connected:
+            return CellStatus(False, "DISCONNECTED", "-", "-", fault_reason(state))
+        return CellStatus(
+            True,
+            RobotMode(state.robot_mode).name,
+            SafetyMode(state.safety_mode).name,
+            "PLAYING" if state.program_running else "STOPPED",
+            fault_reason(state),
+        )
+
+    # ---------------------------------------------------------------- lifetime
+
+    def close(self) -> None:
+        for button in self._buttons:
+            button.stop()
+        self.connection.close()
+        self.workers.close()
+
+    def __enter__(self) -> URCellSession:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()
+
+
+class _Recovery:
+    """(I/O thread) The robot side of clearing a fault, polled every cycle, never finished.
+
+    The operator clears the cause (unlocks a protective stop, releases an emergency stop and
+    powers on, restores the network); this then uploads the control script again once the
+    robot is running in normal safety, and reconnects when the connection is gone.
+    """
+
+    def __init__(self) -> None:
+        self._next_try = 0.0
+        self._lost_since: float | None = None
+        self._fault_seen = False  # a stop or a power loss the operator must clear first
+
+    def __call__(self, conn: URConnection) -> bool:
+        now = time.monotonic()
+        state = conn.state
+        if state.connected:
+            self._lost_since = None
+        elif self._lost_since is None:
+            self._lost_since = now
+        problem = fault_reason(state)
+        if problem and problem != NO_SCRIPT:
+            self._fault_seen = True
+        elif not problem:
+            self._fault_seen = False
+        if now < self._next_try:
+            return False
+        try:
+            if not state.connected:
+                # ur_rtde's control interface first tries to reconnect on its own thread;
+                # disconnecting it while it does crashes the process: let it finish first.
+                if now - (self._lost_since or now) < _LET_UR_RTDE_TRY:
+                    return False
+                self._next_try = now + _RETRY_CONNECT
+                conn.reconnect()
+            elif problem == NO_SCRIPT and self._fault_seen:
+                # The operator cleared a stop (the script ends with it): upload it again. A
+                # script that ended on its own (stopped on the pendant, a script error) waits
+                # for the operator's clear() instead.
+                self._next_try = now + _RETRY_SCRIPT
+                conn.start_control()
+        except Exception as exc:  # the controller is not back yet: try again later
+            _log.debug("UR recovery: %s", exc)
+        return False

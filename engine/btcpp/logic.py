@@ -1,0 +1,185 @@
+"""Our logic node kinds as BehaviorTree.CPP nodes, and their settings both ways.
+
+Most kinds are BehaviorTree.CPP built-ins (Sequence, Fallback, Parallel, ...); Iterator and
+Enforce (paper III-B) have no built-in twin and are declared as custom decorators in the
+file's TreeNodesModel. A setting is written as the built-in's own port (a Parallel's
+``success`` as ``success_count``, a Wait's seconds as Sleep's ``msec``); where that text
+would not give back the exact setting (``success`` = 1, a time that is no whole number of
+milliseconds), the exact value goes beside it in ``_<setting>``, which reading prefers.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from engine.spec import NodeKind
+
+__all__ = ["BUILTIN_MODELS", "LOGIC", "LOGIC_BY_MODEL", "LogicModel", "SettingMap"]
+
+Setting = str | float
+
+
+def _count_text(value: Setting) -> str:
+    if isinstance(value, float) and value.is_integer():
+        return str(int(value))
+    return str(value) if isinstance(value, str) else repr(value)
+
+
+def _number(text: str) -> Setting:
+    return float(text)
+
+
+def _words(out: dict[str, str]) -> tuple[Callable[[Setting], str], Callable[[str], Setting]]:
+    """A count port whose words (``all`` / ``any``) are counts in BehaviorTree.CPP."""
+    back = {text: word for word, text in out.items()}
+
+    def write(value: Setting) -> str:
+        return out[value] if isinstance(value, str) and value in out else _count_text(value)
+
+    def read(text: str) -> Setting:
+        return back[text] if text in back else float(text)
+
+    return write, read
+
+
+def _msec_text(value: Setting) -> str:
+    if isinstance(value, str):
+        return value
+    return str(round(value * 1000.0))
+
+
+def _msec_read(text: str) -> Setting:
+    return int(text) / 1000.0
+
+
+@dataclass(frozen=True)
+class SettingMap:
+    """One setting of a kind: its port in BehaviorTree.CPP and the text both ways."""
+
+    port: str
+    write: Callable[[Setting], str] = _count_text
+    read: Callable[[str], Setting] = _number
+
+
+@dataclass(frozen=True)
+class LogicModel:
+    """A logic kind as a BehaviorTree.CPP node.
+
+    Attributes:
+        kind: our kind.
+        model: BehaviorTree.CPP's id (the compact element name).
+        element: its model type: Control, Decorator or Action.
+        builtin: True when BehaviorTree.CPP has it; False: declared in the TreeNodesModel.
+        settings: our setting name -> how it is written.
+    """
+
+    kind: NodeKind
+    model: str
+    element: str
+    builtin: bool = True
+    settings: dict[str, SettingMap] = field(default_factory=dict)
+
+
+_SUCCESS = _words({"all": "-1", "any": "1"})
+_FAILURE = _words({"any": "1"})
+_MSEC = SettingMap("msec", _msec_text, _msec_read)
+
+LOGIC: dict[NodeKind, LogicModel] = {
+    m.kind: m
+    for m in (
+        LogicModel(NodeKind.SEQUENCE, "Sequence", "Control"),
+        LogicModel(NodeKind.SELECTOR, "Fallback", "Control"),
+        LogicModel(
+            NodeKind.PARALLEL,
+            "Parallel",
+            "Control",
+            settings={
+                "success": SettingMap("success_count", *_SUCCESS),
+                "failure": SettingMap("failure_count", *_FAILURE),
+            },
+        ),
+        LogicModel(NodeKind.REACTIVE_SEQUENCE, "ReactiveSequence", "Control"),
+        LogicModel(NodeKind.REACTIVE_SELECTOR, "ReactiveFallback", "Control"),
+        LogicModel(
+            NodeKind.ITERATOR,
+            "Iterator",
+            "Decorator",
+            builtin=False,
+            settings={"count": SettingMap("count"), "timeout": SettingMap("timeout")},
+        ),
+        LogicModel(
+            NodeKind.ENFORCE,
+            "Enforce",
+            "Decorator",
+            builtin=False,
+            settings={"count": SettingMap("count"), "timeout": SettingMap("timeout")},
+        ),
+        LogicModel(NodeKind.INVERTER, "Inverter", "Decorator"),
+        LogicModel(
+            NodeKind.REPEAT, "Repeat", "Decorator", settings={"count": SettingMap("num_cycles")}
+        ),
+        LogicModel(
+            NodeKind.RETRY,
+            "RetryUntilSuccessful",
+            "Decorator",
+            settings={"count": SettingMap("num_attempts")},
+        ),
+        LogicModel(NodeKind.TIMEOUT, "Timeout", "Decorator", settings={"seconds": _MSEC}),
+        LogicModel(NodeKind.FORCE_SUCCESS, "ForceSuccess", "Decorator"),
+        LogicModel(NodeKind.FORCE_FAILURE, "ForceFailure", "Decorator"),
+        LogicModel(NodeKind.WAIT, "Sleep", "Action", settings={"seconds": _MSEC}),
+    )
+}
+LOGIC_BY_MODEL: dict[str, LogicModel] = {m.model: m for m in LOGIC.values()}
+
+# Every built-in id of BehaviorTree.CPP 4.10 (an operation's model id must not be one).
+BUILTIN_MODELS: frozenset[str] = frozenset(
+    {
+        "AlwaysFailure",
+        "AlwaysSuccess",
+        "AsyncFallback",
+        "AsyncSequence",
+        "Delay",
+        "EntryUpdated",
+        "Fallback",
+        "ForceFailure",
+        "ForceSuccess",
+        "IfThenElse",
+        "Inverter",
+        "KeepRunningUntilFailure",
+        "LoopBool",
+        "LoopDouble",
+        "LoopInt",
+        "LoopString",
+        "Parallel",
+        "ParallelAll",
+        "Precondition",
+        "ReactiveFallback",
+        "ReactiveSequence",
+        "Repeat",
+        "RetryUntilSuccessful",
+        "RunOnce",
+        "Script",
+        "ScriptCondition",
+        "Sequence",
+        "SequenceWithMemory",
+        "SetBlackboard",
+        "SkipUnlessUpdated",
+        "Sleep",
+        "SubTree",
+        "Switch2",
+        "Switch3",
+        "Switch4",
+        "Switch5",
+        "Switch6",
+        "Timeout",
+        "TryCatch",
+        "UnsetBlackboard",
+        "WaitValueUpdate",
+        "WasEntryUpdated",
+        "WhileDoElse",
+        "Iterator",
+        "Enforce",
+    }
+)

@@ -1,0 +1,159 @@
+"""Edits of a document that involve library subtrees, each one undo step.
+
+An instance and the definition it runs travel together: inserting an instance embeds its
+subtree in the plan (``PlanSpec.subtrees``); saving nodes as a subtree replaces them with an
+instance of it; detaching turns an instance back into plain nodes; updating moves an
+instance to the library's newer version. Each is a macro of the document's small commands
+(:class:`ReplaceNodeCommand`, :class:`AddNodeCommand`, :class:`SetPlanFieldCommand` of
+``subtrees``), so undo restores the plan byte for byte.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+from engine.operations import OperationSource
+from engine.spec import NodeSpec, SubtreeSpec
+from engine.subtree_ops import (
+    OpenPort,
+    detach,
+    instance_of,
+    make_subtree,
+    ports_of,
+    subtrees_in_use,
+    update,
+)
+from instructor_app.document.commands import (
+    AddNodeCommand,
+    ReplaceNodeCommand,
+    SetPlanFieldCommand,
+)
+from instructor_app.document.editing import PlanDocument
+from instructor_app.document.model import DocumentError
+from instructor_app.document.tree_ops import can_have_child
+
+__all__ = ["SubtreeEditor"]
+
+
+class SubtreeEditor:
+    """Subtree edits of one document (its undo stack holds them).
+
+    Args:
+        document: the document edited.
+    """
+
+    def __init__(self, document: PlanDocument) -> None:
+        self.document = document
+
+    def _embedded_with(self, *subtrees: SubtreeSpec) -> list[SubtreeSpec]:
+        have = list(self.document.plan.subtrees)
+        for subtree in subtrees:
+            if all(s.ref != subtree.ref for s in have):
+                have.append(subtree)
+        return have
+
+    def _unused_dropped(self, subtrees: list[SubtreeSpec]) -> list[SubtreeSpec]:
+        """The definitions some instance of the plan still runs."""
+        return subtrees_in_use(self.document.plan.tree, subtrees)
+
+    def insert_instance(
+        self, subtree: SubtreeSpec, parent_id: str | None, index: int | None = None
+    ) -> str:
+        """Insert an instance of a library subtree (its inputs unbound); returns its id."""
+        doc = self.document
+        if parent_id is not None and not can_have_child(doc.node(parent_id)):
+            raise DocumentError(f"{doc.node(parent_id).label!r} cannot take another child")
+        if parent_id is None and doc.plan.tree is not None:
+            raise DocumentError("the plan already has a root node; add the instance under it")
+        node = instance_of(subtree)
+        if parent_id is not None and index is None:
+            index = len(doc.node(parent_id).children)
+        stack = doc.undo_stack
+        stack.beginMacro(f"Insert {subtree.name}")
+        try:
+            stack.push(SetPlanFieldCommand(doc, "subtrees", self._embedded_with(subtree)))
+            stack.push(AddNodeCommand(doc, node, parent_id, index or 0))
+        finally:
+            stack.endMacro()
+        return node.id
+
+    def save_as_subtree(
+        self,
+        node_id: str,
+        name: str,
+        source: OperationSource,
+        open_ports: Sequence[OpenPort] = (),
+        outputs: Mapping[str, str] | None = None,
+        description: str = "",
+    ) -> SubtreeSpec:
+        """A subtree made from a node and the nodes below it (version 0: not in a library).
+
+        The caller saves it to the library and then calls :meth:`use_saved` to replace the
+        nodes with an instance of the saved version.
+
+        Raises:
+            DocumentError: a chosen port or output does not fit the nodes.
+        """
+        doc = self.document
+        try:
+            return make_subtree(
+                doc.node(node_id), name, ports_of(doc.plan, source), open_ports, outputs,
+                description,
+            )  # fmt: skip
+        except ValueError as exc:
+            raise DocumentError(str(exc)) from exc
+
+    def use_saved(
+        self, node_id: str, saved: SubtreeSpec, open_ports: Sequence[OpenPort] = ()
+    ) -> str:
+        """Replace a node with an instance of ``saved`` that does what it did; returns its id."""
+        doc = self.document
+        original = doc.node(node_id)
+        instance = instance_of(saved, original, open_ports)
+        instance.name = original.name or saved.name
+        layout = doc.plan.layout.get(node_id)
+        stack = doc.undo_stack
+        stack.beginMacro(f"Save {original.label} as the subtree {saved.name}")
+        try:
+            stack.push(SetPlanFieldCommand(doc, "subtrees", self._embedded_with(saved)))
+            stack.push(
+                ReplaceNodeCommand(doc, node_id, instance, {instance.id: layout} if layout else {})
+            )
+        finally:
+            stack.endMacro()
+        return instance.id
+
+    def detach(self, node_id: str) -> str:
+        """Turn an instance into plain nodes; returns the id of the top one."""
+        doc = self.document
+        instance = doc.node(node_id)
+        try:
+            nodes = detach(doc.plan, instance)
+        except ValueError as exc:
+            raise DocumentError(str(exc)) from exc
+        self._replace(node_id, nodes, f"Detach {instance.label}")
+        return nodes.id
+
+    def update(self, node_id: str, newer: SubtreeSpec) -> None:
+        """Move an instance to another version of its subtree, keeping what still fits."""
+        doc = self.document
+        instance = doc.node(node_id)
+        doc.undo_stack.beginMacro(f"Update {instance.label} to version {newer.version}")
+        try:
+            doc.undo_stack.push(SetPlanFieldCommand(doc, "subtrees", self._embedded_with(newer)))
+            self._replace(node_id, update(instance, newer), "")
+        finally:
+            doc.undo_stack.endMacro()
+
+    def _replace(self, node_id: str, node: NodeSpec, text: str) -> None:
+        doc = self.document
+        layout = doc.plan.layout.get(node_id)
+        stack = doc.undo_stack
+        stack.beginMacro(text or f"Replace {doc.node(node_id).label}")
+        try:
+            stack.push(ReplaceNodeCommand(doc, node_id, node, {node.id: layout} if layout else {}))
+            kept = self._unused_dropped(list(doc.plan.subtrees))
+            if len(kept) != len(doc.plan.subtrees):
+                stack.push(SetPlanFieldCommand(doc, "subtrees", kept))
+        finally:
+            stack.endMacro()

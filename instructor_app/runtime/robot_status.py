@@ -1,0 +1,117 @@
+"""The robot's state in the status bar: connection, robot mode, safety mode, program, live.
+
+A real cell (``capabilities.ur.cell.URCellSession``) keeps a snapshot of what its controller
+reports, refreshed on its own I/O thread; this widget reads that snapshot on a timer, so the
+GUI thread never waits on the robot. Cells without a robot controller (the simulated cell,
+none) have no ``status()``: the widget hides.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from PySide6.QtCore import QTimer, Signal
+from PySide6.QtWidgets import QLabel, QToolButton, QWidget
+
+from instructor_app.runtime.session import CellSession
+
+__all__ = ["RobotStatusLabel", "ScriptRestartButton"]
+
+_OK_STYLE = "QLabel { background: #d8f0d8; color: #104010; padding: 2px 6px; }"
+_FAULT_STYLE = "QLabel { background: #f6d0d0; color: #601010; padding: 2px 6px; }"
+
+
+class RobotStatusLabel(QLabel):
+    """Shows the open cell's robot state, refreshed every ``interval_ms``.
+
+    Args:
+        session: the cell session (the open cell may change under it).
+        interval_ms: how often the snapshot is read.
+
+    Signals:
+        presence_changed(bool): the open cell has (or no longer has) a robot controller; a
+            window shows or hides the label on it.
+        fault_changed(str): the problem shown changed ("" when the robot can move).
+    """
+
+    presence_changed = Signal(bool)
+    fault_changed = Signal(str)
+
+    def __init__(
+        self, session: CellSession, interval_ms: int = 100, parent: QWidget | None = None
+    ) -> None:
+        super().__init__(parent)
+        self.setObjectName("RobotStatus")
+        self._session = session
+        self._shown: Any = None
+        self._timer = QTimer(self)
+        self._timer.setInterval(interval_ms)
+        self._timer.timeout.connect(self.refresh)
+        self._timer.start()
+        session.cell_changed.connect(lambda _name: self.refresh())
+        self.refresh()
+
+    def refresh(self) -> None:
+        """Read the cell's status snapshot and show it (only when it changed)."""
+        status_of = getattr(self._session.cell, "status", None)
+        status = status_of() if callable(status_of) else None
+        if status == self._shown:
+            return
+        if (status is None) != (self._shown is None):
+            self.presence_changed.emit(status is not None)
+        fault_before = self.fault
+        self._shown = status
+        if self.fault != fault_before:
+            self.fault_changed.emit(self.fault)
+        if status is None:
+            self.setText("")
+            return
+        if not status.connected:
+            self.setText(f"Robot: {status.problem}")
+        else:
+            text = (
+                f"Robot: {status.robot_mode} · safety {status.safety_mode} · "
+                f"program {status.program}"
+            )
+            self.setText(text + (f" — {status.problem}" if status.problem else ""))
+        self.setStyleSheet(_FAULT_STYLE if status.problem else _OK_STYLE)
+        self.setToolTip(
+            "What the robot's controller reports: connection, robot mode, safety mode and "
+            "the control program. " + (f"Stopped: {status.problem}." if status.problem else "")
+        )
+
+    @property
+    def present(self) -> bool:
+        """Whether the open cell has a robot controller to show."""
+        return self._shown is not None
+
+    @property
+    def fault(self) -> str:
+        """The problem shown now ("" when the robot can move or there is no robot)."""
+        return str(getattr(self._shown, "problem", ""))
+
+
+class ScriptRestartButton(QToolButton):
+    """ "Restart control script": the operator's clear of a control script that ended on its
+    own (stopped on the pendant, a script error). Shown only while that is the robot's problem;
+    the cell uploads the script on its own thread, so the click returns at once."""
+
+    def __init__(
+        self, session: CellSession, status: RobotStatusLabel, parent: QWidget | None = None
+    ) -> None:
+        super().__init__(parent)
+        self.setObjectName("RestartScript")
+        self.setText("Restart control script")
+        self.setToolTip("Upload the robot's control script again; a held run then goes on")
+        self._session = session
+        self.setVisible(False)
+        status.fault_changed.connect(self._on_fault)
+        self.clicked.connect(self._restart)
+
+    def _on_fault(self, fault: str) -> None:
+        self.setVisible(fault.startswith("the control script is not running"))
+
+    def _restart(self) -> None:
+        clear = getattr(self._session.cell, "clear", None)
+        if callable(clear):
+            clear()

@@ -1,0 +1,123 @@
+"""The Instructor on a UR cell (the loopback emulator through ur_rtde): the cell chooser opens a
+cell file, and the toolbar shows connection, robot mode, safety mode and program state live."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+
+import dashboard_client
+import pytest
+from PySide6.QtCore import Qt
+
+from capabilities.ur.emulator.process import EmulatorProcess
+from instructor_app.runtime.session import CellSession
+from tests.capabilities.ur.emulators import next_host
+from tests.instructor_app.gui_driver import ScriptedDialogs, make_window
+
+pytestmark = pytest.mark.sim
+
+WAIT_MS = 15_000
+
+
+@pytest.fixture
+def emulator(tmp_path: Path) -> Iterator[EmulatorProcess]:
+    process = EmulatorProcess(
+        next_host(), "5.12", unlock_delay=0.0, write_cell=tmp_path / "emulated.cell.json"
+    )
+    with process:
+        yield process
+
+
+def test_the_toolbar_shows_each_robot_state(qtbot, tmp_path: Path, emulator) -> None:
+    cell_file = str(tmp_path / "emulated.cell.json")
+    session = CellSession("none")
+    session.open()
+    dialogs = ScriptedDialogs()
+    dialogs.cell_paths.append(cell_file)
+    window = make_window(qtbot, session, tmp_path, dialogs)
+    label = window.robot_status
+    assert not label.isVisibleTo(window)  # no robot controller on the "none" cell
+    # The cell chooser's last entry asks for a cell file.
+    combo = window.cell_combo
+    combo.activated.emit(combo.count() - 1)
+    assert session.name == cell_file and combo.currentText() == "emulated.cell.json"
+    try:
+        text = label.text
+        qtbot.waitUntil(lambda: "RUNNING" in text() and "PLAYING" in text(), timeout=WAIT_MS)
+        assert label.isVisibleTo(window) and "safety NORMAL" in text() and not label.fault
+
+        emulator.protective_stop()
+        qtbot.waitUntil(lambda: label.fault == "protective stop", timeout=WAIT_MS)
+        assert "PROTECTIVE_STOP" in text() and "protective stop" in text()
+        pendant = dashboard_client.DashboardClient(emulator.host)
+        pendant.connect()
+        pendant.unlockProtectiveStop()  # the operator clears it; the cell uploads the script
+        qtbot.waitUntil(lambda: not label.fault and "PLAYING" in text(), timeout=WAIT_MS)
+
+        emulator.emergency_stop()
+        qtbot.waitUntil(lambda: label.fault == "emergency stop", timeout=WAIT_MS)
+        emulator.release_emergency_stop()
+        qtbot.waitUntil(lambda: "powered off" in label.fault, timeout=WAIT_MS)
+        assert "POWER_OFF" in text()
+        pendant.powerOn()
+        pendant.brakeRelease()
+        qtbot.waitUntil(lambda: not label.fault and "PLAYING" in text(), timeout=WAIT_MS)
+
+        emulator.kill_script()  # stopped on the pendant: the operator restarts it here
+        qtbot.waitUntil(lambda: "control script is not running" in label.fault, timeout=WAIT_MS)
+        assert "program STOPPED" in text()
+        restart = window.robot_restart
+        assert restart.isVisibleTo(window)
+        qtbot.mouseClick(restart, Qt.MouseButton.LeftButton)
+        qtbot.waitUntil(lambda: not label.fault and "PLAYING" in text(), timeout=WAIT_MS)
+        assert not restart.isVisibleTo(window)
+
+        emulator.kill()
+        qtbot.waitUntil(lambda: label.fault.startswith("connection lost"), timeout=WAIT_MS)
+        assert text().startswith("Robot: connection lost")
+    finally:
+        session.close()
+
+
+def test_a_protective_stop_during_a_run_is_said_in_words_and_the_run_goes_on(
+    qtbot, tmp_path: Path, emulator
+) -> None:
+    from engine.files import save_plan
+    from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
+    from engine.status import Status
+    from engine.types import JointConfig, ParamType
+    from instructor_app.document.editing import PlanDocument
+    from instructor_app.runtime.controller import RunController
+    from tests.capabilities.ur.emulators import HOME, wait_for
+
+    target = JointConfig((HOME[0] + 1.2, *HOME[1:]))
+    move = NodeSpec(NodeKind.OPERATION, "turn", op="motion.move_joints", params={
+        "target": Binding.fixed(target, ParamType.JOINTS),
+        "speed": Binding.fixed(0.5, ParamType.NUMBER),
+    })  # fmt: skip
+    plan_path = tmp_path / "turn.costar.json"
+    save_plan(PlanSpec(move, "turn"), plan_path)
+    session = CellSession(str(tmp_path / "emulated.cell.json"))
+    assert session.open()
+    try:
+        document = PlanDocument()
+        document.open(plan_path)
+        controller = RunController(document, session, rate_hz=20.0)
+        logs: list[tuple[str, str]] = []
+        controller.log_message.connect(lambda text, level: logs.append((text, level)))
+        with qtbot.waitSignal(controller.run_finished, timeout=60_000) as finished:
+            controller.run()
+            assert wait_for(lambda: emulator.state()["moving"], 20)
+            emulator.protective_stop()
+            qtbot.waitUntil(
+                lambda: ("The robot stopped the run: protective stop", "error") in logs,
+                timeout=WAIT_MS,
+            )
+            pendant = dashboard_client.DashboardClient(emulator.host)
+            pendant.connect()
+            pendant.unlockProtectiveStop()
+        assert finished.args[0].status is Status.SUCCESS
+        assert ("The robot is ready again: the run goes on", "info") in logs
+    finally:
+        session.close()

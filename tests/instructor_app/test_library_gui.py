@@ -1,0 +1,232 @@
+"""The subtree library in the Instructor, driven through its widgets.
+
+Save a selection as a subtree (the dialog's tables), the Library panel (folders, search,
+preview, insert, find usages), palette search-to-insert of a library subtree, an instance's
+binding form in the inspector, detach and update, each one undo step.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+import pytest
+from PySide6.QtCore import QPointF, Qt
+from PySide6.QtGui import QDropEvent
+from PySide6.QtWidgets import QDialog
+
+from engine.files import dump_plan
+from engine.library import LIBRARY_ENV, Library
+from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
+from engine.status import Status
+from engine.types import ParamType
+from instructor_app.main_window import MainWindow
+from instructor_app.runtime.session import CellSession
+from instructor_app.subtree_dialog import SaveSubtreeDialog
+from tests.instructor_app.gui_driver import (
+    ScriptedDialogs,
+    make_window,
+    run_to_end,
+    search_insert,
+    select,
+    set_value,
+)
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "resources" / "examples"
+
+
+@pytest.fixture
+def window(qtbot: Any, none_session: CellSession, tmp_path: Path) -> MainWindow:
+    return make_window(qtbot, none_session, tmp_path, ScriptedDialogs())
+
+
+def _op(label: str, op: str, **params: Binding) -> NodeSpec:
+    return NodeSpec(NodeKind.OPERATION, label, op=op, params=params)
+
+
+def _text(value: str) -> Binding:
+    return Binding.fixed(value, ParamType.TEXT)
+
+
+def _plan() -> PlanSpec:
+    part = NodeSpec(
+        NodeKind.SEQUENCE, "part",
+        children=[_op("say", "debug.log", message=_text("hello")),
+                  _op("keep", "debug.set_param", value=_text("x"), name=Binding.reference("OUT"))],
+    )  # fmt: skip
+    check = _op("check", "debug.check_param", value=Binding.reference("OUT"), expected=_text("x"))
+    return PlanSpec(NodeSpec(NodeKind.SEQUENCE, "main", children=[part, check]), "library test")
+
+
+def _open(window: MainWindow, tmp_path: Path, plan: PlanSpec) -> None:
+    path = tmp_path / "plan.costar.json"
+    path.write_text(dump_plan(plan), encoding="utf-8")
+    assert window.open_plan(path)
+
+
+def _node(window: MainWindow, name: str) -> NodeSpec:
+    return next(n for _, n in window.document.plan.walk() if n.name == name)
+
+
+def _save_part_with_open_message(qtbot: Any, window: MainWindow) -> str:
+    """Select "part", open Save as subtree, tick its message as the input MESSAGE and OUT as
+    an output, save; returns the instance's id."""
+    shown: list[SaveSubtreeDialog] = []
+
+    def dialog(*args: Any) -> SaveSubtreeDialog:
+        made = SaveSubtreeDialog(*args)
+        row = made.parameter_rows().index("say / message")
+        made.set_open(row, "MESSAGE", "what to say")
+        made.set_output(made.output_rows().index("OUT"), "the kept value")
+        made.folder_field.setText("tests")
+        made.exec = lambda: QDialog.DialogCode.Accepted  # type: ignore[method-assign]
+        shown.append(made)
+        return made
+
+    window.library.dialog_factory = dialog
+    select(window, _node(window, "part").id)
+    window.library.actions["save_subtree"].trigger()
+    assert shown, "the dialog was not shown"
+    return _node(window, "part").id
+
+
+def test_save_selection_as_subtree_runs_undoes_and_detaches(
+    qtbot: Any, window: MainWindow, tmp_path: Path
+) -> None:
+    _open(window, tmp_path, _plan())
+    before = window.document.serialized()
+    instance_id = _save_part_with_open_message(qtbot, window)
+    instance = window.document.node(instance_id)
+    assert instance.kind is NodeKind.SUBTREE
+    assert instance.params["MESSAGE"] == _text("hello")
+    saved = Path(os.environ[LIBRARY_ENV]) / "tests" / "part.subtree.json"
+    assert saved.exists()
+    assert "part" in window.views.library.visible_names()
+    outcome = run_to_end(qtbot, window)
+    assert outcome.status is Status.SUCCESS
+    # one undo step puts the plain nodes back, byte for byte
+    window.document.undo_stack.undo()
+    assert window.document.serialized() == before
+    window.document.undo_stack.redo()
+    select(window, instance_id)
+    window.library.actions["detach"].trigger()
+    part = _node(window, "part")
+    assert part.kind is NodeKind.SEQUENCE and part.children[0].params["message"] == _text("hello")
+    assert window.document.plan.subtrees == []
+    assert run_to_end(qtbot, window).status is Status.SUCCESS
+
+
+def test_an_instance_input_is_bound_through_its_port_row(
+    qtbot: Any, window: MainWindow, tmp_path: Path
+) -> None:
+    _open(window, tmp_path, _plan())
+    instance_id = _save_part_with_open_message(qtbot, window)
+    set_value(qtbot, window, instance_id, "MESSAGE", "good bye")
+    assert window.document.node(instance_id).params["MESSAGE"] == _text("good bye")
+    assert window.views.inspector.port_row("OUT") is not None  # outputs are ports too
+    window.document.undo_stack.undo()
+    assert window.document.node(instance_id).params["MESSAGE"] == _text("hello")
+
+
+def test_library_panel_lists_folders_searches_and_previews(qtbot: Any, window: MainWindow) -> None:
+    panel = window.views.library
+    assert {"Handoff", "Unholster", "Transfer", "Holster", "Return"} <= set(panel.visible_names())
+    qtbot.keyClicks(panel.search_field, "suction")
+    assert set(panel.visible_names()) == {"Unholster", "Holster"}
+    panel.search_field.clear()
+    panel.select("Transfer")
+    text = panel.preview.toPlainText()
+    assert "Version 1" in text and "OBJECT: ObjectModel" in text and "Shape" in text
+    assert "perception.detect_objects" in text
+
+
+def test_palette_search_inserts_a_library_subtree_with_one_undo(
+    qtbot: Any, window: MainWindow, tmp_path: Path
+) -> None:
+    _open(window, tmp_path, _plan())
+    before = window.document.serialized()
+    select(window, _node(window, "main").id)
+    added = search_insert(qtbot, window, "Transfer", "subtree")
+    node = window.document.node(added)
+    assert node.subtree is not None and node.subtree.id == "kitting.transfer"
+    assert [s.name for s in window.document.plan.subtrees] == ["Transfer"]
+    select(window, added)
+    assert window.views.inspector.kind_label.text().startswith("<b>Subtree Transfer")
+    window.document.undo_stack.undo()
+    assert window.document.serialized() == before
+
+
+def test_library_panel_insert_button_and_find_usages(
+    qtbot: Any, window: MainWindow, tmp_path: Path
+) -> None:
+    _open(window, tmp_path, _plan())
+    panel = window.views.library
+    panel.select("Holster")
+    select(window, _node(window, "main").id)
+    qtbot.mouseClick(panel.insert_button, Qt.MouseButton.LeftButton)
+    assert window.document.plan.tree.children[-1].name == "Holster"  # type: ignore[union-attr]
+    window.library.folder_chooser = lambda: str(EXAMPLES)
+    panel.select("Transfer")
+    qtbot.mouseClick(panel.usages_button, Qt.MouseButton.LeftButton)
+    assert len(window.library.last_usages) == 3
+    assert "kitting.costar.json" in panel.preview.toPlainText()
+
+
+def test_a_newer_library_version_is_shown_and_the_instance_updates(
+    qtbot: Any, window: MainWindow, tmp_path: Path
+) -> None:
+    _open(window, tmp_path, _plan())
+    instance_id = _save_part_with_open_message(qtbot, window)
+    library = Library(Path(os.environ[LIBRARY_ENV])).scan()  # a second Instructor saves v2
+    current = library.latest(window.document.node(instance_id).subtree.id)  # type: ignore[union-attr]
+    assert current is not None
+    current.description = "says something, keeps a value"
+    library.save(current, base_version=current.version)
+    window.library.reload()
+    problems = window.views.validation.problems()
+    assert any("newer version" in p.message and p.node_id == instance_id for p in problems)
+    select(window, instance_id)
+    window.library.actions["update"].trigger()
+    assert window.document.node(instance_id).subtree.version == 2  # type: ignore[union-attr]
+    qtbot.waitUntil(
+        lambda: not any("newer version" in p.message for p in window.views.validation.problems())
+    )
+
+
+def test_the_inside_of_a_selected_instance_shows_the_run_live(
+    qtbot: Any, window: MainWindow, tmp_path: Path
+) -> None:
+    _open(window, tmp_path, _plan())
+    instance_id = _save_part_with_open_message(qtbot, window)
+    select(window, instance_id)
+    inside = window.views.inside
+    assert inside.title.text().startswith("Inside part")
+    assert set(inside.status_texts()) == {
+        "part (sequence)",
+        "say (debug.log)",
+        "keep (debug.set_param)",
+    }
+    assert run_to_end(qtbot, window).status is Status.SUCCESS
+    qtbot.waitUntil(lambda: set(inside.status_texts().values()) == {"SUCCESS"})
+
+
+def test_a_subtree_dragged_from_the_library_onto_a_node_becomes_its_child(
+    qtbot: Any, window: MainWindow, tmp_path: Path
+) -> None:
+    _open(window, tmp_path, _plan())
+    panel = window.views.library
+    panel.select("Unholster")
+    row = panel.tree.currentItem()
+    mime = panel.tree.mimeData([row])  # what the tree hands to a drag
+    canvas = window.views.canvas
+    main = canvas.item(_node(window, "main").id)
+    pos = canvas.viewer.mapFromScene(main.mapToScene(main.shape_rect().center()))
+    event = QDropEvent(
+        QPointF(pos), Qt.DropAction.CopyAction, mime, Qt.MouseButton.LeftButton,
+        Qt.KeyboardModifier.NoModifier,
+    )  # fmt: skip
+    canvas.viewer.dropEvent(event)
+    added = window.document.plan.tree.children[-1]  # type: ignore[union-attr]
+    assert added.kind is NodeKind.SUBTREE and added.name == "Unholster"
+    assert [s.name for s in window.document.plan.subtrees] == ["Unholster"]
