@@ -152,27 +152,29 @@ class CameraFeed:
             next_due = max(next_due + 1.0 / max(self.fps, 0.1), now)
             seq += 1
             if own:
-                self._capture(name, seq, lambda: camera.preview(self.size))
-                continue
-            with self._cell_lock:
-                started = self._clock()
-                self._capture(name, seq, lambda: self._plain_capture(camera))
-                took = self._clock() - started
-                self._not_before = self._clock() + took * (1.0 / max(self.max_duty, 0.01) - 1.0)
+                captured = self._capture(name, seq, lambda: camera.preview(self.size))
+            else:
+                with self._cell_lock:
+                    started = self._clock()
+                    captured = self._capture(name, seq, lambda: self._plain_capture(camera))
+                    took = self._clock() - started
+                    self._not_before = self._clock() + took * (1.0 / max(self.max_duty, 0.01) - 1.0)
+            if not captured:
+                self._stop.wait(0.5)  # a failing camera is asked again later, never in a loop
 
     def _plain_capture(self, camera: Any) -> Any:
         sized = self.size is not None and "size" in inspect.signature(camera.capture).parameters
         return camera.capture(size=self.size) if sized else camera.capture()
 
-    def _capture(self, name: str, seq: int, grab: Callable[[], Any]) -> None:
+    def _capture(self, name: str, seq: int, grab: Callable[[], Any]) -> bool:
+        """Capture one frame and leave it in the camera's slot; False if the capture failed."""
         try:
             frame = grab()
         except Exception as exc:  # a closed cell or a failing camera must not end the feed
             self.errors += 1
             self.failures[name] = str(exc) or type(exc).__name__
             _log.debug("camera %s: %s", name, exc)
-            self._stop.wait(0.5)
-            return
+            return False
         self.failures.pop(name, None)
         rgb = np.array(frame.rgb, dtype=np.uint8, copy=True)
         depth = depth_image(frame.depth)
@@ -182,3 +184,4 @@ class CameraFeed:
             except Exception:  # an overlay bug shows a plain picture, never ends the feed
                 _log.exception("drawing the overlays of camera %s failed", name)
         self._slots[name] = FeedFrame(frame, rgb, depth, seq)
+        return True
