@@ -42,11 +42,12 @@ __all__ = ["LiveView", "LiveViewError", "MirrorRecipe"]
 
 START_TIMEOUT = 60.0  # s: a fresh interpreter imports numpy and pybullet, builds the scene
 FRAME_TIMEOUT = 10.0  # s: one frame on a loaded machine
-# Priority of a mirror process (added niceness). Measured with bench/cell_views.py on the
-# loaded 2-core VM: niceness 5 cost a third of the frames (4.6 vs 7.2 fps) and bought no ticks
-# (tick_rate_ratio 0.95 vs 0.97, simulation speed 0.97 in both): the physics thread and the
-# engine mostly sleep, and a task that wakes from sleep is served promptly anyway.
-NICENESS = 0
+# Priority of a mirror process (added niceness): below the app's, so that the live pictures
+# take only spare CPU. Measured with bench/cell_views.py on the loaded 2-core VM (under Xvfb
+# the 3D scene's OpenGL is drawn by the CPU too): at niceness 0 the cameras got ~1.5x the
+# frames but the 3D scene fell from ~22 to ~13 frames a second (means over runs); the ticks
+# and the simulation's speed did not measurably differ.
+NICENESS = 5
 
 
 class LiveViewError(SimError):
