@@ -153,6 +153,11 @@ def test_the_panel_says_when_a_live_view_stopped_and_the_other_camera_goes_on(qt
         os.kill(cell.live_view.pids()["shoulder"], signal.SIGKILL)  # the renderer crashes
         qtbot.waitUntil(lambda: "No live picture" in widget.rate_label.text(), timeout=20000)
         assert "shoulder" in widget.rate_label.text() and "stopped" in widget.rate_label.text()
+        captions = {
+            name: [x.toPlainText() for x in labels] for name, labels in widget._labels.items()
+        }
+        assert all("NO LIVE PICTURE" in text for text in captions["shoulder"])  # on the pictures
+        assert not any("NO LIVE PICTURE" in text for text in captions["wrist"])
         wrist = widget.shown["wrist"].seq
         qtbot.waitUntil(lambda: widget.shown["wrist"].seq > wrist, timeout=20000)
         widget.stop()
