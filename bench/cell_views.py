@@ -9,8 +9,14 @@ between phases with the camera and 3D docks hidden (nothing captured or drawn) a
   the same run (goal at least 0.9).
 - ``scene3d_fps``: frames per second the 3D scene draws while the arm moves (null where no
   OpenGL context can be made: run under xvfb-run).
-- ``sim_speed_on`` / ``sim_speed_off``: simulated seconds per wall second in each phase (the
-  CPU renderer runs on the physics thread, so camera frames cost the simulation time).
+- ``sim_speed_on`` / ``sim_speed_off``: simulated seconds per wall second in each phase.
+- ``camera_fps_by_camera``: frames each camera's feed captured per second (shown phase).
+- ``renderer_cpu_ms_per_frame``: CPU time each camera's live-view renderer process spent per
+  frame (independent of the load; 1000 / it is what an idle core would give).
+- ``app_cpu_on`` / ``app_cpu_off``: cores the app's own process used in each phase.
+- ``first_picture_s``: seconds from starting the plan to the first picture of every camera
+  (the live view's renderer processes start); both phases are measured after it.
+- ``load_average``: the machine's load (1, 5, 15 min) at the end: the figures depend on it.
 
 Run it on its own or through ``bench/gui.py`` (which runs it in a process of its own with
 ``QT_QPA_PLATFORM=xcb`` when there is a display)::
@@ -53,7 +59,33 @@ def _wait(seconds: float) -> None:
     loop.exec()
 
 
-def _phase(window: Any, shown: bool, seconds: float) -> dict[str, float]:
+def _cpu_seconds(pid: int) -> float | None:
+    """CPU time (user + system) a process has used so far (Linux; None elsewhere)."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return None
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def _renderers(cell: Any) -> dict[str, int]:
+    """Camera -> process id of its live-view renderer (none on a cell without one)."""
+    live = getattr(cell, "live_view", None)
+    return live.pids() if live is not None else {}
+
+
+def _first_pictures(window: Any, timeout: float = 60.0) -> float:
+    """Seconds until the camera panel shows a picture of every camera: the live view's
+    renderers start once (a fresh process each), before either phase is measured."""
+    cameras, started = window.cell_views.cameras, time.perf_counter()
+    while len(cameras.shown) < len(cameras._pictures):
+        _wait(0.1)
+        if time.perf_counter() - started > timeout:
+            raise RuntimeError(f"the camera panel showed no picture within {timeout:g} s")
+    return time.perf_counter() - started
+
+
+def _phase(window: Any, shown: bool, seconds: float) -> dict[str, Any]:
     views = window.cell_views
     for name in ("cameras", "scene3d"):
         window.docks[name].setVisible(shown)
@@ -62,14 +94,32 @@ def _phase(window: Any, shown: bool, seconds: float) -> dict[str, float]:
     cell = window.session.cell
     ticks0, sim0, wall0 = executor.tree.ctx.tick_count, cell.sim.time(), time.perf_counter()
     frames0, drawn0 = views.cameras.frames_shown, views.scene3d.frames_drawn
+    seq0 = {name: frame.seq for name, frame in views.cameras.shown.items()}
+    cpu0 = {name: _cpu_seconds(pid) for name, pid in _renderers(cell).items()}
+    app0 = _cpu_seconds(os.getpid())
     _wait(seconds)
     wall = time.perf_counter() - wall0
+    app1 = _cpu_seconds(os.getpid())
     cameras = max(len(views.cameras.shown), 1)
     return {
         "ticks_per_s": (executor.tree.ctx.tick_count - ticks0) / wall,
         "camera_fps": (views.cameras.frames_shown - frames0) / wall / cameras,
         "scene3d_fps": (views.scene3d.frames_drawn - drawn0) / wall,
         "sim_speed": (cell.sim.time() - sim0) / wall,
+        # Frames each camera's feed captured (the panel may show fewer).
+        "per_camera": {
+            name: round((frame.seq - seq0.get(name, 0)) / wall, 1)
+            for name, frame in views.cameras.shown.items()
+        },
+        "app_cpu": None if app0 is None or app1 is None else (app1 - app0) / wall,
+        # CPU milliseconds each renderer process spent per frame: what a frame costs whatever
+        # the machine's load (1000 / it is the rate one idle core would give).
+        "cpu_ms_per_frame": {
+            name: round(1000 * (cpu - start) / max(frame.seq - seq0.get(name, 0), 1), 1)
+            for name, frame in views.cameras.shown.items()
+            if (start := cpu0.get(name)) is not None
+            and (cpu := _cpu_seconds(_renderers(cell).get(name, -1))) is not None
+        },
     }
 
 
@@ -91,7 +141,7 @@ def measure_cell_views(seconds: float = 6.0) -> dict[str, Any]:
             window.document.open(PLAN)
             window.document.set_plan_field("run_policy", RunPolicy.FOREVER)
             assert window.controller.run(), "the plan did not start"
-            _wait(1.0)
+            first_picture = _first_pictures(window)
             off = _phase(window, False, seconds)
             on = _phase(window, True, seconds)
             app.processEvents()
@@ -110,6 +160,14 @@ def measure_cell_views(seconds: float = 6.0) -> dict[str, Any]:
         "ticks_per_s_panels_off": round(off["ticks_per_s"], 1),
         "sim_speed_on": round(on["sim_speed"], 2),
         "sim_speed_off": round(off["sim_speed"], 2),
+        "camera_fps_by_camera": on["per_camera"],
+        "first_picture_s": round(first_picture, 1),
+        "renderer_cpu_ms_per_frame": on["cpu_ms_per_frame"],
+        # Cores the app's own process used (physics, engine, GUI, feed): with / without panels.
+        "app_cpu_on": on["app_cpu"] and round(on["app_cpu"], 2),
+        "app_cpu_off": off["app_cpu"] and round(off["app_cpu"], 2),
+        # Others' work on the machine: compare figures only with runs under a similar load.
+        "load_average": [round(v, 2) for v in os.getloadavg()],
     }
 
 

@@ -33,6 +33,8 @@ from capabilities.sim.cameras import (
 )
 from capabilities.sim.cell import SimCell
 from capabilities.sim.config import CameraSettings, CellConfig
+from capabilities.sim.live_view import LiveView, MirrorRecipe
+from capabilities.sim.mirror_state import take_snapshot
 from capabilities.sim.scene import SceneState, default_scene_path, load_scene
 from capabilities.sim.worker import SimWorker, install_scene_worker
 from capabilities.world_model import WorldModel
@@ -58,6 +60,7 @@ class SimCameraDevice:
         mount = camera.mount
         self.on_wrist = isinstance(mount, LinkMount)
         self._preview: SimCamera | None = None
+        self.live: LiveView | None = None  # the session's mirror renderer, if it has one
         self._believed: Pose = (
             mount.T_link_camera if isinstance(mount, LinkMount) else mount.T_world_camera
         )
@@ -86,6 +89,19 @@ class SimCameraDevice:
             return dataclasses.replace(frame, T_world_camera=self.extrinsics())
 
         return self._cell.call(render)
+
+    def preview(self, size: tuple[int, int]) -> RGBDFrame:
+        """A live picture at ``size`` (width, height) for a view of the cell, rendered by the
+        session's mirror in another process: the physics thread only takes a snapshot.
+
+        Not for perception: use :meth:`capture` (exact, rendered on the physics thread).
+
+        Raises:
+            LiveViewError: the mirror stopped (the message says why).
+        """
+        if self.live is None:
+            return self.capture(size)
+        return self.live.capture(self.name, size, self.extrinsics())
 
     def _resized(self, size: tuple[int, int]) -> SimCamera:
         config = self.camera.config
@@ -131,6 +147,7 @@ class SimCellSession:
         self.workers = WorkerPool(2, "costar-sim-worker")
         self.operator = OperatorConsole()
         self.worker: SimWorker | None = None  # the simulated person, if the scene has one
+        self.live_view: LiveView | None = None  # live pictures (a mirror per camera)
         self.sim.start()
         try:
             path = (
@@ -151,6 +168,15 @@ class SimCellSession:
                 for name, settings in self.sim.config.cameras.items()
             }
             self.worker = install_scene_worker(self.sim, self.scene, path, seed)
+            self._install_live_view(
+                MirrorRecipe(
+                    self.sim.config,
+                    path,
+                    seed,
+                    self.sim.table_top_z,
+                    ((holster[0], holster[1], 0.12),),
+                )
+            )
         except BaseException:
             self.close()
             raise
@@ -162,6 +188,18 @@ class SimCellSession:
         if settings.source == "sim":
             return SimCameraDevice(self.sim, self._camera(name, settings, size))
         return open_source(name, settings.source, settings.where, self.sim.config.folder())
+
+    def _install_live_view(self, recipe: MirrorRecipe) -> None:
+        """Give each camera the live view (its mirror starts on the first picture asked)."""
+        sim = self.sim
+
+        def snapshot(known: set[str]) -> Any:
+            return sim.call(lambda c: take_snapshot(c, sim.world, self.scene, sim.time(), known))
+
+        rendered = {n: d for n, d in self.cameras.items() if isinstance(d, SimCameraDevice)}
+        self.live_view = LiveView(recipe, {n: d.camera for n, d in rendered.items()}, snapshot)
+        for device in rendered.values():  # a recorded or real source shows its own frames
+            device.live = self.live_view
 
     def _camera(
         self, name: str, settings: CameraSettings, size: tuple[int, int] | None
@@ -234,6 +272,8 @@ class SimCellSession:
         return config.capabilities, config.source or "the simulated cell's configuration"
 
     def close(self) -> None:
+        if self.live_view is not None:
+            self.live_view.close()
         self.workers.close()
         self.sim.close()
 

@@ -6,6 +6,9 @@ colour picture and the depth picture, both with the overlays of
 confidence, markers, the plan's regions). Frames are captured and drawn by a
 :class:`~instructor_app.runtime.camera_feed.CameraFeed` thread; a GUI timer only shows the
 newest picture of each camera when it changed. A hidden or paused panel captures nothing.
+A camera that gives no picture (the simulated cell's live-view renderer stopped, a camera
+failed) says so on its pictures' captions, with the reason in the toolbar; the rest of the
+app goes on.
 
 Regions by pointing: with "Draw region" on, press on a depth picture where the region's
 centre is and drag out its radius; on release ``region_drawn(Region)`` fires (the window saves
@@ -112,6 +115,8 @@ class CameraPanel(QWidget):
         self._draft: tuple[str, tuple[float, float, float], float, float, float] | None = None
         self._draft_radius_px = 0.0
         self._pictures: dict[str, tuple[_Picture, _Picture]] = {}
+        self._labels: dict[str, list[pg.TextItem]] = {}  # the captions on each camera's pictures
+        self._stopped: frozenset[str] = frozenset()  # cameras captioned as giving no picture
         self._build()
         self._timer = QTimer(self)
         self._timer.setInterval(POLL_MS)
@@ -153,6 +158,8 @@ class CameraPanel(QWidget):
         self.stop()
         self.view.clear()
         self._pictures.clear()
+        self._labels.clear()
+        self._stopped = frozenset()
         self.shown.clear()
         interfaces = cell.interfaces() if cell is not None else {}
         layout = interfaces.get("scene_layout") or {}
@@ -176,6 +183,7 @@ class CameraPanel(QWidget):
                     fill=(0, 0, 0, 140),
                 )
                 box.addItem(label)
+                self._labels.setdefault(name, []).append(label)
                 pictures.append(picture)
             self._pictures[name] = (pictures[0], pictures[1])
         self.feed = CameraFeed(cameras, self.painter, self.fps)
@@ -236,6 +244,15 @@ class CameraPanel(QWidget):
             depth.setImage(latest.depth, autoLevels=False, levels=(0, 255))
             self.shown[name] = latest
             self.frames_shown += 1
+        failures = dict(self.feed.failures)
+        if frozenset(failures) != self._stopped:
+            self._stopped = frozenset(failures)
+            self._caption(self._stopped)
+        if failures:  # e.g. the simulated cell's live-view renderer stopped: say so
+            text = "; ".join(f"{name}: {why}" for name, why in sorted(failures.items()))
+            self.rate_label.setText(f"No live picture ({text})")
+            self.rate_label.setToolTip(text)
+            return
         elapsed = time.perf_counter() - self._rate_start
         if elapsed > 1.0:
             per_camera = (
@@ -243,6 +260,14 @@ class CameraPanel(QWidget):
             )
             self.rate_label.setText(f"{per_camera:.0f} fps")
             self._rate_start, self._rate_frames = time.perf_counter(), self.frames_shown
+
+    def _caption(self, failures: frozenset[str]) -> None:
+        """Caption each picture with its camera, or say on it that no live picture comes."""
+        for name, labels in self._labels.items():
+            for label, kind in zip(labels, ("colour", "depth"), strict=True):
+                stopped = name in failures
+                label.setText(f"{name} {kind}" + (": NO LIVE PICTURE" if stopped else ""))
+                label.fill = pg.mkBrush((170, 0, 0, 200) if stopped else (0, 0, 0, 140))
 
     def _set_overlays(self, on: bool) -> None:
         self.painter.show_objects = self.painter.show_markers = self.painter.show_regions = on

@@ -1,9 +1,12 @@
 """Live frames of the cell's RGB-D cameras for the GUI, captured on a thread of their own.
 
-A camera's ``capture()`` blocks its caller while the cell renders (in simulation the physics
-thread renders with pybullet's CPU renderer), so neither the GUI thread nor the engine's may
-call it. :class:`CameraFeed` runs one daemon thread that captures the cameras it is asked for
-at a target rate, draws the overlays (:mod:`instructor_app.runtime.overlays`) and leaves one
+A camera's ``capture()`` blocks its caller while the cell renders, so neither the GUI thread
+nor the engine's may call it. A camera that also has ``preview(size)`` (the simulated cell's:
+pictures rendered by a mirror of the cell in a process of its own, see
+``capabilities/sim/live_view.py``) gives live pictures without holding the cell's physics
+thread; any other capture holds the cell and is limited to a share of the time.
+:class:`CameraFeed` runs one daemon thread per camera that captures it at a target rate
+(cameras rendered in parallel processes come in parallel), draws the overlays (:mod:`instructor_app.runtime.overlays`) and leaves one
 :class:`FeedFrame` per camera in a latest-frame slot. The GUI thread polls :meth:`latest`
 from a timer, as it drains the event pump: frames it did not get to are coalesced away (only
 the newest is kept), so a slow GUI never queues frames and never slows the capture.
@@ -47,19 +50,21 @@ class FeedFrame:
 
 
 class CameraFeed:
-    """Captures cameras on a background thread; the newest frame of each waits in a slot.
+    """Captures cameras on background threads; the newest frame of each waits in a slot.
 
     Args:
         cameras: name -> camera interface (``capture() -> RGBDFrame``), e.g. the cell's
             ``rgbd:shoulder`` and ``rgbd:wrist``.
         painter: draws detections, markers and regions into the pictures (None: none).
         fps: the target rate of each camera.
-        max_duty: the largest share of wall time spent capturing: after a capture that took
-            d seconds the next waits at least d * (1 / max_duty - 1). A simulated camera
-            renders on the physics thread (and holds Python's GIL while it does), so this
-            keeps the simulation and the engine's ticks going when rendering is slow.
-        size: (width, height) to capture at, for cameras whose ``capture`` takes a ``size``
-            (a smaller preview renders faster); others give their own size.
+        max_duty: the largest share of wall time spent in captures that hold the cell (those
+            of cameras without ``preview``): after one that took d seconds the next waits at
+            least d * (1 / max_duty - 1). A capture rendered on the simulated cell's physics
+            thread holds Python's GIL too, so this keeps the simulation and the engine's
+            ticks going when rendering is slow.
+        size: (width, height) to capture at, for cameras with ``preview(size)`` or whose
+            ``capture`` takes a ``size`` (a smaller picture renders faster); others give
+            their own size; None: every camera's own size through ``capture()``.
         clock: monotonic seconds (tests may pass their own).
     """
 
@@ -80,34 +85,41 @@ class CameraFeed:
         self._clock = clock
         self._slots: dict[str, FeedFrame] = {}
         self._active: frozenset[str] = frozenset(self.cameras)
-        self._wake = threading.Event()
         self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
+        self._threads: list[threading.Thread] = []
+        self._cell_lock = threading.Lock()  # one capture that holds the cell at a time
+        self._not_before = 0.0  # when the next capture that holds the cell may start
         self.errors = 0  # captures that raised (the cell closed, a camera failed)
+        self.failures: dict[str, str] = {}  # camera -> why its last capture failed
 
     # ------------------------------------------------------------------ control (any thread)
 
     def start(self) -> None:
-        if self._thread is None and self.cameras:
-            self._thread = threading.Thread(target=self._run, name="camera-feed", daemon=True)
-            self._thread.start()
+        """Start one capture thread per camera (each keeps its own rate)."""
+        if self._threads or not self.cameras:
+            return
+        self._stop.clear()
+        for name in sorted(self.cameras):
+            thread = threading.Thread(
+                target=self._run, args=(name,), name=f"camera-feed-{name}", daemon=True
+            )
+            self._threads.append(thread)
+            thread.start()
 
     def stop(self, timeout: float = 2.0) -> None:
-        """Stop capturing and wait for the thread (a capture in progress finishes first)."""
+        """Stop capturing and wait for the threads (a capture in progress finishes first)."""
         self._stop.set()
-        self._wake.set()
-        if self._thread is not None:
-            self._thread.join(timeout)
-            self._thread = None
+        for thread in self._threads:
+            thread.join(timeout)
+        self._threads = []
 
     @property
     def running(self) -> bool:
-        return self._thread is not None and self._thread.is_alive()
+        return any(thread.is_alive() for thread in self._threads)
 
     def set_active(self, names: set[str] | frozenset[str]) -> None:
-        """Capture only these cameras (none: the thread sleeps and the cell renders nothing)."""
+        """Capture only these cameras (none: the threads sleep and the cell renders nothing)."""
         self._active = frozenset(n for n in names if n in self.cameras)
-        self._wake.set()
 
     @property
     def active(self) -> frozenset[str]:
@@ -117,45 +129,53 @@ class CameraFeed:
         """The newest frame of a camera (a plain read of a slot: no lock, no wait)."""
         return self._slots.get(name)
 
-    # ------------------------------------------------------------------ the thread
+    # ------------------------------------------------------------------ the threads
 
-    def _run(self) -> None:
-        next_due: dict[str, float] = {}
-        seq: dict[str, int] = {}
-        not_before = 0.0
+    def _run(self, name: str) -> None:
+        camera = self.cameras[name]
+        # A camera with ``preview(size)`` renders its live pictures away from the cell (the
+        # simulated cell's mirror process): nothing to spare, it runs at the target rate.
+        # Any other capture holds the cell: the duty limit, shared by all such cameras.
+        own = self.size is not None and callable(getattr(camera, "preview", None))
+        next_due, seq = 0.0, 0
         while not self._stop.is_set():
-            active = sorted(self._active)
-            if not active:
-                self._wake.wait(0.5)
-                self._wake.clear()
+            if name not in self._active:
+                self._stop.wait(0.05)  # asleep: the cell renders nothing for this camera
                 continue
-            period = 1.0 / max(self.fps, 0.1)
             now = self._clock()
-            name = min(active, key=lambda n: next_due.get(n, 0.0))
-            wait = max(next_due.get(name, 0.0), not_before) - now
+            wait = max(next_due, 0.0 if own else self._not_before) - now
             if wait > 0:
-                self._wake.wait(wait)
-                self._wake.clear()
+                self._stop.wait(min(wait, 0.5))
                 continue
             # Due again one period after it was due, not after it finished: the rate holds
             # while a capture takes a good part of the period; a late camera does not burst.
-            next_due[name] = max(next_due.get(name, now) + period, now)
-            seq[name] = seq.get(name, 0) + 1
-            started = self._clock()
-            self._capture(name, seq[name])
-            took = self._clock() - started
-            not_before = self._clock() + took * (1.0 / max(self.max_duty, 0.01) - 1.0)
+            next_due = max(next_due + 1.0 / max(self.fps, 0.1), now)
+            seq += 1
+            if own:
+                captured = self._capture(name, seq, lambda: camera.preview(self.size))
+            else:
+                with self._cell_lock:
+                    started = self._clock()
+                    captured = self._capture(name, seq, lambda: self._plain_capture(camera))
+                    took = self._clock() - started
+                    self._not_before = self._clock() + took * (1.0 / max(self.max_duty, 0.01) - 1.0)
+            if not captured:
+                self._stop.wait(0.5)  # a failing camera is asked again later, never in a loop
 
-    def _capture(self, name: str, seq: int) -> None:
+    def _plain_capture(self, camera: Any) -> Any:
+        sized = self.size is not None and "size" in inspect.signature(camera.capture).parameters
+        return camera.capture(size=self.size) if sized else camera.capture()
+
+    def _capture(self, name: str, seq: int, grab: Callable[[], Any]) -> bool:
+        """Capture one frame and leave it in the camera's slot; False if the capture failed."""
         try:
-            camera = self.cameras[name]
-            sized = self.size is not None and "size" in inspect.signature(camera.capture).parameters
-            frame = camera.capture(size=self.size) if sized else camera.capture()
+            frame = grab()
         except Exception as exc:  # a closed cell or a failing camera must not end the feed
             self.errors += 1
+            self.failures[name] = str(exc) or type(exc).__name__
             _log.debug("camera %s: %s", name, exc)
-            self._stop.wait(0.5)
-            return
+            return False
+        self.failures.pop(name, None)
         rgb = np.array(frame.rgb, dtype=np.uint8, copy=True)
         depth = depth_image(frame.depth)
         if self.painter is not None:
@@ -164,3 +184,4 @@ class CameraFeed:
             except Exception:  # an overlay bug shows a plain picture, never ends the feed
                 _log.exception("drawing the overlays of camera %s failed", name)
         self._slots[name] = FeedFrame(frame, rgb, depth, seq)
+        return True

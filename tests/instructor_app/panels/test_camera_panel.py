@@ -4,6 +4,8 @@ read by ``occupancy.is_occupied``."""
 
 from __future__ import annotations
 
+import os
+import signal
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -60,7 +62,10 @@ def test_detections_of_the_world_model_are_outlined_with_class_and_confidence(
     qtbot, panel: CameraPanel, cell: SimCellSession
 ) -> None:
     before = panel.shown["shoulder"].seq
-    plain = panel.feed.latest("shoulder").frame.rgb  # the rendered picture, without overlays
+    assert panel.feed is not None
+    newest = panel.feed.latest("shoulder")
+    assert newest is not None
+    plain = newest.frame.rgb  # the rendered picture, without overlays
     # A detection as the perception operations write it (its pose taken from the truth here,
     # in the test only).
     cell.world_model.replace("test", [Detection("cup", cell.truth_pose("cup"), 0.9, 0.0, "test")])
@@ -82,7 +87,7 @@ def test_pause_stops_capturing_and_snapshot_writes_a_png(
     qtbot, panel: CameraPanel, tmp_path: Path
 ) -> None:
     panel.pause_button.setChecked(True)
-    assert panel.feed.active == frozenset()
+    assert panel.feed is not None and panel.feed.active == frozenset()
     path = panel.snapshot(tmp_path / "cams.png")
     assert path is not None and path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     panel.pause_button.setChecked(False)
@@ -113,7 +118,9 @@ def test_a_region_drawn_on_the_depth_picture_is_saved_in_the_plan_and_read_by_is
         qtbot.mouseRelease(
             viewport, Qt.MouseButton.LeftButton, pos=_viewport_point(panel, "shoulder", u + 25, v)
         )
-    region = document.plan.find(node.id).params["region"].value
+    found = document.plan.find(node.id)
+    assert found is not None
+    region = found.params["region"].value
     assert isinstance(region, Region)
     assert np.linalg.norm(np.subtract(region.center, cup)) < 0.08  # a point on the cup
     assert 0.03 < region.radius < 0.3
@@ -133,3 +140,24 @@ def test_a_region_without_a_selected_region_node_becomes_a_plan_parameter(qapp: 
     assert plan_regions(document.plan) == [("KEEP_OUT", Region((0.5, 0.0, 0.1), 0.1))]
     save_region(document, Region((0.6, 0.0, 0.1), 0.2), None, "KEEP_OUT")
     assert plan_regions(document.plan) == [("KEEP_OUT", Region((0.6, 0.0, 0.1), 0.2))]
+
+
+def test_the_panel_says_when_a_live_view_stopped_and_the_other_camera_goes_on(qtbot) -> None:
+    with SimCellSession("cup_to_bin", seed=0) as cell:
+        widget = CameraPanel(fps=15.0)
+        qtbot.addWidget(widget)
+        widget.set_cell(cell)
+        widget.show()
+        qtbot.waitUntil(lambda: {"shoulder", "wrist"} <= set(widget.shown), timeout=30000)
+        assert cell.live_view is not None
+        os.kill(cell.live_view.pids()["shoulder"], signal.SIGKILL)  # the renderer crashes
+        qtbot.waitUntil(lambda: "No live picture" in widget.rate_label.text(), timeout=20000)
+        assert "shoulder" in widget.rate_label.text() and "stopped" in widget.rate_label.text()
+        captions = {
+            name: [x.toPlainText() for x in labels] for name, labels in widget._labels.items()
+        }
+        assert all("NO LIVE PICTURE" in text for text in captions["shoulder"])  # on the pictures
+        assert not any("NO LIVE PICTURE" in text for text in captions["wrist"])
+        wrist = widget.shown["wrist"].seq
+        qtbot.waitUntil(lambda: widget.shown["wrist"].seq > wrist, timeout=20000)
+        widget.stop()

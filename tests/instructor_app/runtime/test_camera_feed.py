@@ -47,10 +47,11 @@ def test_frames_are_captured_off_the_calling_thread_and_only_the_newest_is_kept(
     feed = CameraFeed({"a": camera}, fps=200.0, max_duty=1.0)
     feed.start()
     try:
-        _wait(lambda: (feed.latest("a") or None) is not None and feed.latest("a").seq >= 5)
+        _wait(lambda: (newest := feed.latest("a")) is not None and newest.seq >= 5)
         latest = feed.latest("a")
+        assert latest is not None
         assert latest.seq == camera.calls or latest.seq == camera.calls - 1  # one slot, newest
-        assert camera.threads == {"camera-feed"}
+        assert camera.threads == {"camera-feed-a"}
         assert latest.depth.shape == (24, 32, 3) and latest.depth.dtype == np.uint8
     finally:
         feed.stop()

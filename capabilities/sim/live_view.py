@@ -1,0 +1,272 @@
+"""The live view of the simulated cameras, rendered by a mirror of the cell in other processes.
+
+pybullet's CPU renderer takes 40-90 ms for a 320x240 RGB-D frame; on the physics thread that
+time stops the simulation and, through Python's GIL, the engine's ticks. A live picture does
+not need to be rendered there: :class:`LiveView` keeps a mirror of the cell in a process of
+its own per camera (a pybullet DIRECT client built with the cell's own ``build_world`` and
+``load_scene``). For each frame the physics thread only takes a :class:`CellSnapshot` (a few
+hundred bytes, some tens of microseconds); the mirror lays it onto its bodies, renders with
+the same :class:`SimCamera` and sends the images back through a pipe.
+
+Perception does not use this: its images are rendered on the physics thread, exact and
+stamped with simulated time (``SimCameraDevice.capture``). A live frame is stamped with the
+simulated time of the snapshot it shows.
+
+A mirror process ends with the cell (``close``), when the cell's process ends (its pipe
+reads end-of-file, even when it was killed). A mirror that
+crashed makes ``capture`` raise :class:`LiveViewError`; the cell goes on.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import os
+import socket
+import subprocess
+import sys
+import threading
+from collections.abc import Callable
+from dataclasses import dataclass
+from multiprocessing.connection import Connection
+from pathlib import Path
+from typing import Any
+
+from capabilities.sim.cameras import LinkMount, RGBDFrame, SimCamera
+from capabilities.sim.config import CellConfig
+from capabilities.sim.errors import SimError
+from capabilities.sim.mirror_state import CellSnapshot, apply_snapshot
+from engine.types import Pose
+
+__all__ = ["LiveView", "LiveViewError", "MirrorRecipe"]
+
+START_TIMEOUT = 60.0  # s: a fresh interpreter imports numpy and pybullet, builds the scene
+FRAME_TIMEOUT = 10.0  # s: one frame on a loaded machine
+# Priority of a mirror process (added niceness): below the app's, so that the live pictures
+# take only spare CPU. Measured with bench/cell_views.py on the loaded 2-core VM (under Xvfb
+# the 3D scene's OpenGL is drawn by the CPU too): at niceness 0 the cameras got ~1.5x the
+# frames but the 3D scene fell from ~22 to ~13 frames a second (means over runs); the ticks
+# and the simulation's speed did not measurably differ.
+NICENESS = 5
+
+
+class LiveViewError(SimError):
+    """The live view's renderer cannot give a frame (it stopped, crashed or was closed)."""
+
+
+@dataclass(frozen=True)
+class MirrorRecipe:
+    """How to build the mirror: the cell's configuration and how its scene was loaded."""
+
+    config: CellConfig
+    scene: Path
+    seed: int | None
+    table_top_z: float
+    keep_out: tuple[tuple[float, float, float], ...] = ()
+
+
+@dataclass(frozen=True)
+class _Request:
+    snapshot: CellSnapshot
+    size: tuple[int, int]
+
+
+# ---------------------------------------------------------------------- the mirror process
+
+
+def _serve(conn: Connection) -> None:
+    """The mirror process: build the cell, then answer frame requests until told to stop."""
+    from capabilities.bullet import pybullet as p
+    from capabilities.sim.scene import load_scene
+    from capabilities.sim.world import build_world
+
+    if NICENESS:
+        os.nice(NICENESS)
+    recipe, name, camera = conn.recv()
+    client = p.connect(p.DIRECT)
+    world = build_world(client, recipe.config)
+    scene = load_scene(
+        client, recipe.scene, recipe.seed, table_top_z=recipe.table_top_z, make_table=False,
+        keep_out=recipe.keep_out,
+    )  # fmt: skip
+    if isinstance(camera.mount, LinkMount):  # the mirror's robot body, not the cell's id
+        camera = SimCamera(
+            name, camera.config, dataclasses.replace(camera.mount, body_id=world.robot)
+        )
+    sized: dict[tuple[int, int], SimCamera] = {}
+    conn.send("ready")
+    while True:
+        try:
+            request = conn.recv()
+        except (EOFError, OSError):  # the cell's process ended: end too
+            break
+        if request is None:
+            break
+        apply_snapshot(client, world, scene, request.snapshot)
+        view = sized.setdefault(request.size, _resized(camera, request.size))
+        frame = view.capture(client, stamp=request.snapshot.stamp)
+        conn.send((frame.rgb, frame.depth, frame.T_world_camera, frame.stamp))
+    p.disconnect(client)
+
+
+def _resized(camera: SimCamera, size: tuple[int, int]) -> SimCamera:
+    config = dataclasses.replace(camera.config, width=int(size[0]), height=int(size[1]))
+    return SimCamera(camera.name, config, camera.mount)
+
+
+# ---------------------------------------------------------------------- the cell's side
+
+
+class _Mirror:
+    """One mirror process rendering one camera; its methods are safe from any thread."""
+
+    def __init__(self, recipe: MirrorRecipe, camera: SimCamera) -> None:
+        self.recipe, self.camera = recipe, camera
+        self.known: set[str] = set()  # objects whose model the mirror has been sent
+        self._lock = threading.Lock()
+        self._conn: Connection | None = None
+        self.process: Any = None
+        self._closed = False
+        self._failure = ""
+
+    def render(self, snapshot: Callable[[set[str]], CellSnapshot], size: tuple[int, int]) -> Any:
+        with self._lock:
+            conn = self._connection()
+            try:
+                conn.send(_Request(snapshot(self.known), size))
+                if not conn.poll(FRAME_TIMEOUT):
+                    raise TimeoutError(f"no frame within {FRAME_TIMEOUT:.0f} s")
+                return conn.recv()
+            except (EOFError, OSError, TimeoutError) as exc:
+                raise self._stopped(str(exc) or type(exc).__name__) from exc
+
+    def _connection(self) -> Connection:
+        if self._closed:
+            raise LiveViewError("the live view was closed with the cell")
+        if self._failure:
+            raise LiveViewError(self._failure)
+        if self._conn is None:
+            self._conn = ours = self._start()
+            try:
+                ours.send((self.recipe, self.camera.name, self.camera))
+                if not ours.poll(START_TIMEOUT) or ours.recv() != "ready":
+                    raise TimeoutError(f"the renderer did not start within {START_TIMEOUT:.0f} s")
+            except (EOFError, OSError, TimeoutError) as exc:
+                raise self._stopped(str(exc) or "it ended while starting") from exc
+            if self._closed:  # closed while it started, before it could be killed
+                raise self._stopped("closed")
+        return self._conn
+
+    def _start(self) -> Connection:
+        """Start the mirror process: a fresh interpreter (the caller's ``__main__`` is never
+        imported again, unlike multiprocessing's spawn) talking over a socket pair."""
+        ours, theirs = socket.socketpair()
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
+        self.process = subprocess.Popen(
+            [sys.executable, "-m", __name__, str(theirs.fileno())], pass_fds=(theirs.fileno(),),
+            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, env=env,
+        )  # fmt: skip
+        theirs.close()  # only the child holds its end: its death reads as end-of-file here
+        return Connection(ours.detach())
+
+    def _stopped(self, why: str) -> LiveViewError:
+        code = None
+        if self.process is not None:
+            with contextlib.suppress(subprocess.TimeoutExpired):
+                code = self.process.wait(0.5)
+        ended = f" (exit code {code})" if code is not None else ""
+        if self._closed:
+            why = "the live view was closed with the cell"
+        self._failure = f"the live view of camera {self.camera.name!r} stopped{ended}: {why}"
+        self._shutdown()
+        return LiveViewError(self._failure)
+
+    def close(self) -> None:
+        self._closed = True
+        if self._lock.acquire(timeout=1.0):
+            try:
+                self._shutdown()
+            finally:
+                self._lock.release()
+            return
+        # A frame or the start is in flight (a start may take seconds): end the process; the
+        # thread waiting for it reads end-of-file and shuts the rest down.
+        process = self.process
+        if process is not None and process.poll() is None:
+            process.kill()
+            process.wait(2.0)
+
+    def _shutdown(self) -> None:
+        conn, process, self._conn = self._conn, self.process, None
+        if conn is not None:
+            with contextlib.suppress(OSError):
+                conn.send(None)
+            conn.close()
+        if process is not None:
+            try:
+                process.wait(2.0)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.wait(2.0)
+
+
+class LiveView:
+    """Live frames of the cell's cameras, each rendered by a mirror process of its own.
+
+    A mirror starts on the first frame asked of its camera (a cell nobody watches starts no
+    process) and ends with :meth:`close`.
+
+    Args:
+        recipe: how the cell and its scene were built.
+        cameras: name -> the cell's SimCamera (its optics and mount).
+        snapshot: takes the cell's visible state on the physics thread; called with the
+            names of the objects a mirror already has.
+    """
+
+    def __init__(
+        self,
+        recipe: MirrorRecipe,
+        cameras: dict[str, SimCamera],
+        snapshot: Callable[[set[str]], CellSnapshot],
+    ) -> None:
+        self._snapshot = snapshot
+        self._mirrors = {name: _Mirror(recipe, camera) for name, camera in cameras.items()}
+
+    def capture(
+        self, name: str, size: tuple[int, int], T_world_camera: Pose | None = None
+    ) -> RGBDFrame:
+        """A frame of camera ``name`` at ``size`` (width, height) showing the cell now.
+
+        Args:
+            name: the camera.
+            size: image width and height.
+            T_world_camera: the pose to put on the frame (the cell's belief), default the
+                mirror's true camera pose.
+
+        Raises:
+            LiveViewError: the mirror stopped or was closed (the message says why).
+        """
+        mirror = self._mirrors[name]
+        rgb, depth, true_pose, stamp = mirror.render(self._snapshot, size)
+        config = dataclasses.replace(mirror.camera.config, width=size[0], height=size[1])
+        return RGBDFrame(
+            rgb=rgb, depth=depth, K=config.intrinsics(),
+            T_world_camera=T_world_camera or true_pose, stamp=stamp, camera=name,
+        )  # fmt: skip
+
+    def pids(self) -> dict[str, int]:
+        """Process id of each running mirror (for tests and diagnostics)."""
+        return {
+            name: m.process.pid
+            for name, m in self._mirrors.items()
+            if m.process is not None and m.process.poll() is None
+        }
+
+    def close(self) -> None:
+        """End every mirror process (waits for each; kills one that does not end)."""
+        for mirror in self._mirrors.values():
+            mirror.close()
+
+
+if __name__ == "__main__":  # the mirror process (started by _Mirror._start)
+    _serve(Connection(int(sys.argv[1])))

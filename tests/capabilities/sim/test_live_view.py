@@ -1,0 +1,171 @@
+"""The live view: a mirror of the cell in a process per camera renders what the physics thread
+would render for the same state (the arm moved, an object added and removed), ends with the
+cell and with the cell's process, and a mirror that crashed fails its pictures, not the cell."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import threading
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from capabilities.sim.live_view import LiveViewError
+from capabilities.sim.scene import yaw_pose
+from capabilities.sim.session import SimCameraDevice, SimCellSession
+
+SIZE = (320, 240)
+
+
+def _gone(pid: int) -> bool:
+    """The process has ended (a zombie nobody reaped has ended too)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (FileNotFoundError, ProcessLookupError):
+        return True
+    return state in ("Z", "X")
+
+
+def _wait_gone(pid: int, timeout: float = 10.0) -> bool:
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if _gone(pid):
+            return True
+        time.sleep(0.05)
+    return _gone(pid)
+
+
+def _rendered(cell: SimCellSession, name: str) -> SimCameraDevice:
+    """A camera of the cell rendered in simulation (the default cell's cameras are)."""
+    device = cell.cameras[name]
+    assert isinstance(device, SimCameraDevice)
+    return device
+
+
+def _assert_same_picture(cell: SimCellSession, camera: str) -> None:
+    device = _rendered(cell, camera)
+    live, exact = device.preview(SIZE), device.capture(SIZE)
+    assert live.rgb.shape == exact.rgb.shape == (240, 320, 3)
+    rgb_difference = np.abs(live.rgb.astype(int) - exact.rgb.astype(int)).mean()
+    assert rgb_difference < 1.0, f"{camera}: mean colour difference {rgb_difference:.2f}"
+    both = np.isfinite(live.depth) & np.isfinite(exact.depth)
+    assert both.mean() > 0.5
+    assert np.median(np.abs(live.depth[both] - exact.depth[both])) < 1e-3
+    np.testing.assert_allclose(live.K, exact.K)
+    assert live.T_world_camera == exact.T_world_camera  # what the cell believes, on both
+
+
+@pytest.fixture(scope="module")
+def cell() -> Iterator[SimCellSession]:
+    with SimCellSession("cup_to_bin", seed=0) as session:
+        session.sim.wait_sim(0.3)  # the objects settle
+        yield session
+
+
+def test_the_mirror_shows_what_the_physics_thread_renders_as_the_cell_changes(
+    cell: SimCellSession,
+) -> None:
+    _assert_same_picture(cell, "shoulder")
+    _assert_same_picture(cell, "wrist")
+    before = _rendered(cell, "shoulder").preview(SIZE).rgb
+    home = cell.sim.config.home_joints
+    assert cell.sim.robot.move_joints([home[0] + 0.6, *home[1:]]).wait(30)
+    after = _rendered(cell, "shoulder").preview(SIZE).rgb
+    assert np.abs(after.astype(int) - before.astype(int)).mean() > 0.5  # the arm moved
+    _assert_same_picture(cell, "shoulder")
+    _assert_same_picture(cell, "wrist")
+    model = cell.scene.library.names()[0]
+    pose = yaw_pose(0.45, 0.25, cell.sim.table_top_z, 0.3)
+    cell.sim.call(lambda c: cell.scene.spawn(c, "handed_over", model, pose, fixed=True))
+    _assert_same_picture(cell, "shoulder")  # an object added after the mirror was built
+    cell.sim.call(lambda c: cell.scene.remove(c, "handed_over"))
+    _assert_same_picture(cell, "shoulder")
+    frame = _rendered(cell, "shoulder").preview(SIZE)
+    assert 0.0 < frame.stamp <= cell.clock()  # stamped with the simulated time it shows
+
+
+def test_the_mirrors_end_with_the_cell() -> None:
+    with SimCellSession("cup_to_bin", seed=0) as session:
+        _rendered(session, "shoulder").preview(SIZE)
+        _rendered(session, "wrist").preview(SIZE)
+        pids = session.live_view.pids() if session.live_view else {}
+        assert set(pids) == {"shoulder", "wrist"}
+    assert all(_wait_gone(pid, 1.0) for pid in pids.values())
+    with pytest.raises(LiveViewError, match="closed"):
+        _rendered(session, "shoulder").preview(SIZE)
+
+
+def test_a_mirror_ends_when_the_cells_process_is_killed(tmp_path: Path) -> None:
+    script = textwrap.dedent(
+        """
+        import sys, time
+        from capabilities.sim.session import SimCellSession
+        session = SimCellSession("cup_to_bin", seed=0)
+        session.cameras["shoulder"].preview((320, 240))
+        print(session.live_view.pids()["shoulder"], flush=True)
+        time.sleep(60)
+        """
+    )
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
+    parent = subprocess.Popen(
+        [sys.executable, "-c", script], stdout=subprocess.PIPE, text=True, env=env
+    )
+    try:
+        assert parent.stdout is not None
+        mirror = int(parent.stdout.readline())
+        assert not _gone(mirror)
+        parent.send_signal(signal.SIGKILL)  # no close(), no atexit: only the pipe tells it
+        parent.wait(10)
+        assert _wait_gone(mirror), "the mirror outlived the cell's process"
+    finally:
+        if parent.poll() is None:
+            parent.kill()
+
+
+def test_a_crashed_mirror_fails_its_pictures_and_the_cell_goes_on() -> None:
+    with SimCellSession("cup_to_bin", seed=0) as session:
+        camera = _rendered(session, "shoulder")
+        camera.preview(SIZE)
+        pid = session.live_view.pids()["shoulder"] if session.live_view else 0
+        os.kill(pid, signal.SIGKILL)
+        with pytest.raises(LiveViewError, match="stopped"):
+            camera.preview(SIZE)
+        with pytest.raises(LiveViewError, match="stopped"):  # and stays stopped
+            camera.preview(SIZE)
+        now = session.clock()
+        session.sim.wait_sim(0.1)
+        assert session.clock() > now
+        assert camera.capture(SIZE).rgb.shape == (240, 320, 3)  # perception's frames go on
+
+
+def test_closing_the_cell_while_a_mirror_starts_ends_it() -> None:
+    session = SimCellSession("cup_to_bin", seed=0)
+    errors: list[Exception] = []
+
+    def watch() -> None:
+        try:
+            _rendered(session, "shoulder").preview(SIZE)
+        except LiveViewError as exc:
+            errors.append(exc)
+
+    watcher = threading.Thread(target=watch)
+    watcher.start()
+    assert session.live_view is not None
+    mirror = session.live_view._mirrors["shoulder"]
+    end = time.monotonic() + 10.0
+    while mirror.process is None and time.monotonic() < end:
+        time.sleep(0.01)  # the watcher is starting the mirror process
+    process = mirror.process
+    assert process is not None
+    session.close()  # does not wait for the start to finish
+    watcher.join(30.0)
+    assert not watcher.is_alive()
+    assert process.poll() is not None  # ended and reaped
+    assert len(errors) == 1 and "closed" in str(errors[0])
