@@ -5,7 +5,8 @@
 whose ``capture()`` renders on the physics thread), ``world`` (the cell's world model),
 ``workers`` (a thread pool for blocking work such as perception) and ``operator`` (the
 OperatorConsole: prompts and buttons). The clock is simulated time. A scene file with a
-``worker`` block gets a simulated person (``session.worker``, see ``sim/worker.py``).
+``worker`` block gets a simulated person (``session.worker``, see ``sim/worker.py``), one with
+a ``bender`` block a working 2D wire bender (``session.bender``, see ``sim/bender.py``).
 Ground truth stays on ``ground_truth`` and ``scene`` for tests and scores.
 """
 
@@ -22,6 +23,8 @@ import numpy as np
 
 from capabilities.collaboration.console import OperatorConsole
 from capabilities.jobs import WorkerPool
+from capabilities.sim.bender import WireBender, install_scene_bender
+from capabilities.sim.bender_spec import FaultModel
 from capabilities.sim.cameras import (
     CameraConfig,
     FixedMount,
@@ -97,6 +100,7 @@ class SimCellSession:
         config: the cell configuration (default ``resources/cells/sim_default.json``).
         shoulder_size: (width, height) of the shoulder camera instead of the configured one.
         wrist_size: (width, height) of the wrist camera instead of the configured one.
+        faults: the wire bender's fault rates instead of the scene file's.
     """
 
     name = "sim"
@@ -109,12 +113,14 @@ class SimCellSession:
         config: CellConfig | None = None,
         shoulder_size: tuple[int, int] | None = None,
         wrist_size: tuple[int, int] | None = None,
+        faults: FaultModel | None = None,
     ) -> None:
         self.sim = SimCell(config, speed)
         self.world_model = WorldModel()
         self.workers = WorkerPool(2, "costar-sim-worker")
         self.operator = OperatorConsole()
         self.worker: SimWorker | None = None  # the simulated person, if the scene has one
+        self.bender: WireBender | None = None  # the wire bender, if the scene has one
         self.sim.start()
         try:
             path = (
@@ -135,6 +141,7 @@ class SimCellSession:
                 for name, settings in self.sim.config.cameras.items()
             }
             self.worker = install_scene_worker(self.sim, self.scene, path, seed)
+            self.bender = install_scene_bender(self.sim, self.scene, path, seed, faults)
         except BaseException:
             self.close()
             raise
