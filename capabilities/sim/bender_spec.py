@@ -117,7 +117,7 @@ def _spec(r: JsonReader) -> BenderSpec:
         first_at=first,
         interval=r.number("interval", d.interval, lo=0.5),
         swing=r.number("swing", d.swing, lo=0.05, hi=10.0),
-        hold=r.number("hold", d.hold, lo=0.0, hi=10.0),
+        hold=r.number("hold", d.hold, lo=0.0, hi=60.0),
         spread=(
             spread.number("x", d.spread[0], lo=0.0, hi=0.2),
             spread.number("y", d.spread[1], lo=0.0, hi=0.2),

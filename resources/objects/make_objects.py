@@ -500,7 +500,7 @@ def make_bender() -> tuple[dict, Mesh]:
             "rest_pitch": _r(-math.pi / 2),
             "release_pitch": 0.0,
         },
-        exit={"position": [0.2, 0.0], "drop_height": 0.03},
+        exit={"position": [0.25, 0.0], "drop_height": 0.03},
     )
     return model, mesh
 
