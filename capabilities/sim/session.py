@@ -34,7 +34,7 @@ from capabilities.sim.cameras import (
 )
 from capabilities.sim.cell import SimCell
 from capabilities.sim.config import CameraSettings, CellConfig
-from capabilities.sim.scene import SceneState, default_scene_path, load_scene
+from capabilities.sim.scene import SceneState, default_scene_path, load_scene, yaw_pose
 from capabilities.sim.worker import SimWorker, install_scene_worker
 from capabilities.world_model import WorldModel
 from engine.types import Pose
@@ -185,7 +185,9 @@ class SimCellSession:
 
     def scene_layout(self) -> dict[str, Any]:
         """What a worker configures about the cell (not ground truth of movable objects):
-        marker sizes, which object carries which marker, and the table markers' poses."""
+        marker sizes, which object carries which marker, and the poses of the markers that
+        never move: on the table, and on fixtures the scene file puts at one pose (a machine
+        bolted down, measured once; the paper calibrated its cameras on the bender's)."""
         # Every marker the object library knows, not only those on objects present now: an
         # object handed in later must be recognised by its marker too.
         sizes = {m.marker_id: m.size for m in self.scene.fixed_markers.values()}
@@ -194,8 +196,20 @@ class SimCellSession:
             sizes.update({m.marker_id: m.size for m in library.get(name).markers})
         return {
             "marker_sizes": sizes,
-            "fixed_markers": {m.marker_id: m.pose for m in self.scene.fixed_markers.values()},
+            "fixed_markers": {m.marker_id: m.pose for m in self.scene.fixed_markers.values()}
+            | self._fixture_markers(),
         }
+
+    def _fixture_markers(self) -> dict[int, Pose]:
+        """World poses of the markers on fixtures placed at their nominal pose (no random)."""
+        found: dict[int, Pose] = {}
+        for entry in self.scene.spec.objects:
+            if entry.fixed and not entry.random:
+                x, y = entry.position
+                frame = yaw_pose(x, y, self.scene.table_top_z, entry.yaw)
+                for marker in self.scene.library.get(entry.model).markers:
+                    found[marker.marker_id] = frame.compose(marker.pose)
+        return found
 
     def clock(self) -> float:
         return self.sim.time()

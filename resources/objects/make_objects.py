@@ -214,9 +214,11 @@ def wall_marker(marker_id: int, size: float, normal: Vec, center: Vec) -> dict:
     }
 
 
-def top_marker(marker_id: int, size: float, height: float, x: float = 0.0) -> dict:
+def top_marker(
+    marker_id: int, size: float, height: float, x: float = 0.0, y: float = 0.0
+) -> dict:
     """A marker lying on a horizontal top face: texture top toward the object's +y."""
-    position = [_r(x), 0.0, _r(height + MARKER_LIFT)]
+    position = [_r(x), _r(y), _r(height + MARKER_LIFT)]
     pose = {"position": position, "orientation": [0.0, 0.0, 0.0, 1.0]}
     return {"id": marker_id, "size": size, "pose": pose}
 
@@ -484,14 +486,15 @@ def make_bender() -> tuple[dict, Mesh]:
     mesh.box((0.0, 0.0, size[2] / 2), size)
     model = _model(
         "wire_bender",
-        "2D wire bender (no communication port). Marker 30 on its front, 31 on its top.",
+        "2D wire bender (no communication port). Marker 30 on its front, 31 on its top (to the "
+        "side: the resting welding arm hides the middle of the top from above the robot).",
         collision={"type": "box", "size": list(size)},
         mass=120.0,
         dimensions=list(size),
         symmetry={"kind": "none"},
         markers=[
             wall_marker(30, 0.08, (1, 0, 0), (0.1, 0.0, 0.12)),
-            top_marker(31, 0.08, size[2], -0.03),
+            top_marker(31, 0.07, size[2], -0.04, -0.075),
         ],
         color=[0.33, 0.42, 0.36, 1.0],
         welding_arm={
