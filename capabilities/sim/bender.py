@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from capabilities.bullet import pybullet as p
+from capabilities.geometry import quaternion_to_matrix
 from capabilities.sim.bender_spec import (
     BenderSpec,
     FaultModel,
@@ -116,9 +117,12 @@ class WireBender(ScheduledActor[PlannedPart, BenderEvent]):
             raise SceneError(f"model {machine.name!r} is no wire bender (no welding_arm, exit)")
         self._arm = arm
         self._exit = exit_
+        self._station: dict[str, Pose] = {}
         for shape in spec.shapes:
-            if "weld" not in scene.library.get(shape).extra:
+            model = scene.library.get(shape)
+            if "weld" not in model.extra:
                 raise SceneError(f"model {shape!r} is no wireform (it has no weld)")
+            self._station[shape] = _weld_station(model)
         self._live: dict[str, _Live] = {}
         self._pitch = float(arm["rest_pitch"])
         self._next_release = 0
@@ -155,7 +159,7 @@ class WireBender(ScheduledActor[PlannedPart, BenderEvent]):
         ex, ey = self._exit["position"]
         drop = float(self._exit.get("drop_height", 0.03))
         local = Pose((ex + dx, ey + dy, drop), (0.0, 0.0, math.sin(dyaw / 2), math.cos(dyaw / 2)))
-        pose = self._machine_pose().compose(local)
+        pose = self._machine_pose().compose(local).compose(self._station[planned.shape])
         self._scene.spawn(self._client, planned.name, planned.shape, pose)
         if planned.bad_weld or planned.bad_grasp:
             self._live[planned.name] = _Live(planned)
@@ -255,6 +259,19 @@ class WireBender(ScheduledActor[PlannedPart, BenderEvent]):
             piece = _spawn_piece(client, model, [int(b) for b in boxes], frame)
             p.resetBaseVelocity(piece, velocity[0], velocity[1], physicsClientId=client)
             self._pieces.append(piece)
+
+
+def _weld_station(model: ObjectModelSpec) -> Pose:
+    """Where the bender holds a part while it welds, as the part's frame in the exit's: its
+    weld bead (where the gripper's grasp closes) lies on the exit point, turned so that the
+    grasp's fingers close along the exit's y, whatever the shape (one pick waypoint takes
+    every shape)."""
+    grasp = next((g for g in model.grasps if g.tool == "gripper"), model.grasp())
+    x, y, _ = grasp.pose.position
+    tool_x = quaternion_to_matrix(grasp.pose.orientation)[:, 0]
+    yaw = math.atan2(tool_x[1], tool_x[0])
+    held = Pose((x, y, 0.0), (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)))
+    return held.inverse()
 
 
 def _spawn_piece(client: int, model: ObjectModelSpec, boxes: list[int], frame: Pose) -> int:

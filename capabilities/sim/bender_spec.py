@@ -6,7 +6,7 @@ model) produce wireforms; the plan is drawn once from the scene's seed::
     "bender": {
       "fixture": "bender", "parts": 50, "shapes": ["wireform_u", "wireform_step"],
       "first_at": [3.0, 5.0], "interval": 12.0, "swing": 0.8, "hold": 0.6,
-      "spread": {"x": 0.012, "y": 0.012, "yaw": 0.12},
+      "spread": {"x": 0.008, "y": 0.008, "yaw": 0.08},
       "faults": {"bad_weld": 0.02, "bad_grasp": 0.05, "interval_spread": 0.35}
     }
 
@@ -14,7 +14,8 @@ The first part comes ``first_at`` seconds after the bender starts, each next one
 interval later drawn uniformly in ``interval * (1 +- interval_spread)``; each part's shape is
 drawn from ``shapes``. The welding arm swings down in ``swing`` seconds before a part is
 released, stays ``hold`` seconds and swings back. A part lands at the bender's exit shifted
-by up to ``spread`` (m, m, rad). The fault model (:class:`FaultModel`, defaults from the
+by up to ``spread`` (m, m, rad), its weld bead on the exit point (where the bender held it
+to weld). The fault model (:class:`FaultModel`, defaults from the
 paper's Table I: 2 bad welds and about 5 bad grasps per 100 parts) marks a part's weld bad
 (it comes apart when the part is lifted) or its first grasp bad (the part slips out); a run
 may set other rates (``SimCellSession(faults=...)``).
@@ -75,7 +76,7 @@ class BenderSpec:
     interval: float = 12.0
     swing: float = 0.8
     hold: float = 0.6
-    spread: tuple[float, float, float] = (0.012, 0.012, 0.12)
+    spread: tuple[float, float, float] = (0.008, 0.008, 0.08)
     faults: FaultModel = FaultModel()
     lift: float = 0.025  # m above the table that counts as lifted (handled)
 

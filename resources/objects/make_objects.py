@@ -403,7 +403,7 @@ def all_objects() -> dict[str, tuple[dict, Mesh]]:
 
 
 WIRE = 0.008  # m: side of a wireform's (square) wire
-WELD = 0.028  # m: length of the weld bead the gripper's 20 mm pads close on
+WELD = 0.04  # m: length of the weld bead the gripper's 20 mm pads close on
 
 
 def _bar(x0: float, x1: float, y0: float, y1: float) -> dict:
