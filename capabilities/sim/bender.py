@@ -303,12 +303,12 @@ def _spawn_piece(client: int, model: ObjectModelSpec, boxes: list[int], frame: P
 
 def install_scene_bender(
     cell: Any, scene: SceneState, path: Path | str, seed: int | None,
-    faults: FaultModel | None = None,
+    faults: FaultModel | None = None, start: bool = True,
 ) -> WireBender | None:  # fmt: skip
-    """Make and start the bender of a scene file, or return None when it has none."""
+    """Make (and with ``start`` start) the bender of a scene file; None when it has none."""
     spec = read_bender(path)
     if spec is None:
         return None
     bender = WireBender(spec, scene, seed, faults)
-    bender.install(cell)
+    bender.install(cell, start)
     return bender

@@ -46,17 +46,31 @@ class ScheduledActor(Generic[P, E]):
         self._cell: Any = None
         self.start_time: float | None = None
 
-    def install(self, cell: Any) -> None:
-        """Start acting on ``cell`` (a SimCell): times count from now (simulated)."""
+    def install(self, cell: Any, start: bool = True) -> None:
+        """Join ``cell`` (a SimCell) and, with ``start``, start acting: times count from now
+        (simulated). Without it the actor waits for :meth:`start`."""
 
         def attach(client: int) -> None:
             self._client = client
-            self.start_time = cell.time()
             self._attached(client)
+            if start:
+                self.start_time = cell.time()
 
         cell.call(attach)
         self._cell = cell
         cell.add_step_hook(post=self._on_step)
+
+    def start(self) -> None:
+        """Start acting now (simulated time) if not started yet (after :meth:`install`)."""
+        cell = self._cell
+        if cell is None:
+            raise RuntimeError("install the actor on a cell before starting it")
+
+        def begin(_client: int) -> None:
+            if self.start_time is None:
+                self.start_time = cell.time()
+
+        cell.call(begin)
 
     def uninstall(self) -> None:
         """Stop acting (idempotent)."""

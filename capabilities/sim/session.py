@@ -101,6 +101,9 @@ class SimCellSession:
         shoulder_size: (width, height) of the shoulder camera instead of the configured one.
         wrist_size: (width, height) of the wrist camera instead of the configured one.
         faults: the wire bender's fault rates instead of the scene file's.
+        start_actors: start the scene's worker and bender now; False: they wait for
+            :meth:`start_actors` (a run as fast as possible starts them with its plan, so
+            that setting up the run costs no simulated time of theirs).
     """
 
     name = "sim"
@@ -114,6 +117,7 @@ class SimCellSession:
         shoulder_size: tuple[int, int] | None = None,
         wrist_size: tuple[int, int] | None = None,
         faults: FaultModel | None = None,
+        start_actors: bool = True,
     ) -> None:
         self.sim = SimCell(config, speed)
         self.world_model = WorldModel()
@@ -140,8 +144,10 @@ class SimCellSession:
                 name: SimCameraDevice(self.sim, self._camera(name, settings, sizes.get(name)))
                 for name, settings in self.sim.config.cameras.items()
             }
-            self.worker = install_scene_worker(self.sim, self.scene, path, seed)
-            self.bender = install_scene_bender(self.sim, self.scene, path, seed, faults)
+            self.worker = install_scene_worker(self.sim, self.scene, path, seed, start_actors)
+            self.bender = install_scene_bender(
+                self.sim, self.scene, path, seed, faults, start_actors
+            )
         except BaseException:
             self.close()
             raise
@@ -159,6 +165,12 @@ class SimCellSession:
             mount = LinkMount(self.sim.robot_body_id, self.sim.robot.flange_link(), settings.pose)
             return SimCamera(name, optics, mount)
         return SimCamera(name, optics, FixedMount(settings.pose))
+
+    def start_actors(self) -> None:
+        """Start the scene's worker and bender if they wait (``start_actors=False``)."""
+        for actor in (self.worker, self.bender):
+            if actor is not None:
+                actor.start()
 
     @property
     def ground_truth(self) -> Any:

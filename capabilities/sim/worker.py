@@ -240,12 +240,12 @@ class SimWorker(ScheduledActor[PlannedEvent, WorkerEvent]):
 
 
 def install_scene_worker(
-    cell: Any, scene: SceneState, path: Path | str, seed: int | None
+    cell: Any, scene: SceneState, path: Path | str, seed: int | None, start: bool = True
 ) -> SimWorker | None:
-    """Make and start the worker of a scene file, or return None when it has no worker."""
+    """Make (and with ``start`` start) the worker of a scene file; None when it has none."""
     spec = read_worker(path)
     if spec is None:
         return None
     worker = SimWorker(spec, scene, seed)
-    worker.install(cell)
+    worker.install(cell, start)
     return worker
