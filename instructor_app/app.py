@@ -55,6 +55,8 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--cell", choices=("sim", "none"), default="sim",
                         help="the cell to work with (default: sim, the simulated cell)")  # fmt: skip
     parser.add_argument("--seed", type=int, default=0, help="scene seed of the simulated cell")
+    parser.add_argument("--scene", help="scene of the simulated cell (name or path; default "
+                        "cup_to_bin), e.g. tending for the wire bender")  # fmt: skip
     parser.add_argument("--run", action="store_true", help="run the plan once it is open")
     parser.add_argument("--screenshot", metavar="PNG",
                         help="render the window to PNG and exit (after the run with --run)")  # fmt: skip
@@ -97,7 +99,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _interactive(args: argparse.Namespace) -> int:
-    session = CellSession(args.cell, seed=args.seed, speed=1.0)  # real time on screen
+    session = CellSession(
+        args.cell, seed=args.seed, scene=args.scene, speed=1.0
+    )  # real time on screen
     failures: list[str] = []
     session.cell_failed.connect(failures.append)
     session.open()
@@ -120,7 +124,9 @@ def _interactive(args: argparse.Namespace) -> int:
 
 def _screenshot(args: argparse.Namespace) -> int:
     # As fast as possible when running for a picture; real time otherwise (nothing moves).
-    session = CellSession(args.cell, seed=args.seed, speed=None if args.run else 1.0)
+    session = CellSession(
+        args.cell, seed=args.seed, scene=args.scene, speed=None if args.run else 1.0
+    )
     session.cell_failed.connect(lambda message: print(f"error: {message}", file=sys.stderr))
     session.open()
     with tempfile.TemporaryDirectory(prefix="costar-shot-") as scratch:

@@ -5,7 +5,7 @@ model) produce wireforms; the plan is drawn once from the scene's seed::
 
     "bender": {
       "fixture": "bender", "parts": 50, "shapes": ["wireform_u", "wireform_step"],
-      "first_at": [3.0, 5.0], "interval": 12.0, "swing": 0.8, "hold": 0.6,
+      "first_at": [8.0, 10.0], "interval": 20.0, "swing": 0.8, "hold": 0.6,
       "spread": {"x": 0.008, "y": 0.008, "yaw": 0.08},
       "faults": {"bad_weld": 0.02, "bad_grasp": 0.05, "interval_spread": 0.35}
     }

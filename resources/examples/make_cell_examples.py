@@ -178,12 +178,15 @@ def cup_to_bin_vision() -> PlanSpec:
 def _tending_cycle(m: _Maker) -> NodeSpec:
     """One part: the arm swings down and back up, pick at the exit, onto the rack."""
     region = Binding.fixed(ARM_REGION, ParamType.REGION)
-    no_limit = Binding.fixed(600.0, ParamType.DURATION)
+    long = Binding.fixed(600.0, ParamType.DURATION)
+    # Four looks a second see the arm, which stays over the exit for more than a second.
+    period = Binding.fixed(0.25, ParamType.DURATION)
     return m.node(
         NodeKind.SEQUENCE, "one part",
         m.op("occupancy.wait_until_occupied", "wait for the welding arm", region=region,
-             timeout=no_limit),
-        m.op("occupancy.wait_until_empty", "wait until the arm is back up", region=region),
+             timeout=long, period=period),
+        m.op("occupancy.wait_until_empty", "wait until the arm is back up", region=region,
+             period=period),
         m.move("over the exit", "over exit"),
         m.move("down to the part", "at exit", linear=True),
         m.op("gripper.close", "close on the part"),

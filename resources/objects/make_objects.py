@@ -542,7 +542,7 @@ def make_rack() -> tuple[dict, Mesh]:
         dimensions=list(size),
         symmetry={"kind": "none"},
         markers=[
-            top_marker(32, 0.05, size[2], -0.095),
+            top_marker(32, 0.07, size[2], -0.09),
             wall_marker(33, 0.045, (-1, 0, 0), (-0.13, 0.0, 0.03)),
         ],
         color=[0.3, 0.3, 0.34, 1.0],

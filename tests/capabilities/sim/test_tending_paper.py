@@ -1,0 +1,106 @@
+"""The paper's wire-bender tending plan (resources/examples/tending_paper.costar.json) in a
+short trial on the ``tending`` scene: a bad weld stops the robot until the operator presses
+Continue, while the bender goes on; the next, good part ends on the rack. Ground truth is
+read here only."""
+
+from __future__ import annotations
+
+import threading
+import time
+from pathlib import Path
+
+from capabilities.base import CapabilityRegistry
+from capabilities.sim.bender import read_bender
+from capabilities.sim.bender_spec import FaultModel, plan_parts
+from capabilities.sim.session import SimCellSession
+from engine.build import build_tree
+from engine.events import Event, StatusChanged
+from engine.executor import Executor
+from engine.files import load_plan
+from engine.status import Status
+from engine.validation import has_errors, validate_plan
+from tests.capabilities.sim.test_bender import tending_scene
+
+PLAN = Path(__file__).resolve().parents[3] / "resources" / "examples" / "tending_paper.costar.json"
+OPERATOR = "operator resets the cell, presses Continue"
+# Paced: perception takes wall time, and as fast as possible a part could come and go while
+# the shoulder camera's image is searched for markers.
+SPEED = 4.0
+
+
+class Trial:
+    """Runs the plan on a session of the scene; counts the operator's waits, presses
+    Continue for each (``press``)."""
+
+    def __init__(self, session: SimCellSession, press: bool) -> None:
+        self.session = session
+        self.waits = 0
+        self._press = press
+        self._lock = threading.Lock()
+        registry = CapabilityRegistry(cell=session)
+        plan = load_plan(PLAN, registry.aliases())
+        assert not has_errors(validate_plan(plan, registry))
+        self._names = {node.id: node.name for _, node in plan.walk()}
+        tree = build_tree(plan, registry, clock=session.clock)
+        self.executor = Executor(tree, 50.0, [self._heard])
+
+    def _heard(self, event: Event) -> None:
+        if not isinstance(event, StatusChanged) or event.new is not Status.RUNNING:
+            return
+        if self._names.get(event.node_id) == OPERATOR:
+            with self._lock:
+                self.waits += 1
+            if self._press:
+                self.session.operator.press("continue")
+
+    def run(self, until: float) -> None:
+        """Start the bender with the plan; run ``until`` simulated seconds after."""
+        self.session.start_actors()
+        self.executor.start()
+        bender = self.session.bender
+        assert bender is not None and bender.start_time is not None
+        deadline = time.monotonic() + 300.0  # a generous wall-time bound
+        while self.session.clock() - bender.start_time < until:
+            assert time.monotonic() < deadline, "the trial did not reach its simulated time"
+            self.session.sim.wait_sim(0.5)
+        self.executor.stop("trial over")
+        assert self.executor.wait(10.0) is not None
+
+
+def on_rack(session: SimCellSession, part: str) -> bool:
+    """GROUND TRUTH: the part lies on the rack's shelf."""
+    if part not in session.scene.objects:
+        return False
+    local = session.truth_pose("rack").inverse().compose(session.truth_pose(part)).position
+    return abs(local[0]) < 0.13 and abs(local[1]) < 0.12 and 0.055 < local[2] < 0.1
+
+
+def _seed_with(bad_welds: list[bool], faults: FaultModel, scene: Path) -> int:
+    """A seed whose parts have these welds (the plan is drawn from the seed)."""
+    spec = read_bender(scene)
+    assert spec is not None
+    for seed in range(200):
+        if [p.bad_weld for p in plan_parts(spec, seed, faults)] == bad_welds:
+            return seed
+    raise AssertionError(f"no seed gives welds {bad_welds}")
+
+
+def test_a_bad_weld_stops_the_robot_until_the_operator_resets_it(tmp_path: Path) -> None:
+    """Part 1's weld comes apart when lifted: the robot drops it, steps back and waits for
+    the operator; after Continue it catches part 2 and puts it on the rack."""
+    scene = tending_scene(tmp_path, parts=2, interval=18.0)
+    faults = FaultModel(bad_weld=0.5, bad_grasp=0.0, interval_spread=0.0)
+    seed = _seed_with([True, False], faults, scene)
+    with SimCellSession(
+        scene, seed, speed=SPEED, faults=faults, start_actors=False, shoulder_size=(320, 240)
+    ) as session:
+        trial = Trial(session, press=True)
+        bender = session.bender
+        assert bender is not None
+        trial.run(until=bender.plan[-1].offset + 20.0)
+        kinds = [(e.kind, e.part) for e in bender.events()]
+        assert kinds == [("released", "part_001"), ("weld_broke", "part_001"),
+                         ("released", "part_002")]  # fmt: skip
+        assert trial.waits == 1  # the robot stopped once, the operator let it go on
+        assert on_rack(session, "part_002")
+        assert not session.sim.gripper.is_holding()
