@@ -43,6 +43,8 @@ __all__ = ["BenderEvent", "WireBender", "install_scene_bender", "read_bender"]
 RELEASED, WELD_BROKE, SLIPPED = "released", "weld_broke", "slipped"
 ARM = "bender_arm"  # the scene object name of the welding arm
 SLIP = 0.02  # m a slipping part slides down the fingers: out of 15 mm long fingertips
+RESTING_SPEED = 0.01  # m/s: a released part slower than this has landed...
+SETTLE = 0.3  # s: ...once it had this long to fall
 
 
 @dataclass(frozen=True)
@@ -66,7 +68,8 @@ class _Live:
     """A released part the bender still watches for its fault."""
 
     planned: PlannedPart
-    landed: bool = False
+    released: float  # simulated time
+    rest: float | None = None  # its height once it came to rest (m above the table)
 
 
 def read_bender(path: Path | str) -> BenderSpec | None:
@@ -162,7 +165,7 @@ class WireBender(ScheduledActor[PlannedPart, BenderEvent]):
         pose = self._machine_pose().compose(local).compose(self._station[planned.shape])
         self._scene.spawn(self._client, planned.name, planned.shape, pose)
         if planned.bad_weld or planned.bad_grasp:
-            self._live[planned.name] = _Live(planned)
+            self._live[planned.name] = _Live(planned, now)
         return self._event(now, RELEASED, planned, pose)
 
     @staticmethod
@@ -212,10 +215,13 @@ class WireBender(ScheduledActor[PlannedPart, BenderEvent]):
             del self._live[name]
             return
         height = self._height(name)
-        if not live.landed:
-            live.landed = height < self.spec.lift / 2
+        if live.rest is None:  # falling onto the exit (or onto a part there)
+            body = self._scene.body_id(name)
+            velocity = p.getBaseVelocity(body, physicsClientId=self._client)[0]
+            if now - live.released > SETTLE and math.dist(velocity, (0, 0, 0)) < RESTING_SPEED:
+                live.rest = height
             return
-        if height < self.spec.lift:
+        if height < live.rest + self.spec.lift:
             return
         planned = live.planned
         del self._live[name]
