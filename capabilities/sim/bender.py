@@ -35,7 +35,7 @@ from capabilities.sim.objects import ObjectModelSpec, SceneError, set_object_fra
 from capabilities.sim.scene import SceneState
 from capabilities.sim.scene_spec import SceneFileError
 from capabilities.sim.schedule import ScheduledActor
-from engine.json_reader import JsonFileError, read_json_file
+from engine.json_reader import JsonFileError, JsonReader, read_json_file
 from engine.types import Pose
 
 __all__ = ["BenderEvent", "WireBender", "install_scene_bender", "read_bender"]
@@ -113,13 +113,7 @@ class WireBender(ScheduledActor[PlannedPart, BenderEvent]):
         super().__init__(plan_parts(spec, seed, faults))
         self.spec = spec
         self._scene = scene
-        machine = scene.model(spec.fixture)
-        arm = machine.extra.get("welding_arm")
-        exit_ = machine.extra.get("exit")
-        if not isinstance(arm, dict) or not isinstance(exit_, dict):
-            raise SceneError(f"model {machine.name!r} is no wire bender (no welding_arm, exit)")
-        self._arm = arm
-        self._exit = exit_
+        self._machine = _machine(scene.model(spec.fixture))
         self._station: dict[str, Pose] = {}
         for shape in spec.shapes:
             model = scene.library.get(shape)
@@ -127,7 +121,7 @@ class WireBender(ScheduledActor[PlannedPart, BenderEvent]):
                 raise SceneError(f"model {shape!r} is no wireform (it has no weld)")
             self._station[shape] = _weld_station(model)
         self._live: dict[str, _Live] = {}
-        self._pitch = float(arm["rest_pitch"])
+        self._pitch = self._machine.rest_pitch
         self._next_release = 0
         self._pieces: list[int] = []
 
@@ -152,15 +146,14 @@ class WireBender(ScheduledActor[PlannedPart, BenderEvent]):
     def _attached(self, client: int) -> None:
         if ARM not in self._scene.objects:
             pose = _pitch_pose(self._pivot(), self._pitch)
-            self._scene.spawn(client, ARM, str(self._arm["model"]), pose, fixed=True)
+            self._scene.spawn(client, ARM, self._machine.arm_model, pose, fixed=True)
 
     def _pivot(self) -> Pose:
-        return self._machine_pose().compose(Pose(tuple(self._arm["pivot"])))
+        return self._machine_pose().compose(Pose(self._machine.pivot))
 
     def _act(self, planned: PlannedPart, now: float) -> BenderEvent:
         dx, dy, dyaw = planned.shift
-        ex, ey = self._exit["position"]
-        drop = float(self._exit.get("drop_height", 0.03))
+        (ex, ey), drop = self._machine.exit, self._machine.drop_height
         local = Pose((ex + dx, ey + dy, drop), (0.0, 0.0, math.sin(dyaw / 2), math.cos(dyaw / 2)))
         pose = self._machine_pose().compose(local).compose(self._station[planned.shape])
         self._scene.spawn(self._client, planned.name, planned.shape, pose)
@@ -189,7 +182,7 @@ class WireBender(ScheduledActor[PlannedPart, BenderEvent]):
             and plan[self._next_release].offset + spec.hold + spec.swing < elapsed
         ):
             self._next_release += 1
-        rest, low = float(self._arm["rest_pitch"]), float(self._arm["release_pitch"])
+        rest, low = self._machine.rest_pitch, self._machine.release_pitch
         if self._next_release >= len(plan):
             return rest
         at = plan[self._next_release].offset
@@ -265,6 +258,32 @@ class WireBender(ScheduledActor[PlannedPart, BenderEvent]):
             piece = _spawn_piece(client, model, [int(b) for b in boxes], frame)
             p.resetBaseVelocity(piece, velocity[0], velocity[1], physicsClientId=client)
             self._pieces.append(piece)
+
+
+@dataclass(frozen=True)
+class _Machine:
+    """A wire bender model's ``welding_arm`` and ``exit`` (bender frame, m and rad)."""
+
+    arm_model: str
+    pivot: tuple[float, float, float]
+    rest_pitch: float
+    release_pitch: float
+    exit: tuple[float, float]
+    drop_height: float
+
+
+def _machine(model: ObjectModelSpec) -> _Machine:
+    """The bender geometry of a model; SceneError names the model.json and what is off."""
+    r = JsonReader(model.extra, str(model.directory / "model.json"))
+    try:
+        arm, exit_ = r.child("welding_arm", optional=False), r.child("exit", optional=False)
+        return _Machine(
+            arm.text("model", nonempty=True), arm.vector3("pivot"), arm.number("rest_pitch"),
+            arm.number("release_pitch"), exit_.vector2("position"),
+            exit_.number("drop_height", 0.03, lo=0.0, hi=0.5),
+        )  # fmt: skip
+    except JsonFileError as exc:
+        raise SceneError(f"model {model.name!r} is no wire bender: {exc}") from exc
 
 
 def _weld_station(model: ObjectModelSpec) -> Pose:

@@ -19,6 +19,7 @@ from capabilities.markers import capability as markers_capability
 from capabilities.markers.geometry import pose_errors
 from capabilities.occupancy import capability as occupancy_capability
 from capabilities.sim.bender_spec import FaultModel, parse_bender, plan_parts
+from capabilities.sim.objects import SceneError
 from capabilities.sim.scene import default_scene_path
 from capabilities.sim.scene_spec import SceneFileError
 from capabilities.sim.session import SimCellSession
@@ -95,6 +96,18 @@ def test_a_bad_bender_block_is_refused_with_its_json_path(change: dict, where: s
 
 
 # --------------------------------------------------------------------------- in the sim
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [({"fixture": "rack"}, "'tending_rack' is no wire bender"),
+     ({"shapes": ["wireform_u", "cup"]}, "'cup' is no wireform")],
+)  # fmt: skip
+def test_a_bender_on_the_wrong_models_is_refused(
+    tmp_path: Path, change: dict, message: str
+) -> None:
+    with pytest.raises(SceneError, match=re.escape(message)):
+        SimCellSession(tending_scene(tmp_path, **change), seed=0)
 
 
 def test_the_scene_loads_for_several_seeds_with_the_rack_elsewhere() -> None:
