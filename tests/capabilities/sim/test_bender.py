@@ -299,3 +299,17 @@ def test_the_shoulder_camera_is_calibrated_on_the_benders_markers(tmp_path: Path
         # together, leave the distance along the view ray least constrained (measured: 13 mm
         # and 0.46 deg after).
         assert position_error < 0.02 and math.degrees(angle) < 1.0
+
+
+def test_the_bender_waits_for_the_run_when_asked(tmp_path: Path) -> None:
+    scene = tending_scene(tmp_path, parts=1, first_at=[1.0, 1.0])
+    with SimCellSession(scene, seed=0, start_actors=False) as session:
+        bender = session.bender
+        assert bender is not None
+        session.sim.wait_sim(3.0)
+        assert bender.start_time is None and not bender.events()  # nothing before the start
+        session.start_actors()
+        started = bender.start_time
+        assert started is not None and started >= 3.0
+        session.sim.wait_sim(1.5)
+        assert [e.time for e in bender.produced()] == pytest.approx([started + 1.0], abs=2 / 240)
