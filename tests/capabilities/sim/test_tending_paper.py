@@ -91,9 +91,9 @@ def test_a_bad_weld_stops_the_robot_until_the_operator_resets_it(tmp_path: Path)
     scene = tending_scene(tmp_path, parts=2, interval=18.0)
     faults = FaultModel(bad_weld=0.5, bad_grasp=0.0, interval_spread=0.0)
     seed = _seed_with([True, False], faults, scene)
-    with SimCellSession(
-        scene, seed, speed=SPEED, faults=faults, start_actors=False, shoulder_size=(320, 240)
-    ) as session:
+    # The shoulder camera at its full 640 x 480: at 320 x 240 the rack's marker is too small
+    # to be found from some of the rack's poses.
+    with SimCellSession(scene, seed, speed=SPEED, faults=faults, start_actors=False) as session:
         trial = Trial(session, press=True)
         bender = session.bender
         assert bender is not None
