@@ -72,7 +72,7 @@ def on_rack(session: SimCellSession, part: str) -> bool:
     if part not in session.scene.objects:
         return False
     local = session.truth_pose("rack").inverse().compose(session.truth_pose(part)).position
-    return abs(local[0]) < 0.13 and abs(local[1]) < 0.12 and 0.055 < local[2] < 0.1
+    return abs(local[0]) < 0.13 and abs(local[1]) < 0.12 and 0.055 < local[2] < 0.3  # stacked
 
 
 def _seed_with(bad_welds: list[bool], faults: FaultModel, scene: Path) -> int:
