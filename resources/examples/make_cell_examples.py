@@ -11,7 +11,7 @@ it.
 ``tending_paper.costar.json`` is the paper's wire-bender tending plan (section V-B) on the
 ``tending`` scene: look up the rack by its marker, then for each part wait until the bender's
 welding arm swings into an occupancy region and back out, pick the part at the exit with one
-taught waypoint, check it is held, put it on the rack; on any failure drop what is held, step
+taught waypoint, check it is held, drop it into the rack's tote; on any failure drop what is held, step
 back and wait for the operator's Continue (the paper stopped and reset the robot).
 Usage: python resources/examples/make_cell_examples.py
 """
@@ -66,7 +66,9 @@ EXIT_XY = (0.55, 0.28)
 GRASP_Z, ABOVE_Z = 0.017, 0.12
 # The welding arm over the exit when it releases a part (the occupancy region).
 ARM_REGION = Region((0.6, 0.28, 0.235), 0.05)
-RACK_PLACE_Z = 0.06 + GRASP_Z + 0.01  # on the rack's 60 mm high shelf, let go 1 cm above
+# Over the middle of the rack's tote (rim 80 mm high): the fingertips 55 mm above its rim.
+TOTE = (0.04, 0.0)
+RACK_DROP_Z = 0.15
 
 
 def tending_waypoints() -> list[Waypoint]:
@@ -74,9 +76,9 @@ def tending_waypoints() -> list[Waypoint]:
         Waypoint("observe", WaypointFrame.JOINTS, joints=JointConfig(OBSERVE_JOINTS)),
         Waypoint("over exit", WaypointFrame.WORLD, Pose((*EXIT_XY, ABOVE_Z), EXIT_DOWN)),
         Waypoint("at exit", WaypointFrame.WORLD, Pose((*EXIT_XY, GRASP_Z), EXIT_DOWN)),
-        Waypoint("over rack", WaypointFrame.OBJECT, Pose((0.03, 0.0, 0.2), DOWN),
+        Waypoint("over rack", WaypointFrame.OBJECT, Pose((*TOTE, 0.25), DOWN),
                  reference="tending_rack"),
-        Waypoint("on rack", WaypointFrame.OBJECT, Pose((0.03, 0.0, RACK_PLACE_Z), DOWN),
+        Waypoint("into rack", WaypointFrame.OBJECT, Pose((*TOTE, RACK_DROP_Z), DOWN),
                  reference="tending_rack"),
     ]  # fmt: skip
 
@@ -194,8 +196,8 @@ def _tending_cycle(m: _Maker) -> NodeSpec:
         m.move("lift the part", "over exit", linear=True),
         m.op("gripper.is_holding", "part still held"),
         m.move("over the rack", "over rack", "RACK_POSE"),
-        m.move("down onto the rack", "on rack", "RACK_POSE", linear=True),
-        m.op("gripper.open", "let go"),
+        m.move("down over the tote", "into rack", "RACK_POSE", linear=True),
+        m.op("gripper.open", "let go into the tote"),
         m.move("up from the rack", "over rack", "RACK_POSE", linear=True),
         m.move("step out of view", "observe"),
     )  # fmt: skip
@@ -224,7 +226,8 @@ def tending_paper() -> PlanSpec:
         "The paper's deployment at Marlin Steel on the 'tending' scene: the rack is found by "
         "its marker once; for each part the robot waits until the bender's welding arm swings "
         "into an occupancy region and back out, picks the wireform at the exit with one taught "
-        "waypoint, checks it is held before and after lifting, and puts it on the rack. On any "
+        "waypoint, checks it is held before and after lifting, and drops it into the rack's "
+        "tote. On any "
         "failure (a bad weld, a slipping grasp, a part not there) it drops what it holds, steps "
         "back and waits for the operator's Continue while the bender keeps producing. Runs until "
         "stopped. Run it with: costar run tending_paper.costar.json --cell sim --scene tending.",

@@ -214,9 +214,7 @@ def wall_marker(marker_id: int, size: float, normal: Vec, center: Vec) -> dict:
     }
 
 
-def top_marker(
-    marker_id: int, size: float, height: float, x: float = 0.0, y: float = 0.0
-) -> dict:
+def top_marker(marker_id: int, size: float, height: float, x: float = 0.0, y: float = 0.0) -> dict:
     """A marker lying on a horizontal top face: texture top toward the object's +y."""
     position = [_r(x), _r(y), _r(height + MARKER_LIFT)]
     pose = {"position": position, "orientation": [0.0, 0.0, 0.0, 1.0]}
@@ -529,23 +527,41 @@ def make_bender_arm() -> tuple[dict, Mesh]:
 
 
 def make_rack() -> tuple[dict, Mesh]:
-    """The mobile rack's shelf the wireforms go on; markers on its top corner and its front."""
-    size = (0.26, 0.24, 0.06)
+    """The mobile rack's top: a ledge at -x carrying marker 32 on its top and 33 on its end,
+    and an open tote the wireforms are dropped into (they pile up there, as on a cart)."""
+    length, width, height, ledge = 0.32, 0.24, 0.08, 0.08
+    tote = length - ledge
+    parts = []
+    for p in open_box_parts(tote, width, height, 0.006, 0.006):  # the tote, moved to +x
+        x, y, z = p["position"]
+        parts.append(
+            {"size": [_r(v) for v in p["size"]], "position": [_r(x + ledge / 2), _r(y), _r(z)]}
+        )
+    parts.append(
+        {"size": [ledge, width, height], "position": [_r((ledge - length) / 2), 0.0, height / 2]}
+    )
     mesh = Mesh()
-    mesh.box((0.0, 0.0, size[2] / 2), size)
+    for part in parts:
+        mesh.box(part["position"], part["size"])
+    end = -length / 2
     model = _model(
         "tending_rack",
-        "Top shelf of the mobile rack of the tending task. Marker 32 on its top at -x, 33 on "
-        "its -x side.",
-        collision={"type": "box", "size": list(size)},
+        "Top of the mobile rack of the tending task: a ledge at -x with marker 32 on its top "
+        "and 33 on its end, and an open tote (+x) the wireforms are dropped into.",
+        collision={"type": "compound", "boxes": parts},
         mass=15.0,
-        dimensions=list(size),
+        dimensions=[length, width, height],
         symmetry={"kind": "none"},
         markers=[
-            top_marker(32, 0.07, size[2], -0.09),
-            wall_marker(33, 0.045, (-1, 0, 0), (-0.13, 0.0, 0.03)),
+            top_marker(32, 0.07, height, _r(end + ledge / 2)),
+            wall_marker(33, 0.05, (-1, 0, 0), (end, 0.0, height / 2)),
         ],
         color=[0.3, 0.3, 0.34, 1.0],
+        tote={
+            "center": [_r(ledge / 2), 0.0],
+            "inner": [_r(tote - 0.012), _r(width - 0.012)],
+            "floor": 0.006,
+        },
     )
     return model, mesh
 
