@@ -28,9 +28,8 @@ from capabilities.xml_commands import add_xml_commands
 from engine.build import BuildError, build_tree
 from engine.events import Event, LogMessage, RunFinished, RunHeld, StatusChanged
 from engine.executor import Executor
-from engine.files import PlanFileError, load_plan
+from engine.files import PlanFileError, load_plan, plan_scene
 from engine.instances import runtime_paths
-from engine.json_reader import JsonFileError, read_json_file
 from engine.library import Library, library_folder
 from engine.operations import OperationManifest
 from engine.run_report import FailureLog
@@ -63,21 +62,11 @@ def _load(path: str, registry: CapabilityRegistry, err: TextIO) -> PlanSpec | No
         return None
 
 
-def _plan_scene(path: str) -> str | None:
-    """The simulated scene a plan names (its ``scene``), or None; a file that cannot be read
-    is left to the plan's own load, which says what is wrong with it."""
-    try:
-        scene = read_json_file(path).get("scene")
-    except (JsonFileError, AttributeError):
-        return None
-    return scene if isinstance(scene, str) and scene else None
-
-
 def _open(args: argparse.Namespace, err: TextIO, start: bool) -> Any:
     """The cell the command asked for, or None after saying why it could not be opened.
     The simulated cell opens ``--scene``, else the scene the plan was taught on."""
     plan = getattr(args, "plan", None)
-    scene = args.scene or (_plan_scene(plan) if plan else None)
+    scene = args.scene or (plan_scene(plan) if plan else None)
     try:
         return open_cell(args.cell, seed=args.seed, start=start, scene=scene)
     except CellError as exc:

@@ -28,7 +28,7 @@ from engine.plan_format import (
     READABLE_VERSIONS,
     PlanFileError,
 )
-from engine.plan_reader import load_plan, loads_plan
+from engine.plan_reader import load_plan, loads_plan, plan_scene
 from engine.plan_writer import dump_plan, save_plan
 
 __all__ = [
@@ -42,5 +42,6 @@ __all__ = [
     "dump_plan",
     "load_plan",
     "loads_plan",
+    "plan_scene",
     "save_plan",
 ]

@@ -6,7 +6,7 @@ import os
 from collections.abc import Mapping
 from typing import Any, NoReturn
 
-from engine.json_reader import JsonReader, parse_json, read_json_file
+from engine.json_reader import JsonFileError, JsonReader, parse_json, read_json_file
 from engine.kinds import setting as kind_setting
 from engine.plan_format import (
     FORMAT,
@@ -402,3 +402,14 @@ def load_plan(path: str | os.PathLike[str], aliases: Mapping[str, str] | None = 
     reader = _Reader(file, aliases or {})
     reader.check_format(doc)
     return reader.plan(doc)
+
+
+def plan_scene(path: str | os.PathLike[str]) -> str | None:
+    """The simulated scene a plan file names (its ``scene``), or None: what a cell must open
+    before the plan is loaded. A file that cannot be read is left to :func:`load_plan`,
+    which says what is wrong with it."""
+    try:
+        scene = read_json_file(path).get("scene")
+    except (JsonFileError, AttributeError):
+        return None
+    return scene if isinstance(scene, str) and scene else None

@@ -30,6 +30,7 @@ from PySide6.QtGui import QIcon
 from PySide6.QtWidgets import QApplication, QWidget
 
 from capabilities.cells import CELL_NAMES, is_cell_file
+from engine.files import plan_scene
 from engine.library import LIBRARY_ENV
 from engine.status import Status
 from instructor_app.document.model import DocumentError
@@ -64,6 +65,8 @@ def _parser() -> argparse.ArgumentParser:
                         help="the cell to work with: sim (the default, the simulated cell), "
                         "none, or a cell file (*.cell.json); it opens after the window shows")  # fmt: skip
     parser.add_argument("--seed", type=int, default=0, help="scene seed of the simulated cell")
+    parser.add_argument("--scene", help="scene of the simulated cell (name or path; default "
+                        "cup_to_bin), e.g. tending for the wire bender")  # fmt: skip
     parser.add_argument("--run", action="store_true", help="run the plan once it is open")
     parser.add_argument("--library", metavar="FOLDER",
                         help="the subtree library folder (default: $COSTAR_LIBRARY, else the "
@@ -113,6 +116,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         except FileNotFoundError as exc:
             print(f"error: {exc}", file=sys.stderr)
             return EXIT_BAD_INPUT
+        args.scene = args.scene or plan_scene(args.plan)  # the scene the plan was taught on
     if args.screenshot and not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
         os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
     app = QApplication.instance() or QApplication(
@@ -129,7 +133,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _start_session(args: argparse.Namespace, speed: float | None) -> CellSession:
     """A session on the cell without a robot (opens at once), so that the window can show
     before the cell asked for is open; the window then opens that one in the background."""
-    session = CellSession(args.cell, seed=args.seed, speed=speed)
+    session = CellSession(args.cell, seed=args.seed, scene=args.scene, speed=speed)
     session.open("none")
     return session
 

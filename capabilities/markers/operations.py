@@ -160,7 +160,7 @@ class ObjectFound:
 
 
 class CalibrateCamera:
-    """Finds a fixed camera's pose from the table markers of known pose."""
+    """Finds a fixed camera's pose from the markers of known pose (on the table, on fixtures)."""
 
     def __init__(self, env: _Env) -> None:
         self._env = env
@@ -217,7 +217,7 @@ def capability() -> Capability:
                _object_port()),
             stateful(ObjectFound))  # fmt: skip
     cap.add(manifest(CAP, "calibrate_camera", OperationKind.ACTION,
-               "Finds a fixed camera's pose from the table markers of known pose.",
+               "Finds a fixed camera's pose from the markers of known pose (table, fixtures).",
                _camera_port(),
                PortSpec("max_error_px", (ParamType.NUMBER,), default=1.5, unit="px",
                         doc="refuse a calibration worse than this")),

@@ -5,7 +5,8 @@
 whose ``capture()`` renders on the physics thread), ``world`` (the cell's world model),
 ``workers`` (a thread pool for blocking work such as perception) and ``operator`` (the
 OperatorConsole: prompts and buttons). The clock is simulated time. A scene file with a
-``worker`` block gets a simulated person (``session.worker``, see ``sim/worker.py``).
+``worker`` block gets a simulated person (``session.worker``, see ``sim/worker.py``), one with
+a ``bender`` block a working 2D wire bender (``session.bender``, see ``sim/bender.py``).
 Ground truth stays on ``ground_truth`` and ``scene`` for tests and scores.
 """
 
@@ -24,6 +25,8 @@ from capabilities.camera_source import CameraSource
 from capabilities.camera_sources import open_source
 from capabilities.collaboration.console import OperatorConsole
 from capabilities.jobs import WorkerPool
+from capabilities.sim.bender import WireBender, install_scene_bender
+from capabilities.sim.bender_spec import FaultModel
 from capabilities.sim.cameras import (
     CameraConfig,
     FixedMount,
@@ -35,7 +38,7 @@ from capabilities.sim.cell import SimCell
 from capabilities.sim.config import CameraSettings, CellConfig
 from capabilities.sim.live_view import LiveView, MirrorRecipe
 from capabilities.sim.mirror_state import take_snapshot
-from capabilities.sim.scene import SceneState, default_scene_path, load_scene
+from capabilities.sim.scene import SceneState, default_scene_path, load_scene, yaw_pose
 from capabilities.sim.worker import SimWorker, install_scene_worker
 from capabilities.world_model import WorldModel
 from engine.types import Pose
@@ -129,6 +132,10 @@ class SimCellSession:
         config: the cell configuration (default ``resources/cells/sim_default.json``).
         shoulder_size: (width, height) of the shoulder camera instead of the configured one.
         wrist_size: (width, height) of the wrist camera instead of the configured one.
+        faults: the wire bender's fault rates instead of the scene file's.
+        start_actors: start the scene's worker and bender now; False: they wait for
+            :meth:`start_actors` (a run as fast as possible starts them with its plan, so
+            that setting up the run costs no simulated time of theirs).
     """
 
     name = "sim"
@@ -141,6 +148,8 @@ class SimCellSession:
         config: CellConfig | None = None,
         shoulder_size: tuple[int, int] | None = None,
         wrist_size: tuple[int, int] | None = None,
+        faults: FaultModel | None = None,
+        start_actors: bool = True,
     ) -> None:
         self.sim = SimCell(config, speed)
         self.world_model = WorldModel()
@@ -148,6 +157,7 @@ class SimCellSession:
         self.operator = OperatorConsole()
         self.worker: SimWorker | None = None  # the simulated person, if the scene has one
         self.live_view: LiveView | None = None  # live pictures (a mirror per camera)
+        self.bender: WireBender | None = None  # the wire bender, if the scene has one
         self.sim.start()
         try:
             path = (
@@ -167,7 +177,10 @@ class SimCellSession:
                 name: self._device(name, settings, sizes.get(name))
                 for name, settings in self.sim.config.cameras.items()
             }
-            self.worker = install_scene_worker(self.sim, self.scene, path, seed)
+            self.worker = install_scene_worker(self.sim, self.scene, path, seed, start_actors)
+            self.bender = install_scene_bender(
+                self.sim, self.scene, path, seed, faults, start_actors
+            )
             self._install_live_view(
                 MirrorRecipe(
                     self.sim.config,
@@ -215,6 +228,12 @@ class SimCellSession:
             return SimCamera(name, optics, mount)
         return SimCamera(name, optics, FixedMount(settings.pose))
 
+    def start_actors(self) -> None:
+        """Start the scene's worker and bender if they wait (``start_actors=False``)."""
+        for actor in (self.worker, self.bender):
+            if actor is not None:
+                actor.start()
+
     @property
     def ground_truth(self) -> Any:
         """GROUND TRUTH of the devices, for tests and scores only."""
@@ -240,8 +259,10 @@ class SimCellSession:
 
     def scene_layout(self) -> dict[str, Any]:
         """What a worker configures about the cell (not ground truth of movable objects):
-        marker sizes, which object carries which marker, the table markers' poses, and the
-        fixed furniture (table, holster) as boxes."""
+        marker sizes, which object carries which marker, the poses of the markers that never
+        move (on the table, and on fixtures the scene file puts at one pose: a machine bolted
+        down, measured once; the paper calibrated its cameras on the bender's), and the fixed
+        furniture (table, holster) as boxes."""
         # Every marker the object library knows, not only those on objects present now: an
         # object handed in later must be recognised by its marker too.
         sizes = {m.marker_id: m.size for m in self.scene.fixed_markers.values()}
@@ -251,7 +272,8 @@ class SimCellSession:
         table = self.sim.config.table
         return {
             "marker_sizes": sizes,
-            "fixed_markers": {m.marker_id: m.pose for m in self.scene.fixed_markers.values()},
+            "fixed_markers": {m.marker_id: m.pose for m in self.scene.fixed_markers.values()}
+            | self._fixture_markers(),
             # The furniture, for views of the cell: boxes (name, centre pose, size x y z).
             "fixtures": [
                 ("table", Pose((*table.center, table.top_z - table.size[2] / 2)), table.size),
@@ -262,6 +284,17 @@ class SimCellSession:
                 ),
             ],
         }
+
+    def _fixture_markers(self) -> dict[int, Pose]:
+        """World poses of the markers on fixtures placed at their nominal pose (no random)."""
+        found: dict[int, Pose] = {}
+        for entry in self.scene.spec.objects:
+            if entry.fixed and not entry.random:
+                x, y = entry.position
+                frame = yaw_pose(x, y, self.scene.table_top_z, entry.yaw)
+                for marker in self.scene.library.get(entry.model).markers:
+                    found[marker.marker_id] = frame.compose(marker.pose)
+        return found
 
     def clock(self) -> float:
         return self.sim.time()

@@ -21,13 +21,13 @@ shifts a resting object by ``shift`` metres in a random direction (a person movi
 the robot works); an object that is not resting on the table (held) is left alone.
 
 The worker acts on the physics thread (a step hook) at simulated times and records what it
-did, with those times, for tests and scores: :meth:`SimWorker.events`.
+did, with those times, for tests and scores: :meth:`SimWorker.events` (the mechanism is
+:class:`capabilities.sim.schedule.ScheduledActor`, shared with the wire bender).
 """
 
 from __future__ import annotations
 
 import math
-import threading
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -37,6 +37,7 @@ import numpy as np
 from capabilities.sim.objects import object_frame_pose, set_object_frame_pose
 from capabilities.sim.scene import SceneState, yaw_pose
 from capabilities.sim.scene_spec import SceneFileError
+from capabilities.sim.schedule import ScheduledActor
 from engine.json_reader import JsonFileError, JsonReader, read_json_file
 from engine.types import Pose
 
@@ -186,7 +187,7 @@ def plan_events(spec: WorkerSpec, seed: int | None, table_top_z: float) -> list[
     return sorted(events, key=lambda e: e.offset)
 
 
-class SimWorker:
+class SimWorker(ScheduledActor[PlannedEvent, WorkerEvent]):
     """Carries out a worker's schedule on the physics thread of a SimCell.
 
     Args:
@@ -196,38 +197,10 @@ class SimWorker:
     """
 
     def __init__(self, spec: WorkerSpec, scene: SceneState, seed: int | None) -> None:
+        super().__init__(plan_events(spec, seed, scene.table_top_z))
         self.spec = spec
-        self.plan = plan_events(spec, seed, scene.table_top_z)
         self._scene = scene
         self._drop = {h.object: h.drop_height for h in spec.handoffs}
-        self._lock = threading.Lock()
-        self._events: list[WorkerEvent] = []
-        self._next = 0
-        self._client = -1
-        self._cell: Any = None
-        self.start_time: float | None = None
-
-    def install(self, cell: Any) -> None:
-        """Start acting on ``cell`` (a SimCell): times count from now (simulated)."""
-
-        def attach(client: int) -> None:
-            self._client = client
-            self.start_time = cell.time()
-
-        cell.call(attach)
-        self._cell = cell
-        cell.add_step_hook(post=self._on_step)
-
-    def uninstall(self) -> None:
-        """Stop acting (idempotent)."""
-        cell, self._cell = self._cell, None
-        if cell is not None:
-            cell.remove_step_hook(post=self._on_step)
-
-    def events(self) -> list[WorkerEvent]:
-        """What the worker did so far, in order (a copy)."""
-        with self._lock:
-            return list(self._events)
 
     def planned_times(self) -> list[tuple[float, str, str]]:
         """(simulated time, kind, object) of every planned event (after ``install``)."""
@@ -235,17 +208,6 @@ class SimWorker:
         return [(start + e.offset, e.kind, e.object) for e in self.plan]
 
     # ------------------------------------------------------------------ physics thread
-
-    def _on_step(self, now: float) -> None:
-        start = self.start_time
-        while start is not None and self._next < len(self.plan):
-            planned = self.plan[self._next]
-            if start + planned.offset > now + 1e-9:
-                return
-            self._next += 1
-            event = self._act(planned, now)
-            with self._lock:
-                self._events.append(event)
 
     def _act(self, planned: PlannedEvent, now: float) -> WorkerEvent:
         scene, client, name = self._scene, self._client, planned.object
@@ -278,12 +240,12 @@ class SimWorker:
 
 
 def install_scene_worker(
-    cell: Any, scene: SceneState, path: Path | str, seed: int | None
+    cell: Any, scene: SceneState, path: Path | str, seed: int | None, start: bool = True
 ) -> SimWorker | None:
-    """Make and start the worker of a scene file, or return None when it has no worker."""
+    """Make (and with ``start`` start) the worker of a scene file; None when it has none."""
     spec = read_worker(path)
     if spec is None:
         return None
     worker = SimWorker(spec, scene, seed)
-    worker.install(cell)
+    worker.install(cell, start)
     return worker

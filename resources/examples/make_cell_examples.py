@@ -6,7 +6,14 @@ markers, the plan checks the cup was found, queries both poses, grasps the cup a
 with the grasp its object model carries (``gripper.grasp``: approach, descend, close, lift)
 and drops it over the bin; when the cup is not visible it waits and tries again (the root
 runs until success). Its waypoints are also written to ``cup_to_bin.waypoints.json`` beside
-it. Usage: python resources/examples/make_cell_examples.py
+it.
+
+``tending_paper.costar.json`` is the paper's wire-bender tending plan (section V-B) on the
+``tending`` scene: look up the rack by its marker, then for each part wait until the bender's
+welding arm swings into an occupancy region and back out, pick the part at the exit with one
+taught waypoint, check it is held, drop it into the rack's tote; on any failure drop what is held, step
+back and wait for the operator's Continue (the paper stopped and reset the robot).
+Usage: python resources/examples/make_cell_examples.py
 """
 
 from __future__ import annotations
@@ -19,7 +26,15 @@ from capabilities.waypoints import WaypointLibrary, waypoints_path_for
 from engine.files import save_plan
 from engine.kinds import setting
 from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec, RunPolicy
-from engine.types import JointConfig, ObjectModel, ParamType, Pose, Waypoint, WaypointFrame
+from engine.types import (
+    JointConfig,
+    ObjectModel,
+    ParamType,
+    Pose,
+    Region,
+    Waypoint,
+    WaypointFrame,
+)
 
 HERE = Path(__file__).resolve().parent
 _NAMESPACE = uuid.UUID("0b7f2a4e-3c1d-4f5e-8a9b-6c7d8e9f0a1b")
@@ -43,11 +58,36 @@ def waypoints() -> list[Waypoint]:
     ]
 
 
+# The tending cell: the TCP over the bender's exit, turned as the bender drops its parts (the
+# weld bead along world x, the fingers closing across it), 17 mm up: the fingertips 2 mm
+# above the table. Taught once, like the paper's one waypoint per part.
+EXIT_DOWN = (0.0, 1.0, 0.0, 0.0)
+EXIT_XY = (0.55, 0.28)
+GRASP_Z, ABOVE_Z = 0.017, 0.12
+# The welding arm over the exit when it releases a part (the occupancy region).
+ARM_REGION = Region((0.6, 0.28, 0.235), 0.05)
+# Over the middle of the rack's tote (rim 80 mm high): the fingertips 55 mm above its rim.
+TOTE = (0.04, 0.0)
+RACK_DROP_Z = 0.15
+
+
+def tending_waypoints() -> list[Waypoint]:
+    return [
+        Waypoint("observe", WaypointFrame.JOINTS, joints=JointConfig(OBSERVE_JOINTS)),
+        Waypoint("over exit", WaypointFrame.WORLD, Pose((*EXIT_XY, ABOVE_Z), EXIT_DOWN)),
+        Waypoint("at exit", WaypointFrame.WORLD, Pose((*EXIT_XY, GRASP_Z), EXIT_DOWN)),
+        Waypoint("over rack", WaypointFrame.OBJECT, Pose((*TOTE, 0.25), DOWN),
+                 reference="tending_rack"),
+        Waypoint("into rack", WaypointFrame.OBJECT, Pose((*TOTE, RACK_DROP_Z), DOWN),
+                 reference="tending_rack"),
+    ]  # fmt: skip
+
+
 class _Maker:
-    def __init__(self, example: str) -> None:
+    def __init__(self, example: str, wps: list[Waypoint] | None = None) -> None:
         self.example = example
         self.count = 0
-        self.wps = {w.name: w for w in waypoints()}
+        self.wps = {w.name: w for w in (wps or waypoints())}
 
     def _id(self) -> str:
         self.count += 1
@@ -65,10 +105,14 @@ class _Maker:
     def op(self, op: str, name: str, **params: Binding) -> NodeSpec:
         return NodeSpec(NodeKind.OPERATION, name, self._id(), op=op, params=params)
 
-    def move(self, name: str, waypoint: str, reference: str | None = None) -> NodeSpec:
+    def move(
+        self, name: str, waypoint: str, reference: str | None = None, linear: bool = False
+    ) -> NodeSpec:
         params = {"target": Binding.fixed(self.wps[waypoint], ParamType.WAYPOINT)}
         if reference:
             params["reference"] = Binding.reference(reference)
+        if linear:
+            params["mode"] = Binding.fixed("linear", ParamType.TEXT)
         return self.op("motion.move_to", name, **params)
 
     def obj(self, name: str) -> Binding:
@@ -133,6 +177,68 @@ def cup_to_bin_vision() -> PlanSpec:
     )  # fmt: skip
 
 
+def _tending_cycle(m: _Maker) -> NodeSpec:
+    """One part: the arm swings down and back up, pick at the exit, onto the rack."""
+    region = Binding.fixed(ARM_REGION, ParamType.REGION)
+    long = Binding.fixed(600.0, ParamType.DURATION)
+    # Four looks a second see the arm, which stays over the exit for more than a second.
+    period = Binding.fixed(0.25, ParamType.DURATION)
+    return m.node(
+        NodeKind.SEQUENCE, "one part",
+        m.op("occupancy.wait_until_occupied", "wait for the welding arm", region=region,
+             timeout=long, period=period),
+        m.op("occupancy.wait_until_empty", "wait until the arm is back up", region=region,
+             period=period),
+        m.move("over the exit", "over exit"),
+        m.move("down to the part", "at exit", linear=True),
+        m.op("gripper.close", "close on the part"),
+        m.op("gripper.is_holding", "part in the gripper"),
+        m.move("lift the part", "over exit", linear=True),
+        m.op("gripper.is_holding", "part still held"),
+        m.move("over the rack", "over rack", "RACK_POSE"),
+        m.move("down over the tote", "into rack", "RACK_POSE", linear=True),
+        m.op("gripper.open", "let go into the tote"),
+        m.move("up from the rack", "over rack", "RACK_POSE", linear=True),
+        m.move("step out of view", "observe"),
+    )  # fmt: skip
+
+
+def tending_paper() -> PlanSpec:
+    """The paper's wire-bender tending plan: no error handling but the operator's reset."""
+    m = _Maker("tending_paper", tending_waypoints())
+    operator = m.node(
+        NodeKind.SEQUENCE, "stop and wait for the operator",
+        m.op("gripper.open", "drop what is held"),
+        m.move("step back", "observe"),
+        m.op("collaboration.wait_for_button", "operator resets the cell, presses Continue"),
+    )  # fmt: skip
+    tree = m.node(
+        NodeKind.SEQUENCE, "tend the wire bender",
+        m.move("step out of view", "observe"),
+        m.op("markers.detect_markers", "find the rack"),
+        m.op("markers.object_pose", "pose of RACK", object=m.obj("tending_rack"),
+             pose=Binding.reference("RACK_POSE")),
+        m.node(NodeKind.ITERATOR, "every part",
+               m.node(NodeKind.SELECTOR, "part or operator", _tending_cycle(m), operator)),
+    )  # fmt: skip
+    return PlanSpec(
+        tree, "Wire-bender tending, the paper's plan (section V-B, simulated cell)",
+        "The paper's deployment at Marlin Steel on the 'tending' scene: the rack is found by "
+        "its marker once; for each part the robot waits until the bender's welding arm swings "
+        "into an occupancy region and back out, picks the wireform at the exit with one taught "
+        "waypoint, checks it is held before and after lifting, and drops it into the rack's "
+        "tote. On any "
+        "failure (a bad weld, a slipping grasp, a part not there) it drops what it holds, steps "
+        "back and waits for the operator's Continue while the bender keeps producing. Runs until "
+        "stopped. It is taught on the simulated scene tending, which the simulated cell opens "
+        "for it. Run it with: costar run example:tending_paper.",
+        RunPolicy.ONCE, waypoints=tending_waypoints(), objects=["tending_rack"],
+        reset_cell=True,  # each run in the Instructor starts from the scene's seed
+        scene="tending",
+        id=uuid.uuid5(_NAMESPACE, "tending_paper").hex,
+    )  # fmt: skip
+
+
 def main() -> None:
     path = HERE / "cup_to_bin.costar.json"
     save_plan(cup_to_bin(), path)
@@ -141,6 +247,10 @@ def main() -> None:
     vision = HERE / "cup_to_bin_vision.costar.json"
     save_plan(cup_to_bin_vision(), vision)
     print(f"wrote {vision.name}")
+    tending = HERE / "tending_paper.costar.json"
+    save_plan(tending_paper(), tending)
+    WaypointLibrary(tending_waypoints()).save(waypoints_path_for(tending))
+    print(f"wrote {tending.name} and its waypoints")
 
 
 if __name__ == "__main__":

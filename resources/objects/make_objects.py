@@ -7,9 +7,11 @@ frame at the bottom centre, z up. The output is byte for byte reproducible; run
     python resources/objects/make_objects.py --check    # exit 1 if a file differs
 
 Needs numpy only. Objects: the paper's cup and waste bin (transport task) and the kitting
-task's metal plates with 3, 4 and 8 holes and the kit bin. Grasps are taught here, once per
-model, relative to the object: the cup's for the gripper, the plates' for the suction tool. Marker ids (DICT_4X4_50): cup 1-2,
-waste bin 10-15, kit bin 20-25; scenes use 40-49 for fixed markers.
+task's metal plates with 3, 4 and 8 holes and the kit bin; the tending task's 2D wire bender
+(its welding arm is a model of its own), two wireforms and the mobile rack. Grasps are taught
+here, once per model, relative to the object: the cup's and the wireforms' for the gripper,
+the plates' for the suction tool. Marker ids (DICT_4X4_50): cup 1-2, waste bin 10-15, kit
+bin 20-25, wire bender 30-31, rack 32-33; scenes use 40-49 for fixed markers.
 """
 
 from __future__ import annotations
@@ -212,9 +214,9 @@ def wall_marker(marker_id: int, size: float, normal: Vec, center: Vec) -> dict:
     }
 
 
-def top_marker(marker_id: int, size: float, height: float, x: float = 0.0) -> dict:
+def top_marker(marker_id: int, size: float, height: float, x: float = 0.0, y: float = 0.0) -> dict:
     """A marker lying on a horizontal top face: texture top toward the object's +y."""
-    position = [_r(x), 0.0, _r(height + MARKER_LIFT)]
+    position = [_r(x), _r(y), _r(height + MARKER_LIFT)]
     pose = {"position": position, "orientation": [0.0, 0.0, 0.0, 1.0]}
     return {"id": marker_id, "size": size, "pose": pose}
 
@@ -391,7 +393,177 @@ def all_objects() -> dict[str, tuple[dict, Mesh]]:
             0.010,
             2,
         ),
+        **make_wireforms(),
+        "wire_bender": make_bender(),
+        "bender_arm": make_bender_arm(),
+        "tending_rack": make_rack(),
     }
+
+
+WIRE = 0.008  # m: side of a wireform's (square) wire
+WELD = 0.04  # m: length of the weld bead the gripper's 20 mm pads close on
+
+
+def _bar(x0: float, x1: float, y0: float, y1: float) -> dict:
+    """A straight piece of wire lying on z=0 between corners (x0, y0) and (x1, y1)."""
+    size = [_r(x1 - x0), _r(y1 - y0), WIRE]
+    return {"size": size, "position": [_r((x0 + x1) / 2), _r((y0 + y1) / 2), WIRE / 2]}
+
+
+def make_wireform(
+    name: str, description: str, bars: list[dict], weld: tuple[int, list[list[int]]], yaw: float
+) -> tuple[dict, Mesh]:
+    """A flat 2D wireform of straight wires. ``weld`` is (index of the weld bead among
+    ``bars``, the bars of each piece a bad weld falls apart into); the gripper's grasp closes
+    on the bead, its fingers across the wire (turned by ``yaw`` about z)."""
+    mesh = Mesh()
+    for bar in bars:
+        mesh.box(bar["position"], bar["size"])
+    bead, pieces = weld
+    volumes = [float(np.prod(b["size"])) for b in bars]
+    xs = [b["position"][0] + s * b["size"][0] / 2 for b in bars for s in (-1, 1)]
+    ys = [b["position"][1] + s * b["size"][1] / 2 for b in bars for s in (-1, 1)]
+    assert abs(max(xs) + min(xs)) < 1e-9 and abs(max(ys) + min(ys)) < 1e-9, name
+    c, s = math.cos(yaw / 2), math.sin(yaw / 2)
+    down = [_r(c), _r(-s), 0.0, 0.0]  # DOWN turned by yaw about the tool's z
+    at = bars[bead]["position"]
+    model = _model(
+        name,
+        description,
+        collision={"type": "compound", "boxes": bars},
+        mass=_r(sum(volumes) * STEEL_DENSITY),
+        center_of_mass=[0.0, 0.0, WIRE / 2],
+        dimensions=[_r(max(xs) - min(xs)), _r(max(ys) - min(ys)), WIRE],
+        symmetry={"kind": "none"},
+        markers=[],
+        color=[0.55, 0.57, 0.6, 1.0],
+        weld={"bead": bead, "pieces": pieces},
+        # The fingertips reach 15 mm below the TCP: 2 mm above the table at this height.
+        grasps=[
+            {
+                "name": "weld",
+                "tool": "gripper",
+                "pose": {"position": [at[0], at[1], 0.017], "orientation": down},
+                "approach": {"position": [at[0], at[1], 0.12], "orientation": down},
+            }
+        ],
+    )
+    return model, mesh
+
+
+def make_wireforms() -> dict[str, tuple[dict, Mesh]]:
+    """The two wireforms the bender makes: a U and a step (both welded in the middle)."""
+    w, h = WIRE, WELD / 2
+    u = [
+        _bar(-0.08, -h, -0.045, -0.045 + w), _bar(-h, h, -0.045, -0.045 + w),
+        _bar(h, 0.08, -0.045, -0.045 + w),
+        _bar(-0.08, -0.08 + w, -0.045 + w, 0.045), _bar(0.08 - w, 0.08, -0.045 + w, 0.045),
+    ]  # fmt: skip
+    step = [
+        _bar(-0.075, w / 2, 0.034, 0.034 + w), _bar(-w / 2, w / 2, h, 0.034),
+        _bar(-w / 2, w / 2, -h, h), _bar(-w / 2, w / 2, -0.034, -h),
+        _bar(-w / 2, 0.075, -0.034 - w, -0.034),
+    ]  # fmt: skip
+    return {
+        "wireform_u": make_wireform(
+            "wireform_u", "A U-shaped 2D wireform, 160 x 90 mm of 8 mm wire, welded in the "
+            "middle of its base; no markers.", u, (1, [[0, 3], [2, 4]]), 0.0),
+        "wireform_step": make_wireform(
+            "wireform_step", "A step-shaped 2D wireform, 150 x 84 mm of 8 mm wire, welded in "
+            "the middle of its riser; no markers.", step, (2, [[0, 1], [3, 4]]), math.pi / 2),
+    }  # fmt: skip
+
+
+def make_bender() -> tuple[dict, Mesh]:
+    """The 2D wire bender: a cabinet whose front (+x) faces the exit where parts land, with a
+    welding arm hinged on its front top edge (``welding_arm``: the pivot, the arm's pitch at
+    rest and when it releases a part, rad about the bender's y) and the exit (``exit``: where
+    a released part lands, in the bender frame)."""
+    size = (0.20, 0.28, 0.22)
+    mesh = Mesh()
+    mesh.box((0.0, 0.0, size[2] / 2), size)
+    model = _model(
+        "wire_bender",
+        "2D wire bender (no communication port). Marker 30 on its front, 31 on its top (to the "
+        "side: the resting welding arm hides the middle of the top from above the robot).",
+        collision={"type": "box", "size": list(size)},
+        mass=120.0,
+        dimensions=list(size),
+        symmetry={"kind": "none"},
+        markers=[
+            wall_marker(30, 0.08, (1, 0, 0), (0.1, 0.0, 0.12)),
+            top_marker(31, 0.07, size[2], -0.04, -0.075),
+        ],
+        color=[0.33, 0.42, 0.36, 1.0],
+        welding_arm={
+            "model": "bender_arm",
+            "pivot": [0.1, 0.0, size[2]],
+            "rest_pitch": _r(-math.pi / 2),
+            "release_pitch": 0.0,
+        },
+        exit={"position": [0.25, 0.0], "drop_height": 0.03},
+    )
+    return model, mesh
+
+
+def make_bender_arm() -> tuple[dict, Mesh]:
+    """The bender's welding arm: a bar from its hinge (the object frame) along +x."""
+    size = (0.16, 0.03, 0.03)
+    center = (0.08, 0.0, 0.015)
+    mesh = Mesh()
+    mesh.box(center, size)
+    model = _model(
+        "bender_arm",
+        "The wire bender's welding arm; the bender swings it about its hinge (this frame).",
+        collision={"type": "box", "size": list(size), "position": list(center)},
+        mass=4.0,
+        center_of_mass=list(center),
+        dimensions=list(size),
+        symmetry={"kind": "none"},
+        markers=[],
+        color=[0.85, 0.55, 0.1, 1.0],
+    )
+    return model, mesh
+
+
+def make_rack() -> tuple[dict, Mesh]:
+    """The mobile rack's top: a ledge at -x carrying marker 32 on its top and 33 on its end,
+    and an open tote the wireforms are dropped into (they pile up there, as on a cart)."""
+    length, width, height, ledge = 0.32, 0.24, 0.08, 0.08
+    tote = length - ledge
+    parts = []
+    for p in open_box_parts(tote, width, height, 0.006, 0.006):  # the tote, moved to +x
+        x, y, z = p["position"]
+        parts.append(
+            {"size": [_r(v) for v in p["size"]], "position": [_r(x + ledge / 2), _r(y), _r(z)]}
+        )
+    parts.append(
+        {"size": [ledge, width, height], "position": [_r((ledge - length) / 2), 0.0, height / 2]}
+    )
+    mesh = Mesh()
+    for part in parts:
+        mesh.box(part["position"], part["size"])
+    end = -length / 2
+    model = _model(
+        "tending_rack",
+        "Top of the mobile rack of the tending task: a ledge at -x with marker 32 on its top "
+        "and 33 on its end, and an open tote (+x) the wireforms are dropped into.",
+        collision={"type": "compound", "boxes": parts},
+        mass=15.0,
+        dimensions=[length, width, height],
+        symmetry={"kind": "none"},
+        markers=[
+            top_marker(32, 0.07, height, _r(end + ledge / 2)),
+            wall_marker(33, 0.05, (-1, 0, 0), (end, 0.0, height / 2)),
+        ],
+        color=[0.3, 0.3, 0.34, 1.0],
+        tote={
+            "center": [_r(ledge / 2), 0.0],
+            "inner": [_r(tote - 0.012), _r(width - 0.012)],
+            "floor": 0.006,
+        },
+    )
+    return model, mesh
 
 
 def _json_text(data: dict) -> str:

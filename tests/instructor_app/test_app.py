@@ -59,3 +59,11 @@ def test_bad_arguments_and_unreadable_plans_exit_2(qapp: Any, tmp_path: Path) ->
     assert not png.exists()
     missing = tmp_path / "missing.costar.json"
     assert main([str(missing), "--cell", "none", "--screenshot", str(png)]) == EXIT_BAD_INPUT
+
+
+def test_scene_chooses_the_simulated_cells_scene(qapp: Any, tmp_path: Path, capsys: Any) -> None:
+    png = tmp_path / "scene.png"
+    assert main(["--scene", "tending", "--size", "400x300", "--screenshot", str(png)]) == EXIT_OK
+    assert "error" not in capsys.readouterr().err
+    assert main(["--scene", "no_such_scene", "--size", "400x300", "--screenshot", str(png)]) == EXIT_OK
+    assert "no_such_scene" in capsys.readouterr().err  # the cell failed on that scene

@@ -72,12 +72,16 @@ def test_cell_examples_are_reproduced_by_their_generator() -> None:
     assert dump_plan(module.cup_to_bin()) == plan_path.read_text(encoding="utf-8")
     stored = WaypointLibrary.load(waypoints_path_for(plan_path))
     assert list(stored) == module.waypoints()
+    tending = EXAMPLES / "tending_paper.costar.json"
+    assert dump_plan(module.tending_paper()) == tending.read_text(encoding="utf-8")
+    assert list(WaypointLibrary.load(waypoints_path_for(tending))) == module.tending_waypoints()
 
 
-def test_cell_examples_validate_on_the_sim_cell_interfaces() -> None:
+@pytest.mark.parametrize("name", ["cup_to_bin", "tending_paper"])
+def test_cell_examples_validate_on_the_sim_cell_interfaces(name: str) -> None:
     """Validated against the registry of a cell with the simulated cell's interfaces."""
     registry = CapabilityRegistry(cell=_InterfacesOnly())
-    plan = load_plan(EXAMPLES / "cup_to_bin.costar.json", aliases=registry.aliases())
+    plan = load_plan(EXAMPLES / f"{name}.costar.json", aliases=registry.aliases())
     problems = validate_plan(plan, registry)
     assert not has_errors(problems), problems
 
@@ -89,7 +93,7 @@ class _InterfacesOnly:
 
     def interfaces(self) -> dict[str, object]:
         names = ("arm", "gripper", "suction", "freedrive", "rgbd:shoulder", "rgbd:wrist", "world",
-                 "workers", "scene_layout", "objects")  # fmt: skip
+                 "workers", "scene_layout", "objects", "operator")  # fmt: skip
         return {name: object() for name in names}
 
     def clock(self) -> float:

@@ -27,7 +27,10 @@ from capabilities.sim.scene_spec import SceneFileError, read_scene
 from engine.types import Pose
 
 SCENES = ("empty", "cup_to_bin", "kitting")
-MODELS = ("cup", "kit_bin", "plate_3_holes", "plate_4_holes", "plate_8_holes", "waste_bin")
+MODELS = (
+    "bender_arm", "cup", "kit_bin", "plate_3_holes", "plate_4_holes", "plate_8_holes",
+    "tending_rack", "waste_bin", "wire_bender", "wireform_step", "wireform_u",
+)  # fmt: skip
 
 
 @pytest.fixture
