@@ -5,7 +5,7 @@ BehaviorTree.CPP's SubTree node does with port remapping: when it starts, each d
 is copied into the instance's own scope (from its fixed value, or from the name it is bound to
 outside); when the inside succeeds, each declared output bound to an outside name is copied
 out. Every other name inside lives in the instance's scope, so two instances of one subtree
-never write each other's values; the subtree's ``shared`` names are the ones that cross on
+never write each other's values; the subtree's ``shared_names`` are the ones that cross on
 purpose.
 
 The scope is a prefix on the one blackboard of the tree (``Transfer 4-hole#ab12cd/PICK``), so
@@ -112,7 +112,7 @@ class Scope:
         return Scope(
             ids=f"{self.node_id(instance.id)}/",
             names=f"{self.names}{label}#{instance.id[:6]}/",
-            shared=frozenset(subtree.shared),
+            shared=frozenset(subtree.shared_names),
             outer=self,
             stack=(*self.stack, subtree.ref),
         )

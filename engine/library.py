@@ -4,7 +4,7 @@ One versioned JSON file per subtree (``<folder>/<sub/folders>/<Name>.subtree.jso
 
     {"format": "costar-subtree", "format_version": 1, "id": ..., "name": ..., "version": 3,
      "date": "2026-11-24T19:40:00Z", "description": ..., "inputs": [...], "outputs": [...],
-     "shared": [...], "tree": {...}, "layout": {"nodes": {...}}}
+     "shared_names": [...], "tree": {...}, "layout": {"nodes": {...}}}
 
 Files are read with the one JSON reader and written atomically (a temporary file, then a
 rename), so a reader never sees half a file, whether on a network folder or in a git checkout.

@@ -47,7 +47,7 @@ TOP_FIELDS += ("subtrees",)
 NODE_FIELDS = ("id", "kind", "name", "op", "params", "children", "subtree")
 # A subtree definition: embedded in a plan's "subtrees", or the body of a library file.
 SUBTREE_FIELDS: tuple[str, ...] = ("id", "name", "version", "date", "description")
-SUBTREE_FIELDS += ("inputs", "outputs", "shared", "tree", "layout")
+SUBTREE_FIELDS += ("inputs", "outputs", "shared_names", "tree", "layout")
 NODE_FIELDS_V1 = ("id", "kind", "name", "op", "params", "config", "children")
 
 

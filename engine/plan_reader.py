@@ -137,10 +137,10 @@ class _Reader:
         outputs = self.ports(obj.get("outputs", []), at(path, "outputs"), with_default=False)
         shared: list[str] = []
         for index, name in enumerate(
-            self.items(obj.get("shared", []), at(path, "shared"), "names")
+            self.items(obj.get("shared_names", []), at(path, "shared_names"), "names")
         ):
-            self.unique(name, shared, at(at(path, "shared"), index))
-            shared.append(self.text(name, at(at(path, "shared"), index), nonempty=True))
+            self.unique(name, shared, at(at(path, "shared_names"), index))
+            shared.append(self.text(name, at(at(path, "shared_names"), index), nonempty=True))
         return SubtreeSpec(
             id=self.text(obj["id"], at(path, "id"), nonempty=True),
             name=self.text(obj["name"], at(path, "name"), nonempty=True),
@@ -150,7 +150,7 @@ class _Reader:
             description=self.text(obj.get("description", ""), at(path, "description")),
             inputs=inputs,
             outputs=outputs,
-            shared=shared,
+            shared_names=shared,
             layout=self.layout(obj.get("layout", {"nodes": {}}), at(path, "layout")),
         )
 

@@ -108,7 +108,7 @@ def encode_subtree(subtree: SubtreeSpec) -> dict[str, Any]:
         "description": subtree.description,
         "inputs": [_encode_port(port) for port in subtree.inputs],
         "outputs": [_encode_port(port) for port in subtree.outputs],
-        "shared": list(subtree.shared),
+        "shared_names": list(subtree.shared_names),
         "tree": _encode_node(subtree.tree, 1),
         "layout": {"nodes": _encode_layout(subtree.tree, subtree.layout)},
     }

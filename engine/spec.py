@@ -202,7 +202,7 @@ class SubtreeSpec:
 
     Inside ``tree``, an input is read by reference to its name; a declared output is a name a
     query inside writes. Every other name the tree reads or writes is private to each
-    instance (its own scope), except the names in ``shared``, which cross scopes on purpose
+    instance (its own scope), except the names in ``shared_names``, which cross scopes on purpose
     (they are the same name in the plan that holds the instance).
 
     Attributes:
@@ -214,7 +214,7 @@ class SubtreeSpec:
         tree: the subtree's nodes.
         inputs: declared inputs, in binding-form order.
         outputs: declared outputs.
-        shared: names that cross scopes on purpose.
+        shared_names: names that cross scopes on purpose.
         layout: canvas positions of the nodes inside (the engine ignores it).
     """
 
@@ -226,7 +226,7 @@ class SubtreeSpec:
     description: str = ""
     inputs: list[SubtreePort] = field(default_factory=list)
     outputs: list[SubtreePort] = field(default_factory=list)
-    shared: list[str] = field(default_factory=list)
+    shared_names: list[str] = field(default_factory=list)
     layout: dict[str, NodeLayout] = field(default_factory=dict)
 
     @property

@@ -3,7 +3,7 @@
 An instance's bindings are checked like an operation's ports (its manifest is built from the
 subtree's declared inputs and outputs); the inside is checked as a tree of its own whose
 inputs and shared names are given, and its problems are reported at the instance's path.
-A name that crosses scopes (a subtree's ``shared`` name) written inside an instance and also
+A name that crosses scopes (a subtree's ``shared_names``) written inside an instance and also
 by another instance or by the plan is a collision: reported, since each overwrites the other.
 """
 
@@ -83,7 +83,7 @@ def check_instance(
 
 def _check_definition(check: Check, node: NodeSpec, subtree: SubtreeSpec) -> None:
     declared = {p.name for p in [*subtree.inputs, *subtree.outputs]}
-    for name in subtree.shared:
+    for name in subtree.shared_names:
         if name in declared:
             check.add(
                 ERROR,
@@ -104,7 +104,7 @@ def _check_inside(
 ) -> None:
     """The inside, checked as a tree of its own, its problems reported at the instance."""
     given: dict[str, tuple[ParamType, ...]] = {p.name: (ParamType(p.type),) for p in subtree.inputs}
-    for name in subtree.shared:
+    for name in subtree.shared_names:
         given.setdefault(name, (ParamType.ANY,))
     inner = PlanSpec(tree=subtree.tree, name=subtree.name, subtrees=check.plan.subtrees)
     problems = validate(inner, check.source, library, given=given, stack=stack)
@@ -151,11 +151,11 @@ def inner_writes(subtree: SubtreeSpec, check: Check) -> dict[str, tuple[ParamTyp
 def _add_crossings(check: Check, node: NodeSpec, subtree: SubtreeSpec) -> None:
     """Shared names: writes inside count in this scope; reads inside need a writer here."""
     written = inner_writes(subtree, check)
-    for name in subtree.shared:
+    for name in subtree.shared_names:
         if name in written:
             writer = Writer(repr(node.label), written[name], node, crossing=True)
             check.writers.setdefault(name, []).append(writer)
-    reads = [name for name in subtree.shared if name not in written]
+    reads = [name for name in subtree.shared_names if name not in written]
     check.crossing_reads[id(node)] = tuple(reads)
 
 

@@ -234,7 +234,7 @@ def detach(plan: PlanSpec, instance: NodeSpec) -> NodeSpec:
                 node.params[port_name] = values[name]
             elif name in renames:
                 node.params[port_name] = Binding.reference(renames[name])
-            elif name not in subtree.shared:
+            elif name not in subtree.shared_names:
                 renames[name] = _free_name(name, used)
                 used.add(renames[name])
                 node.params[port_name] = Binding.reference(renames[name])

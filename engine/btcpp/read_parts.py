@@ -128,7 +128,7 @@ class ReaderBase:
             shared = json.loads(attrs.get("_shared", "[]"))
             if not isinstance(shared, list) or not all(isinstance(s, str) for s in shared):
                 raise ValueError
-            sub.shared = shared
+            sub.shared_names = shared
         except ValueError:
             self.problem(
                 element.line, "_version a whole number, _shared a JSON list of names", "other"

@@ -251,7 +251,7 @@ class _Reader(ReaderBase):
         node = NodeSpec(NodeKind.SUBTREE, subtree=sub.ref)
         for port, text in self._ports(element).items():
             spec = sub.port(port)
-            if spec is None and port in sub.shared and text == "{" + port + "}":
+            if spec is None and port in sub.shared_names and text == "{" + port + "}":
                 continue
             if text == UNUSED_OUTPUT and spec in sub.outputs:
                 continue

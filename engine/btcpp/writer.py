@@ -157,7 +157,7 @@ class _Writer:
                 "_version": str(sub.version),
                 "_date": sub.date,
                 "_description": sub.description,
-                "_shared": json.dumps(sub.shared, ensure_ascii=False),
+                "_shared": json.dumps(sub.shared_names, ensure_ascii=False),
             },
         )
         element.append(self._node(sub.tree, sub.layout, f"{sub.name}:{sub.tree.label}"))
@@ -253,7 +253,7 @@ class _Writer:
         self._bindings(node, self.models[tree_id], attrs, path)
         for port in sub.outputs:  # BehaviorTree.CPP wants every port remapped: a sink
             attrs.setdefault(encode_port(port.name), UNUSED_OUTPUT)
-        for name in sub.shared:  # crosses the scope on purpose: remapped to itself
+        for name in sub.shared_names:  # crosses the scope on purpose: remapped to itself
             attrs.setdefault(name, "{" + name + "}")
         return "SubTree"
 

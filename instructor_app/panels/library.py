@@ -74,8 +74,8 @@ def preview_html(subtree: SubtreeSpec, folder: str = "", shipped: bool = False) 
         + _ports("Inputs", subtree.inputs)
         + _ports("Outputs", subtree.outputs)
         + (
-            f"<p>Shared names: {html.escape(', '.join(subtree.shared))}</p>"
-            if subtree.shared
+            f"<p>Shared names: {html.escape(', '.join(subtree.shared_names))}</p>"
+            if subtree.shared_names
             else ""
         )
         + "<p><b>Shape</b></p><p><tt>"

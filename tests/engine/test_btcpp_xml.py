@@ -70,7 +70,7 @@ def _transfer() -> SubtreeSpec:
         description="moves one plate into the bin",
         inputs=[SubtreePort("OBJECT", ParamType.OBJECT, "which plate", ObjectModel("plate_8"))],
         outputs=[SubtreePort("PLACED", ParamType.POSE, "where it went")],
-        shared=["BIN"],
+        shared_names=["BIN"],
         layout={inner.id: NodeLayout(10.5, -3.25, collapsed=True)},
     )
 
@@ -327,7 +327,7 @@ def test_every_field_of_the_spec_is_carried() -> None:
         | {"parameters", "waypoints", "objects", "layout", "id", "subtrees"},
         NodeSpec: {"kind", "name", "id", "op", "params", "children", "subtree"},
         SubtreeSpec: {"id", "name", "tree", "version", "date", "description", "inputs"}
-        | {"outputs", "shared", "layout"},
+        | {"outputs", "shared_names", "layout"},
         SubtreePort: {"name", "type", "doc", "default"},
         NodeLayout: {"x", "y", "collapsed"},
         ParameterDecl: {"name", "type", "value", "doc"},

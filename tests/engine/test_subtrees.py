@@ -39,7 +39,7 @@ def pick_subtree(version: int = 1, shared: tuple[str, ...] = ()) -> SubtreeSpec:
         description="Finds an object.",
         inputs=[SubtreePort("OBJECT", ParamType.TEXT, "what to pick")],
         outputs=[SubtreePort("RESULT", ParamType.ANY, "what was picked")],
-        shared=list(shared),
+        shared_names=list(shared),
     )
 
 

@@ -60,7 +60,9 @@ def test_v1_file_means_what_the_shipped_v2_file_means(path: Path) -> None:
     """The reader turns "config" and timing.wait into the ports and Wait node of format 2."""
     shipped = V2_AT_MIGRATION / path.relative_to(V1)
     if not shipped.exists():
-        shipped = Path(__file__).resolve().parents[2] / "resources" / "examples" / path.relative_to(V1)
+        shipped = (
+            Path(__file__).resolve().parents[2] / "resources" / "examples" / path.relative_to(V1)
+        )
     assert '"format_version": 1' in path.read_text(encoding="utf-8")
     assert '"format_version": 2' in shipped.read_text(encoding="utf-8")
     assert load_plan(path) == load_plan(shipped)
