@@ -6,7 +6,9 @@ not need to be rendered there: :class:`LiveView` keeps a mirror of the cell in a
 its own per camera (a pybullet DIRECT client built with the cell's own ``build_world`` and
 ``load_scene``). For each frame the physics thread only takes a :class:`CellSnapshot` (a few
 hundred bytes, some tens of microseconds); the mirror lays it onto its bodies, renders with
-the same :class:`SimCamera` and sends the images back through a pipe.
+the same :class:`SimCamera` and sends the images back through a pipe. The mirror's world is
+the light one (``build_world(light=True)``: a finite floor, the arm drawn with its collision
+meshes), which halves a frame's CPU time; objects, table, markers and tools are the cell's.
 
 Perception does not use this: its images are rendered on the physics thread, exact and
 stamped with simulated time (``SimCameraDevice.capture``). A live frame is stamped with the
@@ -84,7 +86,7 @@ def _serve(conn: Connection) -> None:
         os.nice(NICENESS)
     recipe, name, camera = conn.recv()
     client = p.connect(p.DIRECT)
-    world = build_world(client, recipe.config)
+    world = build_world(client, recipe.config, light=True)
     scene = load_scene(
         client, recipe.scene, recipe.seed, table_top_z=recipe.table_top_z, make_table=False,
         keep_out=recipe.keep_out,

@@ -5,6 +5,14 @@ resolve; at load time a copy with absolute mesh paths, without the URDF's ``worl
 that ``base_link`` is the root pybullet places) and with the primitive gripper of
 ``resources/robots/parallel_gripper.urdf.xml`` fixed to ``tool0``, is written to a cache
 directory. The meshes themselves are never copied.
+
+A *light* variant (``light=True``, for the live view's mirror only: ``live_view.py``) draws
+each UR5 link with the collision mesh example-robot-data ships beside its visual one (a few
+hundred triangles instead of some tens of thousands: pybullet's CPU renderer spent ~28 ms of a
+~50 ms frame on them) in a flat UR grey. The STL files carry no usable normals (pybullet draws
+them black), so each is converted once with Open3D to a Wavefront OBJ with normals, cached
+beside the URDF copy. The physics cell, and so perception, always loads the full visual
+meshes.
 """
 
 from __future__ import annotations
@@ -24,6 +32,9 @@ __all__ = ["ROBOTS_DIR", "find_ur5_urdf", "robot_urdf_path"]
 ROBOTS_DIR = resource_path("robots")
 _UR5_SUFFIX = "example-robot-data/robots/ur_description/urdf/ur5_robot.urdf"
 _PACKAGE_PREFIX = "package://example-robot-data/"
+# A visual mesh of the UR5 (COLLADA, with its own colours), to be replaced in the light variant.
+_VISUAL_MESH = re.compile(r'"[^"]*/meshes/ur5/visual/(\w+)\.dae"\s*/>\s*</geometry>')
+_LIGHT_RGBA = "0.72 0.73 0.75 1"  # the UR's grey
 
 
 def find_ur5_urdf() -> Path:
@@ -53,9 +64,27 @@ def _share_dir(urdf: Path) -> Path:
     return Path(*parts[:index])
 
 
-def build_robot_urdf(urdf: Path, gripper_fragment: str) -> str:
-    """The UR5 URDF text with resolved mesh paths, no world link, and the gripper added."""
+def build_robot_urdf(urdf: Path, gripper_fragment: str, light_meshes: Path | None = None) -> str:
+    """The UR5 URDF text with resolved mesh paths, no world link, and the gripper added.
+
+    Args:
+        urdf: example-robot-data's UR5 URDF.
+        gripper_fragment: the text of ``parallel_gripper.urdf.xml``.
+        light_meshes: the folder of the light meshes (``<link>.obj``) to draw the arm's links
+            with instead of the visual meshes (see the module's text); None for the visual.
+
+    Raises:
+        SimError: the gripper fragment or the URDF is not what this expects.
+    """
     text = urdf.read_text(encoding="utf-8")
+    if light_meshes is not None:
+        light = (
+            f'"{light_meshes.as_posix()}/\\1.obj"/></geometry>'
+            f'<material name="ur5_light_\\1"><color rgba="{_LIGHT_RGBA}"/></material>'
+        )
+        text, count = _VISUAL_MESH.subn(light, text)
+        if count == 0:
+            raise SimError(f"{urdf}: no visual mesh under meshes/ur5/visual/ to lighten")
     text = text.replace(_PACKAGE_PREFIX, f"{_share_dir(urdf).as_posix()}/example-robot-data/")
     text = re.sub(r'<link name="world"\s*/>', "", text)
     text = re.sub(r'<joint name="world_joint".*?</joint>', "", text, flags=re.S)
@@ -67,13 +96,20 @@ def build_robot_urdf(urdf: Path, gripper_fragment: str) -> str:
     return text.replace("</robot>", body.group(1) + "\n</robot>")
 
 
-def robot_urdf_path(cache_dir: Path | None = None) -> Path:
-    """Write (once per content) the resolved robot URDF and return its path."""
+def robot_urdf_path(cache_dir: Path | None = None, light: bool = False) -> Path:
+    """Write (once per content) the resolved robot URDF and return its path.
+
+    Args:
+        cache_dir: where to write it, default ``costar_sim`` in the temporary directory.
+        light: the light variant, for the live view's mirror only (see the module's text).
+    """
     fragment = (ROBOTS_DIR / "parallel_gripper.urdf.xml").read_text(encoding="utf-8")
-    text = build_robot_urdf(find_ur5_urdf(), fragment)
-    digest = hashlib.sha1(text.encode("utf-8")).hexdigest()[:12]
     folder = cache_dir or Path(tempfile.gettempdir()) / "costar_sim"
     folder.mkdir(parents=True, exist_ok=True)
+    urdf = find_ur5_urdf()
+    meshes = _light_meshes(urdf, folder / "ur5_light_meshes") if light else None
+    text = build_robot_urdf(urdf, fragment, meshes)
+    digest = hashlib.sha1(text.encode("utf-8")).hexdigest()[:12]
     path = folder / f"ur5_gripper_{digest}.urdf"
     if not path.is_file():
         # Written atomically: several cells (test workers) may build it at the same time.
@@ -82,3 +118,24 @@ def robot_urdf_path(cache_dir: Path | None = None) -> Path:
             handle.write(text)
         os.replace(tmp, path)
     return path
+
+
+def _light_meshes(urdf: Path, folder: Path) -> Path:
+    """Convert (once) each UR5 collision mesh to an OBJ with normals in ``folder``."""
+    folder.mkdir(parents=True, exist_ok=True)
+    for stl in sorted((urdf.parent.parent / "meshes" / "ur5" / "collision").glob("*.stl")):
+        target = folder / f"{stl.stem}.obj"
+        if target.is_file():
+            continue
+        import open3d  # only here: the physics cell never needs it
+
+        mesh = open3d.io.read_triangle_mesh(stl)
+        if len(mesh.triangles) == 0:
+            raise SimError(f"{stl}: no triangles read")
+        mesh.compute_vertex_normals()
+        mesh.triangle_normals = open3d.utility.Vector3dVector()  # OBJ keeps vertex normals
+        # Written under another name, then renamed: two mirrors may convert at the same time.
+        tmp = folder / f"{stl.stem}.{os.getpid()}.tmp.obj"
+        open3d.io.write_triangle_mesh(tmp, mesh, write_vertex_normals=True)
+        os.replace(tmp, target)
+    return folder

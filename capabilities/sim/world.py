@@ -4,6 +4,11 @@ holster and suction tool.
 Layout (default config): the world frame's origin is the UR base, on a stand whose top is
 flush with the table top (z = 0); the table (0.8 x 1.2 m) spans x 0.15..0.95 in front of the
 robot; the floor is 0.75 m below. Scene objects are added later by the scene helper.
+
+The live view's mirror (``live_view.py``) builds a *light* world: the same bodies, but the
+floor is a finite slab under what the cameras see instead of pybullet's infinite plane (which
+cost pybullet's CPU renderer ~20 ms a frame) and the robot has its light meshes
+(``robot_model.py``). Only pictures come from it; the cell and perception use the full world.
 """
 
 from __future__ import annotations
@@ -21,6 +26,10 @@ __all__ = ["World", "build_world"]
 # base_link of the URDF is the UR "base" frame turned 180 degrees about z (and back).
 _BASE_LINK_IN_BASE = Pose((0.0, 0.0, 0.0), (0.0, 0.0, 1.0, 0.0))
 _TOOL_IN_HOLSTER = Pose((0.0, 0.0, 0.01))  # the tool's cup tip rests on the 10 mm plate
+# The light world's floor: a slab reaching past everything the cameras see of the floor,
+# coloured like the mean of the white and blue squares the renderer draws on the plane.
+_LIGHT_FLOOR_HALF = (3.0, 3.0, 0.005)
+_LIGHT_FLOOR_RGBA = (0.78, 0.84, 0.95, 1.0)
 
 
 @dataclass(frozen=True)
@@ -57,13 +66,28 @@ def _box(
     )
 
 
-def _static_world(client: int, config: CellConfig) -> tuple[int, int, int]:
-    table = config.table
-    floor_z = table.top_z - table.size[2]
+def _floor(client: int, floor_z: float, light: bool) -> int:
+    if light:  # seen, never touched: the mirror does not step its physics
+        half = _LIGHT_FLOOR_HALF
+        visual = pybullet.createVisualShape(
+            pybullet.GEOM_BOX, halfExtents=half, rgbaColor=_LIGHT_FLOOR_RGBA,
+            physicsClientId=client,
+        )  # fmt: skip
+        return int(
+            pybullet.createMultiBody(
+                0.0, -1, visual, basePosition=(0, 0, floor_z - half[2]), physicsClientId=client
+            )
+        )
     plane = pybullet.createCollisionShape(pybullet.GEOM_PLANE, physicsClientId=client)
-    floor = int(
+    return int(
         pybullet.createMultiBody(0.0, plane, basePosition=(0, 0, floor_z), physicsClientId=client)
     )
+
+
+def _static_world(client: int, config: CellConfig, light: bool) -> tuple[int, int, int]:
+    table = config.table
+    floor_z = table.top_z - table.size[2]
+    floor = _floor(client, floor_z, light)
     half = (table.size[0] / 2, table.size[1] / 2, table.size[2] / 2)
     table_id = _box(
         client,
@@ -78,10 +102,10 @@ def _static_world(client: int, config: CellConfig) -> tuple[int, int, int]:
     return floor, table_id, stand
 
 
-def _load_robot(client: int, config: CellConfig) -> tuple[int, dict[str, int]]:
+def _load_robot(client: int, config: CellConfig, light: bool) -> tuple[int, dict[str, int]]:
     base_link = config.robot_base.compose(_BASE_LINK_IN_BASE)
     robot = pybullet.loadURDF(
-        str(robot_urdf_path()),
+        str(robot_urdf_path(light=light)),
         basePosition=base_link.position,
         baseOrientation=base_link.orientation,
         useFixedBase=True,
@@ -95,11 +119,17 @@ def _load_robot(client: int, config: CellConfig) -> tuple[int, dict[str, int]]:
     return int(robot), joints
 
 
-def build_world(client: int, config: CellConfig) -> World:
-    """Create every fixed body of the cell (physics thread only)."""
+def build_world(client: int, config: CellConfig, light: bool = False) -> World:
+    """Create every fixed body of the cell (on the physics thread, or in a live view mirror).
+
+    Args:
+        client: the pybullet client.
+        config: the cell's configuration.
+        light: the live view mirror's cheaper-to-draw world (see the module's text).
+    """
     pybullet.setGravity(0, 0, -9.81, physicsClientId=client)
-    floor, table, stand = _static_world(client, config)
-    robot, index = _load_robot(client, config)
+    floor, table, stand = _static_world(client, config, light)
+    robot, index = _load_robot(client, config, light)
     arm = tuple(index[name] for name in UR5_JOINT_NAMES)
     for joint, value in zip(arm, config.home_joints, strict=True):
         pybullet.resetJointState(robot, joint, value, physicsClientId=client)

@@ -1,9 +1,14 @@
 """The live view: a mirror of the cell in a process per camera renders what the physics thread
 would render for the same state (the arm moved, an object added and removed), ends with the
-cell and with the cell's process, and a mirror that crashed fails its pictures, not the cell."""
+cell and with the cell's process, and a mirror that crashed fails its pictures, not the cell.
+
+The mirror draws a light world (a finite floor, the arm with its collision meshes): its
+pictures match the physics thread's pixel for pixel everywhere but on the arm and the floor,
+and the arm is where the physics thread draws it (its depth, within a mesh's coarseness)."""
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import signal
 import subprocess
@@ -14,12 +19,16 @@ import time
 from collections.abc import Iterator
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pytest
 
+from capabilities.bullet import pybullet as p
+from capabilities.sim.cameras import _CV_TO_GL, SimCamera
 from capabilities.sim.live_view import LiveViewError
 from capabilities.sim.scene import yaw_pose
 from capabilities.sim.session import SimCameraDevice, SimCellSession
+from capabilities.sim.transforms import pose_to_matrix
 
 SIZE = (320, 240)
 
@@ -49,15 +58,46 @@ def _rendered(cell: SimCellSession, name: str) -> SimCameraDevice:
     return device
 
 
+def _body_ids(cell: SimCellSession, device: SimCameraDevice) -> np.ndarray:
+    """Which body each pixel of the physics thread's picture shows (-1: none)."""
+    config = dataclasses.replace(device.camera.config, width=SIZE[0], height=SIZE[1])
+    camera = SimCamera(device.name, config, device.camera.mount)
+
+    def render(client: int) -> np.ndarray:
+        view = np.linalg.inv(pose_to_matrix(camera.pose(client)) @ _CV_TO_GL)
+        projection = p.computeProjectionMatrixFOV(
+            np.degrees(config.fov_y), SIZE[0] / SIZE[1], config.near, config.far
+        )
+        seg = p.getCameraImage(
+            SIZE[0], SIZE[1], viewMatrix=view.T.ravel().tolist(), projectionMatrix=projection,
+            renderer=p.ER_TINY_RENDERER, physicsClientId=client,
+        )[4]  # fmt: skip
+        return np.asarray(seg, dtype=np.int64).reshape(SIZE[1], SIZE[0])
+
+    return cell.sim.call(render)
+
+
 def _assert_same_picture(cell: SimCellSession, camera: str) -> None:
     device = _rendered(cell, camera)
     live, exact = device.preview(SIZE), device.capture(SIZE)
     assert live.rgb.shape == exact.rgb.shape == (240, 320, 3)
-    rgb_difference = np.abs(live.rgb.astype(int) - exact.rgb.astype(int)).mean()
+    world = cell.sim.world
+    bodies = _body_ids(cell, device)
+    robot = bodies == world.robot
+    # The light arm's meshes are a few millimetres off the detailed ones: a 3-pixel margin
+    # around the arm and the floor (and the background the floor's edge may show) is left out.
+    lighter = robot | (bodies == world.floor) | (bodies < 0)
+    lighter = cv2.dilate(lighter.astype(np.uint8), np.ones((7, 7), np.uint8)) > 0
+    same = ~lighter
+    assert same.mean() > 0.15, f"{camera}: too little of the picture to compare"
+    rgb_difference = np.abs(live.rgb[same].astype(int) - exact.rgb[same].astype(int)).mean()
     assert rgb_difference < 1.0, f"{camera}: mean colour difference {rgb_difference:.2f}"
-    both = np.isfinite(live.depth) & np.isfinite(exact.depth)
-    assert both.mean() > 0.5
+    both = same & np.isfinite(live.depth) & np.isfinite(exact.depth)
+    assert both.mean() > 0.15
     assert np.median(np.abs(live.depth[both] - exact.depth[both])) < 1e-3
+    arm = robot & np.isfinite(live.depth) & np.isfinite(exact.depth)
+    if arm.sum() > 50:  # the arm, where it is seen, is where the physics thread has it
+        assert np.median(np.abs(live.depth[arm] - exact.depth[arm])) < 0.01
     np.testing.assert_allclose(live.K, exact.K)
     assert live.T_world_camera == exact.T_world_camera  # what the cell believes, on both
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pybullet
@@ -89,3 +90,28 @@ def test_robot_urdf_has_resolved_meshes_and_the_gripper() -> None:
     assert "package://" not in text
     assert 'name="world"' not in text
     assert "gripper_body" in text
+
+
+def test_the_light_robot_draws_its_links_with_converted_collision_meshes(tmp_path: Path) -> None:
+    """The live view's light variant: every visual mesh replaced, joints and links the same."""
+    full = robot_urdf_path(tmp_path)
+    light = robot_urdf_path(tmp_path, light=True)
+    assert light != full and ".dae" in full.read_text() and ".dae" not in light.read_text()
+    meshes = sorted((tmp_path / "ur5_light_meshes").glob("*.obj"))
+    assert [m.stem for m in meshes] == sorted(
+        ["base", "shoulder", "upperarm", "forearm", "wrist1", "wrist2", "wrist3"]
+    )
+    assert all("\nvn " in m.read_text() for m in meshes)  # normals: not drawn black
+    client = pybullet.connect(pybullet.DIRECT)
+    try:
+        bodies = [pybullet.loadURDF(str(u), physicsClientId=client) for u in (full, light)]
+        joints = [
+            [pybullet.getJointInfo(b, i, physicsClientId=client)[1] for i in range(
+                pybullet.getNumJoints(b, physicsClientId=client))]
+            for b in bodies
+        ]  # fmt: skip
+        assert joints[0] == joints[1]
+        shapes = pybullet.getVisualShapeData(bodies[1], physicsClientId=client)
+        assert sum(s[4].endswith(b".obj") for s in shapes) == 7
+    finally:
+        pybullet.disconnect(client)
