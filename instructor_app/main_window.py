@@ -347,6 +347,7 @@ class MainWindow(QMainWindow):
     def _wire_run(self) -> None:
         controller, views = self.controller, self.views
         controller.statuses_changed.connect(views.canvas.set_statuses)
+        controller.failures_described.connect(views.canvas.set_failure_tips)
         controller.inner_statuses_changed.connect(views.inside.set_statuses)
         controller.blackboard_written.connect(views.blackboard.set_value)
         controller.log_message.connect(views.log.append)

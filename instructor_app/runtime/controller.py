@@ -15,13 +15,14 @@ from dataclasses import dataclass
 from PySide6.QtCore import QObject, QTimer, Signal
 
 from engine.build import BuildError, build_tree
+from engine.error_types import ErrorType
 from engine.events import RunFinished
 from engine.executor import Executor, ExecutorState
 from engine.spec import PlanSpec
 from engine.status import Status
 from engine.validation import ERROR, Problem, has_errors, validate_plan
 from instructor_app.document.editing import PlanDocument
-from instructor_app.runtime.pump import Batch, EventPump
+from instructor_app.runtime.pump import Batch, EventPump, failure_text
 from instructor_app.runtime.session import CellSession
 
 __all__ = ["RunController", "RunOutcome"]
@@ -66,6 +67,7 @@ class RunController(QObject):
         run_finished(object): a :class:`RunOutcome`.
         run_refused(list): the validation problems (or a build error) that kept it from starting.
         failure_changed(str, str): the deepest failing node and its message ("" "": none).
+        failures_described(object): node id -> "error type: message" of the nodes that failed.
         inner_statuses_changed(object): runtime id ("instance/inner") -> Status inside subtree
             instances; None when a new run starts.
     """
@@ -81,6 +83,7 @@ class RunController(QObject):
     # runtime id ("instance/inner") -> Status of nodes inside subtree instances; None: a new run
     inner_statuses_changed = Signal(object)
     failure_changed = Signal(str, str)
+    failures_described = Signal(object)
 
     def __init__(
         self,
@@ -264,10 +267,17 @@ class RunController(QObject):
                 self.log_message.emit("The robot is ready again: the run goes on", "info")
         for node_id, message in batch.logs:
             self.log_message.emit(f"{self._label(node_id)}: {message}", "info")
-        for node_id, message in batch.failures:
+        described: dict[str, str] = {}
+        for node_id, message, error in batch.failures:
             if node_id in self._order:
-                text = f"{self._label(node_id)} failed" + (f": {message}" if message else "")
+                described[node_id] = failure_text(error, message)
+                if batch.statuses.get(node_id) is Status.FAILURE:  # the failure panel shows it
+                    self._messages[node_id] = described[node_id]
+                kind = f" ({error})" if error and error != ErrorType.FAILED.value else ""
+                text = f"{self._label(node_id)} failed{kind}" + (f": {message}" if message else "")
                 self.log_message.emit(text, "error")
+        if described:
+            self.failures_described.emit(described)
 
     def _update_running(self) -> None:
         running = sorted(
