@@ -109,3 +109,20 @@ def test_parse_error_types() -> None:
         parse_error_types("grasp_failed, dropped")
     with pytest.raises(ValueError, match="at least one"):
         parse_error_types(" , ")
+
+
+def test_the_executor_reports_the_type_with_the_failure(registry: Any) -> None:
+    from bt_fakes import Recorder, logic, op, plan
+
+    from engine.build import build_tree
+    from engine.executor import run_to_end
+    from engine.spec import NodeKind
+
+    spec = plan(logic(NodeKind.SEQUENCE, op("debug.fail", "look", error="not_found")))
+    tree = build_tree(spec, registry)
+    recorder = Recorder()
+    run_to_end(tree, 200.0, timeout=5.0, listeners=[recorder])
+    failed = [e for e in recorder.of(StatusChanged) if e.new is FAILURE]
+    assert failed and {e.error for e in failed} == {"not_found"}  # the leaf and its parents
+    others = [e for e in recorder.of(StatusChanged) if e.new is not FAILURE]
+    assert all(e.error == "" for e in others)
