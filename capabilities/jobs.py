@@ -12,6 +12,8 @@ from collections.abc import Callable, Mapping
 from concurrent.futures import Future, ThreadPoolExecutor
 from typing import Any, Protocol
 
+from capabilities.faults import fault_error
+from engine.error_types import ErrorType
 from engine.operations import Job, OperationFailed
 
 __all__ = ["CommandHandleLike", "job_from_handle", "WorkerPool", "chain_jobs"]
@@ -52,7 +54,7 @@ def job_from_handle(
                 job.fail(f"{describe}: {type(exc).__name__}: {exc}" if describe else str(exc))
         else:
             text = handle.message or "failed"
-            job.fail(f"{describe}: {text}" if describe else text)
+            job.fail(f"{describe}: {text}" if describe else text, fault_error(text))
 
     handle.add_done_callback(finished)
     return job
@@ -78,10 +80,10 @@ class WorkerPool:
             try:
                 outputs = fn()
             except OperationFailed as exc:
-                job.fail(str(exc))
+                job.fail(str(exc), exc.error)
             except Exception as exc:  # a perception bug fails the node, never the engine
                 prefix = f"{describe}: " if describe else ""
-                job.fail(f"{prefix}{type(exc).__name__}: {exc}")
+                job.fail(f"{prefix}{type(exc).__name__}: {exc}", ErrorType.ERROR)
             else:
                 if not cancelled.is_set():
                     job.succeed(outputs=outputs or None)
@@ -129,6 +131,7 @@ class _ChainJob(Job):
                     self._current = make()
                 except Exception as exc:
                     self.message = f"{self._step_name}: {exc}"
+                    self.error = exc.error if isinstance(exc, OperationFailed) else ErrorType.ERROR
                     return FAILURE
                 if self._on_done is not None:
                     self._current.bind_wake(self._on_done)
@@ -137,6 +140,7 @@ class _ChainJob(Job):
                 return RUNNING
             if status is FAILURE:
                 self.message = f"{self._step_name}: {self._current.message}"
+                self.error = self._current.error  # a protective stop mid-chain stays one
                 return FAILURE
             self.outputs.update(self._current.outputs)
             self._current = None

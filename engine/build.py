@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from engine.blackboard import Blackboard, BlackboardError
+from engine.catch import Catch
 from engine.composites import (
     Parallel,
     ParallelPolicy,
@@ -30,6 +31,7 @@ from engine.decorators import (
     Retry,
     Timeout,
 )
+from engine.error_types import parse_error_types
 from engine.errors import EngineError
 from engine.instances import ROOT_SCOPE, InputCopy, Scope, SubtreeInstance
 from engine.kinds import settings_of
@@ -95,6 +97,9 @@ def _logic_node(spec: NodeSpec, ctx: TreeContext, node_id: str) -> Node:
         NodeKind.RETRY: lambda: Retry(ctx, node_id, label, int(cfg["count"])),
         NodeKind.TIMEOUT: lambda: Timeout(ctx, node_id, label, float(cfg["seconds"])),
         NodeKind.WAIT: lambda: Wait(ctx, node_id, label, float(cfg["seconds"])),
+        NodeKind.CATCH: lambda: Catch(
+            ctx, node_id, label, parse_error_types(str(cfg["errors"])), str(cfg["error"])
+        ),
     }
     return factories[spec.kind]()
 

@@ -10,6 +10,7 @@ so a child that succeeds at once cannot spin the engine.
 from __future__ import annotations
 
 from engine.context import TreeContext
+from engine.error_types import ErrorType
 from engine.node import Node
 from engine.status import FAILURE, RUNNING, SUCCESS, Status
 
@@ -83,8 +84,7 @@ class ForceFailure(Decorator):
         status = self.children[0].tick()
         if status is RUNNING:
             return RUNNING
-        self.message = "forced failure"
-        return FAILURE
+        return self.fail("forced failure", ErrorType.FAILED)
 
 
 class _Looping(Decorator):
@@ -127,6 +127,8 @@ class _Looping(Decorator):
         if self.timeout is not None and self.ctx.clock() - self._started >= self.timeout:
             child.reset()
             self.message = f"time limit of {self.timeout:g} s reached after {self.done} rounds"
+            if self.on_timeout is FAILURE:
+                self.error = ErrorType.TIMEOUT
             return self.on_timeout
         return RUNNING
 
@@ -205,8 +207,7 @@ class Timeout(Decorator):
         status = child.tick()
         if status is RUNNING and self.ctx.clock() - self._started >= self.seconds:
             child.reset()
-            self.message = f"timed out after {self.seconds:g} s"
-            return FAILURE
+            return self.fail(f"timed out after {self.seconds:g} s", ErrorType.TIMEOUT)
         return status
 
     def on_reset(self) -> None:

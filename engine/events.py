@@ -28,12 +28,15 @@ class RunStarted:
 
 @dataclass(frozen=True, slots=True)
 class StatusChanged:
+    """A node's status changed; ``error`` is the type of a FAILURE (empty otherwise)."""
+
     tick: int
     node_id: str
     old: Status
     new: Status
     message: str
     time: float
+    error: str = ""
 
 
 @dataclass(frozen=True, slots=True)

@@ -30,7 +30,7 @@ from engine.events import (
     StatusChanged,
 )
 from engine.node import Node
-from engine.status import RUNNING, Status
+from engine.status import FAILURE, RUNNING, Status
 from engine.tree import BehaviorTree
 
 __all__ = ["Executor", "ExecutorState", "run_to_end"]
@@ -204,7 +204,8 @@ class Executor:
         clock = time.monotonic
 
         def on_status(node: Node, old: Status, new: Status) -> None:
-            put(StatusChanged(ctx.tick_count, node.id, old, new, node.message, clock()))
+            error = node.error.value if new is FAILURE and node.error is not None else ""
+            put(StatusChanged(ctx.tick_count, node.id, old, new, node.message, clock(), error))
 
         def on_log(node_id: str, message: str) -> None:
             put(LogMessage(ctx.tick_count, node_id, message, clock()))

@@ -14,6 +14,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+from engine.error_types import parse_error_types
 from engine.operations import PortSpec
 from engine.spec import Binding, NodeKind
 from engine.types import ParamType
@@ -58,6 +59,21 @@ KIND_PORTS: dict[NodeKind, tuple[PortSpec, ...]] = {
             choices=POLICY_WORDS["failure"],
         ),
     ),
+    NodeKind.CATCH: (
+        PortSpec(
+            "errors",
+            (_T,),
+            default="any",
+            doc="the error types the handler takes: a comma-separated list, or any",
+        ),
+        PortSpec(
+            "error",
+            (_T,),
+            default="",
+            doc="the name of the parameter that receives the caught error as "
+            "'type: message' (empty: not kept)",
+        ),
+    ),
     NodeKind.ITERATOR: (
         _count("count", "stop with SUCCESS after this many successes (0: no limit)", 0.0),
         _seconds("timeout", "stop with SUCCESS after this many seconds (0: no limit)", 0.0),
@@ -94,6 +110,8 @@ KIND_DOC: dict[NodeKind, str] = {
     "the running child when one turns false.",
     NodeKind.REACTIVE_SELECTOR: "A selector that re-checks its conditions every tick and switches "
     "to a higher-priority child when its condition holds.",
+    NodeKind.CATCH: "Runs its first node; when that fails with a chosen error type, runs its "
+    "second node (the handler) instead of failing.",
     NodeKind.ITERATOR: "Repeats its child while it succeeds.",
     NodeKind.ENFORCE: "Retries its child until it succeeds.",
     NodeKind.INVERTER: "Turns success into failure and back.",
@@ -129,6 +147,8 @@ def setting(kind: NodeKind, name: str, value: str | float) -> Binding:
 def check_setting(kind: NodeKind, name: str, value: Any) -> str | None:
     """None when a fixed value of the right type is also in range, else what was expected."""
     if isinstance(value, str):
+        if kind is NodeKind.CATCH and name == "errors":
+            return _error_list_problem(value)
         return None  # a word: checked against the port's choices
     minimum, whole = _LIMITS.get((kind, name), (0.0, False))
     strict = kind is NodeKind.TIMEOUT  # a time limit of 0 would fail at once
@@ -142,6 +162,15 @@ def check_setting(kind: NodeKind, name: str, value: Any) -> str | None:
     if whole:
         return f"a whole number of at least {minimum:g}"
     return "a number of seconds above 0" if strict else "a number of seconds, 0 or more"
+
+
+def _error_list_problem(text: str) -> str | None:
+    """None when ``text`` names error types (or "any"), else what was expected and why."""
+    try:
+        parse_error_types(text)
+    except ValueError as exc:
+        return f"a comma-separated list of error types, or any ({exc})"
+    return None
 
 
 def settings_of(kind: NodeKind, params: Mapping[str, Binding]) -> dict[str, Any]:
@@ -169,7 +198,12 @@ def settings_of(kind: NodeKind, params: Mapping[str, Binding]) -> dict[str, Any]
         if value is None:
             raise ValueError(f"{kind.value} needs a value for {port.name!r} ({port.doc})")
         expected = check_setting(kind, port.name, value)
-        if expected is None and isinstance(value, str) and value not in port.choices:
+        if (
+            expected is None
+            and isinstance(value, str)
+            and port.choices
+            and value not in port.choices
+        ):
             expected = f"one of {', '.join(port.choices)} or a count"
         if expected is not None:
             shown = f"{value:g}" if isinstance(value, float) else repr(value)

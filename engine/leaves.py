@@ -12,6 +12,7 @@ from typing import Any
 
 from engine.blackboard import MISSING
 from engine.context import TreeContext
+from engine.error_types import ErrorType
 from engine.node import Node
 from engine.operations import (
     Job,
@@ -32,6 +33,11 @@ def _error_text(exc: BaseException) -> str:
     if isinstance(exc, OperationFailed):
         return str(exc)
     return f"{type(exc).__name__}: {exc}"
+
+
+def _error_type(exc: BaseException) -> ErrorType:
+    """An OperationFailed names its type; any other exception is unexpected: ``error``."""
+    return exc.error if isinstance(exc, OperationFailed) else ErrorType.ERROR
 
 
 class OperationLeaf(Node):
@@ -100,7 +106,7 @@ class OperationLeaf(Node):
             try:
                 job = self._start()
             except Exception as exc:  # the operation's fault: FAILURE of this node, never a crash
-                return self.fail(_error_text(exc))
+                return self.fail(_error_text(exc), _error_type(exc))
         try:
             # A plain Job's poll() is its status: read it without the call (the tick path of
             # every operation that answers at once).
@@ -124,8 +130,8 @@ class OperationLeaf(Node):
                 return self._succeeded(job.message)
         except Exception as exc:
             self._job = None
-            return self.fail(_error_text(exc))
-        return self.fail(job.message or ("false" if self.is_condition else "failed"))
+            return self.fail(_error_text(exc), _error_type(exc))
+        return self.fail(job.message or ("false" if self.is_condition else "failed"), job.error)
 
     def _start(self) -> Job:
         call = self._call
@@ -135,7 +141,10 @@ class OperationLeaf(Node):
             for port, key, spec in self._refs:
                 value = board.get(key, MISSING)
                 if value is MISSING:
-                    raise OperationFailed(f"parameter {key!r} (for {port!r}) has no value yet")
+                    raise OperationFailed(
+                        f"parameter {key!r} (for {port!r}) has no value yet",
+                        ErrorType.INVALID_INPUT,
+                    )
                 args[port] = value if spec is None else read_reference(spec, key, value)
             call.args = args
         if self._is_query:

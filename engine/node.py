@@ -15,6 +15,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 
 from engine.context import TreeContext
+from engine.error_types import ErrorType
 from engine.status import FAILURE, IDLE, RUNNING, SUCCESS, Status
 
 __all__ = ["Node"]
@@ -28,6 +29,7 @@ class Node:
         name: the label shown to users.
         status: the last status returned (IDLE after a reset).
         message: why the node failed, or what it is doing; may be empty.
+        error: the type of the node's FAILURE (None while it has not failed).
         children: child nodes in tick order (empty for leaves).
         is_condition: True for predicates (and decorators of them) that reactive
             composites re-check every tick.
@@ -42,6 +44,7 @@ class Node:
         self.name = name or self.kind
         self.status: Status = IDLE
         self.message = ""
+        self.error: ErrorType | None = None
         self.children: tuple[Node, ...] = ()
         self.parent: Node | None = None
 
@@ -57,6 +60,8 @@ class Node:
             return status
         new = self.update()
         if new is not status:
+            if new is FAILURE and self.error is None:
+                self.error = self._child_error()
             self.status = new
             sink = self.ctx.status_sink
             if sink is not None:
@@ -86,6 +91,7 @@ class Node:
                 self.ctx.log(self.id, f"error while halting: {type(exc).__name__}: {exc}")
         self.on_reset()
         self.message = ""
+        self.error = None
         self.status = IDLE
         sink = self.ctx.status_sink
         if sink is not None:
@@ -136,7 +142,22 @@ class Node:
         for child in self.children:
             yield from child.iterate()
 
-    def fail(self, message: str) -> Status:
-        """Set the message and return FAILURE (for ``return self.fail(...)`` in update)."""
+    def fail(self, message: str, error: ErrorType | None = None) -> Status:
+        """Set the message and error type and return FAILURE (``return self.fail(...)``).
+
+        ``error`` None: the type of the failed child, else ``failed`` (see :meth:`tick`).
+        """
         self.message = message
+        self.error = error
         return FAILURE
+
+    def _child_error(self) -> ErrorType:
+        """The type a failure that named none carries: its last failed child's, else failed.
+
+        So a Sequence, a Selector or a pass-through decorator passes its child's type up to
+        a Catch without each one saying so.
+        """
+        for child in reversed(self.children):
+            if child.status is FAILURE and child.error is not None:
+                return child.error
+        return ErrorType.FAILED

@@ -14,6 +14,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+from engine.error_types import ErrorType
 from engine.errors import EngineError
 from engine.status import FAILURE, RUNNING, SUCCESS, Status
 from engine.types import ParamType, check_value, type_of_value
@@ -217,12 +218,15 @@ class Job:
         return job
 
     @staticmethod
-    def failed(message: str = "") -> Job:
-        """A job that already failed with ``message`` (empty: the leaf says "failed")."""
-        if not message:
+    def failed(message: str = "", error: ErrorType = ErrorType.FAILED) -> Job:
+        """A job that already failed with ``message`` (empty: the leaf says "failed").
+
+        ``error`` is the failure's type, which a Catch node matches.
+        """
+        if not message and error is ErrorType.FAILED:
             return _FAILED
         job = Job()
-        job.fail(message)
+        job.fail(message, error)
         return job
 
     @staticmethod
@@ -236,6 +240,7 @@ class Job:
         self._lock = threading.Lock()
         self._status = RUNNING
         self.message = ""
+        self.error = ErrorType.FAILED  # the type of a FAILURE
         self.outputs: dict[str, Any] = {}
         self._on_cancel = on_cancel
         self._cancelled = False
@@ -250,11 +255,18 @@ class Job:
         if finished:
             wake()
 
-    def _finish(self, status: Status, message: str, outputs: Mapping[str, Any] | None) -> None:
+    def _finish(
+        self,
+        status: Status,
+        message: str,
+        outputs: Mapping[str, Any] | None,
+        error: ErrorType = ErrorType.FAILED,
+    ) -> None:
         with self._lock:
             if self._status is not RUNNING:
                 return
             self.message = message
+            self.error = error
             if outputs:
                 self.outputs.update(outputs)
             self._status = status
@@ -266,9 +278,9 @@ class Job:
         """Finish with SUCCESS (first finish wins; later calls are ignored)."""
         self._finish(SUCCESS, message, outputs)
 
-    def fail(self, message: str) -> None:
-        """Finish with FAILURE and a message saying why."""
-        self._finish(FAILURE, message, None)
+    def fail(self, message: str, error: ErrorType = ErrorType.FAILED) -> None:
+        """Finish with FAILURE, a message saying why and the failure's type."""
+        self._finish(FAILURE, message, None, error)
 
     @property
     def finished(self) -> bool:
@@ -287,6 +299,7 @@ class Job:
             if self._status is RUNNING:
                 self._status = FAILURE
                 self.message = "halted"
+                self.error = ErrorType.HALTED
             callback = self._on_cancel
         if callback is not None:
             callback()
@@ -347,7 +360,11 @@ class OperationSource(Protocol):
 
 
 class OperationFailed(EngineError):
-    """Raised by an operation to fail its node with exactly this message."""
+    """Raised by an operation to fail its node with exactly this message and error type."""
+
+    def __init__(self, message: str = "", error: ErrorType = ErrorType.FAILED) -> None:
+        super().__init__(message)
+        self.error = error
 
 
 class InputTypeError(OperationFailed):
@@ -362,7 +379,8 @@ class InputTypeError(OperationFailed):
         actual = type_of_value(value).value
         super().__init__(
             f"input {port.name!r} reads {key!r}, which holds {actual} {_short(value)}; "
-            f"expected {expected}"
+            f"expected {expected}",
+            ErrorType.INVALID_INPUT,
         )
 
 

@@ -53,6 +53,9 @@ class NodeKind(str, enum.Enum):
     PARALLEL = "parallel"
     REACTIVE_SEQUENCE = "reactive_sequence"
     REACTIVE_SELECTOR = "reactive_selector"
+    # Two children, a body and a handler: the handler runs when the body fails with a
+    # caught error type (Rethink Intera's Throw/Catch).
+    CATCH = "catch"
     ITERATOR = "iterator"
     ENFORCE = "enforce"
     INVERTER = "inverter"
@@ -73,6 +76,7 @@ KIND_CATEGORY: dict[NodeKind, Category] = {
     NodeKind.PARALLEL: Category.COMPOSITE,
     NodeKind.REACTIVE_SEQUENCE: Category.COMPOSITE,
     NodeKind.REACTIVE_SELECTOR: Category.COMPOSITE,
+    NodeKind.CATCH: Category.COMPOSITE,
     NodeKind.ITERATOR: Category.DECORATOR,
     NodeKind.ENFORCE: Category.DECORATOR,
     NodeKind.INVERTER: Category.DECORATOR,

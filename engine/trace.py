@@ -49,6 +49,8 @@ def _event_record(event: Event) -> dict[str, Any]:
         }
         if event.message:
             record["message"] = event.message
+        if event.error:  # absent in traces written before error types: read as untyped
+            record["error"] = event.error
         return record | {"time": event.time}
     if isinstance(event, BlackboardWritten):
         return {
@@ -199,7 +201,8 @@ def format_timeline(trace: Trace) -> Iterable[str]:
         if kind == "status":
             label = labels.get(event["node"], event["node"])
             text = f"{head} tick {event['tick']:>5}  {label}: {event['old']} -> {event['new']}"
-            yield text + (f"  ({event['message']})" if event.get("message") else "")
+            why = ": ".join(str(event[k]) for k in ("error", "message") if event.get(k))
+            yield text + (f"  ({why})" if why else "")
         elif kind == "write":
             yield f"{head} tick {event['tick']:>5}  {event['key']} = {json.dumps(event['value'])}"
         elif kind == "log":

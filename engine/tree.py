@@ -59,6 +59,15 @@ class Root(Node):
         self.runs = 0
 
 
+# How the earlier children of a parent count when a run starts at a later one.
+_SKIPPED_AS: dict[str, Status] = {
+    "sequence": SUCCESS,
+    "reactive_sequence": SUCCESS,
+    "selector": FAILURE,
+    "reactive_selector": FAILURE,
+}
+
+
 class BehaviorTree:
     """A runnable tree: the root, its context, and its nodes by id."""
 
@@ -89,6 +98,35 @@ class BehaviorTree:
         for node in self.root.iterate():
             if node.status is not IDLE:
                 node.reset()
+
+    def start_at(self, node_id: str) -> dict[str, Status]:
+        """Prepare a fresh tree to run from ``node_id`` on ("resume from this node").
+
+        Along the path from the root to the node, the children of a sequence before the path
+        are marked SUCCESS (done) and the options of a selector before it FAILURE (tried):
+        finished nodes are latched, so the first tick goes down to ``node_id`` without
+        evaluating them. Other parents (a Parallel, a decorator) tick as usual.
+
+        Returns:
+            The ids marked, with their status.
+
+        Raises:
+            KeyError: no node of that id in this tree.
+            ValueError: the tree has been ticked already.
+        """
+        if self.root.status is not IDLE:
+            raise ValueError("a tree starts at a node only before its first tick")
+        child = self.nodes[node_id]
+        marked: dict[str, Status] = {}
+        while child.parent is not None:
+            parent = child.parent
+            done = _SKIPPED_AS.get(parent.kind)
+            if done is not None:
+                for sibling in parent.children[: parent.children.index(child)]:
+                    sibling.status = done
+                    marked[sibling.id] = done
+            child = parent
+        return marked
 
     def iterate(self) -> Iterator[Node]:
         return self.root.iterate()

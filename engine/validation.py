@@ -155,6 +155,13 @@ def _check_structure(check: Check, node: NodeSpec) -> None:
     if category is Category.DECORATOR and count != 1:
         need = "needs one node below it" if count == 0 else f"can hold only one node, not {count}"
         check.add(ERROR, node, f"{label!r} {need}.")
+    elif node.kind is NodeKind.CATCH and count != 2:
+        check.add(
+            ERROR,
+            node,
+            f"{label!r} needs two nodes below it, what it tries and what handles its "
+            f"failure; it has {count}.",
+        )
     elif category is Category.COMPOSITE and count == 0:
         check.add(ERROR, node, f"{label!r} has no nodes below it: add some or remove it.")
     elif category is Category.LEAF and count:
@@ -163,6 +170,10 @@ def _check_structure(check: Check, node: NodeSpec) -> None:
         _check_kind_ports(check, node)
     if node.kind is NodeKind.PARALLEL and count:
         _check_parallel_policy(check, node)
+    if node.kind is NodeKind.CATCH:
+        key = _setting(node, "error")
+        if isinstance(key, str) and key:  # it writes the caught error there, as Text
+            check.writers.setdefault(key, []).append(Writer(repr(label), (ParamType.TEXT,), node))
     if node.kind is not NodeKind.OPERATION and node.op:
         check.add(WARNING, node, f"{label!r} is not an operation; its operation is ignored.")
 
@@ -275,6 +286,8 @@ def _check_reads(check: Check, node: NodeSpec, available: frozenset[str]) -> fro
         for child in children:
             written |= _check_reads(check, child, available | written)
         return written
+    if node.kind is NodeKind.CATCH and len(children) == 2:
+        return _catch_reads(check, node, available)
     results = [_check_reads(check, child, available) for child in children]
     if node.kind is NodeKind.PARALLEL:
         return _parallel_guarantee(node, results)
@@ -285,6 +298,16 @@ def _check_reads(check: Check, node: NodeSpec, available: frozenset[str]) -> fro
     if node.kind in _PASS_CHILD and len(results) == 1:
         return results[0]
     return frozenset()
+
+
+def _catch_reads(check: Check, node: NodeSpec, available: frozenset[str]) -> frozenset[str]:
+    """The handler may read the caught error; after SUCCESS only what both ways wrote."""
+    body, handler = node.children
+    key = _setting(node, "error")
+    caught = frozenset({key}) if isinstance(key, str) and key else frozenset()
+    from_body = _check_reads(check, body, available)
+    from_handler = _check_reads(check, handler, available | caught) | caught
+    return from_body & from_handler
 
 
 def _parallel_guarantee(node: NodeSpec, results: list[frozenset[str]]) -> frozenset[str]:

@@ -8,6 +8,7 @@ save, recent, recovery), and the signal wiring, which lives in :meth:`_wire_view
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -349,6 +350,8 @@ class MainWindow(QMainWindow):
     def _wire_run(self) -> None:
         controller, views = self.controller, self.views
         controller.statuses_changed.connect(views.canvas.set_statuses)
+        controller.failures_described.connect(views.canvas.set_failure_tips)
+        views.canvas.commands.run_entries = self._run_entries
         controller.inner_statuses_changed.connect(views.inside.set_statuses)
         controller.blackboard_written.connect(views.blackboard.set_value)
         controller.log_message.connect(views.log.append)
@@ -474,6 +477,16 @@ class MainWindow(QMainWindow):
         return self.document.plan.path_of(node_id)
 
     # ------------------------------------------------------------------ cell
+
+    def _run_entries(self, node_id: str) -> list[tuple[str, Callable[[], None]]]:
+        """The run commands of a node's context menu: resume from it after a run ended."""
+        if self.controller.state != ExecutorState.FINISHED:
+            return []
+
+        def resume() -> None:
+            self.controller.resume_from(node_id)  # a refused plan shows its problems
+
+        return [("Resume from this node", resume)]
 
     def _on_run_state(self, state: object) -> None:
         """The cell chooser, Reset and Run follow the run's state; all wait while a cell opens."""

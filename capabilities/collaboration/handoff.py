@@ -26,6 +26,7 @@ from capabilities.markers.detection import (
     object_pose_from_marker,
 )
 from capabilities.world_model import Detection, WorldModel
+from engine.error_types import ErrorType
 from engine.operations import Job
 from engine.types import Pose, Region
 
@@ -203,7 +204,7 @@ class HandoffJob(Job):
                 return
             if settings.timeout > 0 and self._clock() - start >= settings.timeout:
                 self.fail(f"timed out: no {self._target.name} put down in the region "
-                          f"within {settings.timeout:g} s")  # fmt: skip
+                          f"within {settings.timeout:g} s", ErrorType.TIMEOUT)  # fmt: skip
                 return
 
     def _still_since(self, since: Detection | None, seen: Detection | None) -> Detection | None:

@@ -29,6 +29,7 @@ from capabilities.collaboration.handoff import (
 )
 from capabilities.kit import CAMERAS, camera, manifest
 from capabilities.world_model import Detection, WorldModel
+from engine.error_types import ErrorType
 from engine.operations import (
     Direction,
     Job,
@@ -147,7 +148,7 @@ class _ButtonJob(Job):
         deadline = self._deadline
         if self._status is RUNNING and deadline is not None and self._clock() >= deadline:
             self._console.remove_listener(self._heard)
-            self.fail(f"timed out: {self._button!r} was not pressed")
+            self.fail(f"timed out: {self._button!r} was not pressed", ErrorType.TIMEOUT)
         return self._status
 
 

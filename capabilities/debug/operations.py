@@ -10,6 +10,7 @@ from typing import Any
 
 from capabilities.base import Capability, CapabilityEnv
 from capabilities.kit import manifest
+from engine.error_types import ErrorType
 from engine.operations import (
     Direction,
     Job,
@@ -36,7 +37,8 @@ class _Succeed:
 
 class _Fail:
     def start(self, call: OperationCall) -> Job:
-        raise OperationFailed(str(call.input("message") or "failed on purpose"))
+        error = ErrorType(str(call.input("error") or ErrorType.FAILED.value))
+        raise OperationFailed(str(call.input("message") or "failed on purpose"), error)
 
 
 class _TickJob(Job):
@@ -132,8 +134,15 @@ def capability() -> Capability:
                 CAP,
                 "fail",
                 OperationKind.ACTION,
-                "Fails at once with a message.",
+                "Fails at once with a message and an error type (a Catch can take it).",
                 PortSpec("message", (ParamType.TEXT,), default="failed on purpose", doc="why"),
+                PortSpec(
+                    "error",
+                    (ParamType.TEXT,),
+                    default=ErrorType.FAILED.value,
+                    doc="the type of the failure",
+                    choices=tuple(t.value for t in ErrorType),
+                ),
             ),
             _Fail,
         ),

@@ -26,6 +26,7 @@ from capabilities.motion.symmetry import SymmetryTable
 from capabilities.motion.targets import symmetric_rotations
 from capabilities.object_library import GraspSpec, ObjectLibraryError
 from capabilities.tool.backend import SuctionBackend
+from engine.error_types import ErrorType
 from engine.operations import (
     Job,
     OperationCall,
@@ -172,4 +173,4 @@ class Grasp:
 
 
 def _check(test: Callable[[], bool], problem: str) -> Job:
-    return Job.done() if test() else Job.failed(problem)
+    return Job.done() if test() else Job.failed(problem, ErrorType.GRASP_FAILED)

@@ -23,6 +23,7 @@ from capabilities.markers.detection import (
     object_pose_from_marker,
 )
 from capabilities.world_model import Detection, WorldModel
+from engine.error_types import ErrorType
 from engine.operations import (
     Direction,
     Job,
@@ -129,7 +130,7 @@ class MarkerPose:
         marker_id = int(call.input("marker_id"))
         found = self._env.world.marker(marker_id)
         if found is None:
-            raise OperationFailed(f"marker {marker_id} has not been seen")
+            raise OperationFailed(f"marker {marker_id} has not been seen", ErrorType.NOT_FOUND)
         call.write("pose", found[0])
         return Job.done()
 
@@ -146,7 +147,9 @@ class ObjectPose:
     def start(self, call: OperationCall) -> Job:
         detection = _best(self._env, call.input("object"))
         if detection is None:
-            raise OperationFailed(f"{call.input('object').name} has not been seen")
+            raise OperationFailed(
+                f"{call.input('object').name} has not been seen", ErrorType.NOT_FOUND
+            )
         call.write("pose", detection.pose)
         return Job.done()
 

@@ -19,6 +19,7 @@ from capabilities.base import Capability
 from capabilities.kit import CAMERAS, manifest
 from capabilities.occupancy.feed import CameraFeed, Capture
 from capabilities.occupancy.state import SETTINGS, OccupancyState, setup
+from engine.error_types import ErrorType
 from engine.operations import (
     Direction,
     Job,
@@ -104,7 +105,7 @@ class FeedJob(Job):
         # Never time out before one frame was judged: on a simulated cell running faster
         # than real time, a short timeout can pass while the first frame renders.
         if self._deadline is not None and now >= self._deadline and self._seen is not None:
-            self.fail(self._on_timeout(self._last))
+            self.fail(self._on_timeout(self._last), ErrorType.TIMEOUT)
             return
         if capture is None or now - capture.stamp >= self._period:
             self._feed.refresh()

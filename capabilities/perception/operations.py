@@ -24,6 +24,7 @@ from capabilities.perception.errors import PerceptionError
 from capabilities.perception.recognizer import Recognizer
 from capabilities.perception.tracker import SurfaceTracker
 from capabilities.world_model import Detection, WorldModel
+from engine.error_types import ErrorType
 from engine.operations import (
     Direction,
     Job,
@@ -135,7 +136,9 @@ class ObjectPose:
     def start(self, call: OperationCall) -> Job:
         seen = self._env.seen(call.input("object"))
         if not seen:
-            raise OperationFailed(f"{_name(call.input('object'))} has not been seen")
+            raise OperationFailed(
+                f"{_name(call.input('object'))} has not been seen", ErrorType.NOT_FOUND
+            )
         call.write("pose", seen[0].pose)
         return Job.done()
 
@@ -166,7 +169,9 @@ class PlateType:
         ]
         ranked = sorted(plates, key=lambda d: math.dist(d.pose.position, near.position))
         if not ranked or math.dist(ranked[0].pose.position, near.position) > within:
-            raise OperationFailed(f"no plate seen within {within:g} m of {near.position}")
+            raise OperationFailed(
+                f"no plate seen within {within:g} m of {near.position}", ErrorType.NOT_FOUND
+            )
         call.write("model", ObjectModel(ranked[0].object_class))
         call.write("pose", ranked[0].pose)
         return Job.done()

@@ -10,6 +10,7 @@ from collections.abc import Callable
 from typing import Any
 
 from capabilities.base import CapabilityEnv
+from engine.error_types import ErrorType
 from engine.operations import (
     Job,
     Operation,
@@ -109,14 +110,17 @@ class WaitUntilJob(Job):
         try:
             result = self._runner.check()
         except OperationFailed as exc:
-            self.fail(f"{self._runner.op_id}: {exc}")
+            self.fail(f"{self._runner.op_id}: {exc}", exc.error)
             return FAILURE
         except Exception as exc:  # the condition's bug fails this node, never the tick
-            self.fail(f"{self._runner.op_id}: {type(exc).__name__}: {exc}")
+            self.fail(f"{self._runner.op_id}: {type(exc).__name__}: {exc}", ErrorType.ERROR)
             return FAILURE
         if result:
             self.succeed(f"{self._runner.op_id} became true")
         elif self._clock() >= self._deadline:
             self._runner.cancel()
-            self.fail(f"timed out after {self._timeout:g} s waiting for {self._runner.op_id}")
+            self.fail(
+                f"timed out after {self._timeout:g} s waiting for {self._runner.op_id}",
+                ErrorType.TIMEOUT,
+            )
         return self._status

@@ -17,6 +17,7 @@ from concurrent.futures import Future
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
+from capabilities.faults import CONNECTION_LOST, EMERGENCY_STOP, PROTECTIVE_STOP
 from capabilities.ur.errors import URConnectionLost, URError
 from capabilities.ur.modes import PolyScopeVersion, RobotMode, SafetyMode, parse_version
 
@@ -61,12 +62,12 @@ class URState:
 def fault_reason(state: URState) -> str:
     """Why the robot cannot move now, in words ("" when it can)."""
     if not state.connected:
-        return "connection lost" + (f" ({state.problem})" if state.problem else "")
+        return CONNECTION_LOST + (f" ({state.problem})" if state.problem else "")
     safety = SafetyMode(state.safety_mode)
     if safety == SafetyMode.PROTECTIVE_STOP:
-        return "protective stop"
+        return PROTECTIVE_STOP
     if safety in _EMERGENCY:
-        return "emergency stop"
+        return EMERGENCY_STOP
     if safety not in (SafetyMode.NORMAL, SafetyMode.REDUCED):
         return f"safety stop ({safety.name})"
     if state.robot_mode < RobotMode.RUNNING:

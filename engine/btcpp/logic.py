@@ -1,7 +1,7 @@
 """Our logic node kinds as BehaviorTree.CPP nodes, and their settings both ways.
 
 Most kinds are BehaviorTree.CPP built-ins (Sequence, Fallback, Parallel, ...); Iterator and
-Enforce (paper III-B) have no built-in twin and are declared as custom decorators in the
+Enforce (paper III-B) and Catch have no built-in twin and are declared as custom decorators in the
 file's TreeNodesModel. A setting is written as the built-in's own port (a Parallel's
 ``success`` as ``success_count``, a Wait's seconds as Sleep's ``msec``); where that text
 would not give back the exact setting (``success`` = 1, a time that is no whole number of
@@ -41,6 +41,15 @@ def _words(out: dict[str, str]) -> tuple[Callable[[Setting], str], Callable[[str
         return back[text] if text in back else float(text)
 
     return write, read
+
+
+def _word_text(value: Setting) -> str:
+    """A word setting (a Catch's error types) is written as it is."""
+    return value if isinstance(value, str) else _count_text(value)
+
+
+def _word_read(text: str) -> Setting:
+    return text
 
 
 def _msec_text(value: Setting) -> str:
@@ -101,6 +110,16 @@ LOGIC: dict[NodeKind, LogicModel] = {
         ),
         LogicModel(NodeKind.REACTIVE_SEQUENCE, "ReactiveSequence", "Control"),
         LogicModel(NodeKind.REACTIVE_SELECTOR, "ReactiveFallback", "Control"),
+        LogicModel(
+            NodeKind.CATCH,
+            "Catch",
+            "Control",
+            builtin=False,
+            settings={
+                "errors": SettingMap("errors", _word_text, _word_read),
+                "error": SettingMap("error", _word_text, _word_read),
+            },
+        ),
         LogicModel(
             NodeKind.ITERATOR,
             "Iterator",

@@ -64,6 +64,9 @@ class CanvasActions(QObject):
         # capability title -> [(label, operation id)], set from the cell's registry
         self.operations: dict[str, list[tuple[str, str]]] = {}
         self.node_factory: NodeFactory = default_node_factory
+        # node id -> (text, handler) entries added by whoever runs the plan ("Resume from
+        # this node"): the canvas knows no runs; empty when none apply now
+        self.run_entries: Callable[[str], list[tuple[str, Callable[[], None]]]] = lambda _: []
         self.actions: dict[str, QAction] = {}
         handlers: dict[str, Callable[[], None]] = {
             "delete": self.delete,
@@ -207,6 +210,11 @@ class CanvasActions(QObject):
                 menu.addAction(self.actions["toggle_collapse"])
             for name in ("move_left", "move_right"):
                 menu.addAction(self.actions[name])
+            entries = self.run_entries(node_id)
+            if entries:
+                menu.addSeparator()
+            for text, handler in entries:
+                menu.addAction(text).triggered.connect(handler)
         else:
             menu.addAction(self.actions["paste"])
         menu.addSeparator()

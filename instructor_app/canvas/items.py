@@ -161,6 +161,7 @@ class TreeNodeItem(NodeItem):
         self._text_item = None  # NodeItem's attribute; the editor exists only while renaming
         self.look: NodeLook | None = None
         self.status: Status | None = None
+        self.status_tip = ""  # why the node failed in the last run ("error type: message")
         self.index_badge = 0  # 1-based place among its parent's children; 0: none
         self.hidden_count = 0  # descendants hidden by collapsing; 0: expanded
         self._elided = ""
@@ -176,11 +177,25 @@ class TreeNodeItem(NodeItem):
         self._elided = _Fonts.title_metrics.elidedText(
             look.title, Qt.TextElideMode.ElideRight, room
         )
+        self._update_tip()
+        self.draw_node()
+
+    def _update_tip(self) -> None:
+        look = self.look
+        if look is None:
+            return
         tip = look.title if self._elided != look.title else ""
         if look.broken:
             tip = f"{look.title}\n{look.broken}".strip()
+        if self.status_tip:
+            tip = f"{look.title}\nFailed: {self.status_tip}"
         self.setToolTip(tip)
-        self.draw_node()
+
+    def set_status_tip(self, text: str) -> None:
+        """Show why the node failed in its tooltip ("" clears it)."""
+        if text != self.status_tip:
+            self.status_tip = text
+            self._update_tip()
 
     def set_status(self, status: Status | None) -> None:
         if status is not self.status:

@@ -51,6 +51,7 @@ _SYMBOLS: dict[NodeKind, str] = {
     NodeKind.PARALLEL: "|A|",
     NodeKind.REACTIVE_SEQUENCE: "R->",
     NodeKind.REACTIVE_SELECTOR: "R?",
+    NodeKind.CATCH: "!?",  # try the first child; on a caught error, the second
 }
 
 _MAX_PARAM_LINES = 4

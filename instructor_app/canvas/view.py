@@ -107,7 +107,22 @@ class CanvasView(QWidget):
             node = nodes.get(node_id)
             if node is not None:
                 node.item.set_status(status)
+                if status is Status.RUNNING or status is Status.SUCCESS:
+                    node.item.set_status_tip("")  # tried again: the old failure is gone
                 self._statused.add(node_id)
+
+    def set_failure_tips(self, mapping: Mapping[str, str]) -> None:
+        """Node id -> "error type: message": shown in the tooltips of the failed nodes."""
+        nodes = self.mirror.nodes
+        for node_id, text in mapping.items():
+            node = nodes.get(node_id)
+            if node is not None:
+                node.item.set_status_tip(text)
+                self._statused.add(node_id)
+
+    def failure_tip(self, node_id: str) -> str:
+        """Why the node failed in the last run, as its tooltip shows it ("" : it did not)."""
+        return self.mirror.nodes[node_id].item.status_tip
 
     def clear_statuses(self) -> None:
         """Back to the category colours."""
@@ -116,6 +131,7 @@ class CanvasView(QWidget):
             node = nodes.get(node_id)
             if node is not None:
                 node.item.set_status(None)
+                node.item.set_status_tip("")
         self._statused.clear()
 
     def status_of(self, node_id: str) -> Status | None:

@@ -14,14 +14,17 @@ from dataclasses import dataclass
 
 from PySide6.QtCore import QObject, QTimer, Signal
 
+from engine.blackboard import Blackboard, BlackboardError
 from engine.build import BuildError, build_tree
+from engine.error_types import ErrorType
 from engine.events import RunFinished
 from engine.executor import Executor, ExecutorState
 from engine.spec import PlanSpec
 from engine.status import Status
+from engine.tree import BehaviorTree
 from engine.validation import ERROR, Problem, has_errors, validate_plan
 from instructor_app.document.editing import PlanDocument
-from instructor_app.runtime.pump import Batch, EventPump
+from instructor_app.runtime.pump import Batch, EventPump, failure_text
 from instructor_app.runtime.session import CellSession
 
 __all__ = ["RunController", "RunOutcome"]
@@ -66,6 +69,7 @@ class RunController(QObject):
         run_finished(object): a :class:`RunOutcome`.
         run_refused(list): the validation problems (or a build error) that kept it from starting.
         failure_changed(str, str): the deepest failing node and its message ("" "": none).
+        failures_described(object): node id -> "error type: message" of the nodes that failed.
         inner_statuses_changed(object): runtime id ("instance/inner") -> Status inside subtree
             instances; None when a new run starts.
     """
@@ -81,6 +85,7 @@ class RunController(QObject):
     # runtime id ("instance/inner") -> Status of nodes inside subtree instances; None: a new run
     inner_statuses_changed = Signal(object)
     failure_changed = Signal(str, str)
+    failures_described = Signal(object)
 
     def __init__(
         self,
@@ -104,6 +109,7 @@ class RunController(QObject):
         self._order: dict[str, tuple[int, int]] = {}  # node id -> (depth, plan order)
         self._statuses: dict[str, Status] = {}
         self._messages: dict[str, str] = {}
+        self._last_board: Blackboard | None = None  # the last run's values, for a resume
         self._running: list[str] = []
         self._failure: tuple[str, str] = ("", "")
         self._stopping = False  # a stop was asked: the halt's IDLE resets are not shown
@@ -190,13 +196,24 @@ class RunController(QObject):
         self.log_message.emit(f"The {self.session.name} cell was reset", "info")
         return True
 
-    def _start(self, paused: bool) -> bool:
+    def resume_from(self, node_id: str) -> bool:
+        """Run again from ``node_id`` after a run stopped or finished (the operator fixed it).
+
+        The cell is not reset; the nodes before it in the sequences on its path count as done
+        (``BehaviorTree.start_at``) and the last run's parameter values are kept, so what
+        those nodes found is there. False when a run is going or the plan was refused.
+        """
+        if self.is_running:
+            return False
+        return self._start(paused=False, start_at=node_id)
+
+    def _start(self, paused: bool, start_at: str | None = None) -> bool:
         if self.session.opening:  # the registry is about to change under the plan
             message = f"the {self.session.opening} cell is still opening; run when it is ready"
             self.run_refused.emit([Problem(ERROR, None, "plan", None, message)])
             return False
         plan = copy.deepcopy(self.document.plan)  # edits during the run do not reach it
-        if plan.reset_cell:
+        if plan.reset_cell and start_at is None:
             self.reset_cell(plan.scene)
         registry = self.session.registry
         problems = validate_plan(plan, registry)
@@ -208,9 +225,14 @@ class RunController(QObject):
         except BuildError as exc:
             self.run_refused.emit([Problem(ERROR, None, exc.path, None, str(exc))])
             return False
+        done = self._resume_at(tree, start_at) if start_at else {}
+        if done is None:
+            return False
         for problem in problems:
             self.log_message.emit(str(problem), "warning")
+        self._last_board = tree.blackboard
         self._reset_run(plan)
+        self._statuses.update({k: v for k, v in done.items() if k in self._order})
         hold = getattr(self.session.cell, "hold_reason", None)  # a real robot's stops
         self._executor = Executor(
             tree, self.rate_hz, [self._pump.put], plan_name=plan.name, hold=hold
@@ -221,8 +243,31 @@ class RunController(QObject):
         # Every node starts the run grey (IDLE), also those the run never reaches; sent after
         # the state change, on which the views clear the last run's colours.
         self.statuses_changed.emit(dict(self._statuses))
-        self.log_message.emit(f"Run of {plan.name or 'the plan'} started", "info")
+        if start_at:
+            self.log_message.emit(
+                f"Run of {plan.name or 'the plan'} resumed from {self._label(start_at)} "
+                f"({len(done)} nodes before it counted as done)",
+                "info",
+            )
+        else:
+            self.log_message.emit(f"Run of {plan.name or 'the plan'} started", "info")
         return True
+
+    def _resume_at(self, tree: BehaviorTree, node_id: str) -> dict[str, Status] | None:
+        """Mark the nodes before ``node_id`` done and carry the last run's values over."""
+        try:
+            done = tree.start_at(node_id)
+        except KeyError:
+            message = f"there is no node {node_id!r} to resume from"
+            self.run_refused.emit([Problem(ERROR, None, node_id, None, message)])
+            return None
+        if self._last_board is not None:
+            for key, value in self._last_board.snapshot().items():
+                try:
+                    tree.blackboard.set(key, value, "resume")
+                except BlackboardError:  # the plan now declares it of another type
+                    continue
+        return done
 
     def _reset_run(self, plan: PlanSpec) -> None:
         self._plan = plan
@@ -269,10 +314,17 @@ class RunController(QObject):
                 self.log_message.emit("The robot is ready again: the run goes on", "info")
         for node_id, message in batch.logs:
             self.log_message.emit(f"{self._label(node_id)}: {message}", "info")
-        for node_id, message in batch.failures:
+        described: dict[str, str] = {}
+        for node_id, message, error in batch.failures:
             if node_id in self._order:
-                text = f"{self._label(node_id)} failed" + (f": {message}" if message else "")
+                described[node_id] = failure_text(error, message)
+                if batch.statuses.get(node_id) is Status.FAILURE:  # the failure panel shows it
+                    self._messages[node_id] = described[node_id]
+                kind = f" ({error})" if error and error != ErrorType.FAILED.value else ""
+                text = f"{self._label(node_id)} failed{kind}" + (f": {message}" if message else "")
                 self.log_message.emit(text, "error")
+        if described:
+            self.failures_described.emit(described)
 
     def _update_running(self) -> None:
         running = sorted(

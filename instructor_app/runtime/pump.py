@@ -13,6 +13,7 @@ import collections
 from dataclasses import dataclass, field
 from typing import Any
 
+from engine.error_types import ErrorType
 from engine.events import (
     BlackboardWritten,
     Event,
@@ -24,7 +25,16 @@ from engine.events import (
 )
 from engine.status import Status
 
-__all__ = ["Batch", "EventPump"]
+__all__ = ["Batch", "EventPump", "failure_text"]
+
+
+def failure_text(error: str, message: str) -> str:
+    """A failure as the Instructor shows it: ``"grasp_failed: the cup is not held"``.
+
+    The untyped ``failed`` is left out: it says nothing the status does not.
+    """
+    kind = "" if error == ErrorType.FAILED.value else error
+    return ": ".join(part for part in (kind, message) if part)
 
 
 @dataclass
@@ -34,8 +44,9 @@ class Batch:
     Attributes:
         statuses: node id -> newest status (only nodes that changed).
         messages: node id -> the message that came with its newest status.
-        failures: node ids that turned FAILURE, in the order they did (a node that failed
-            and was reset in the same batch is still here: its failure was real).
+        failures: (node id, message, error type) of the nodes that turned FAILURE, in the
+            order they did (a node that failed and was reset in the same batch is still
+            here: its failure was real).
         writes: blackboard key -> newest value, in order of first write.
         logs: (node id, message) in order.
         finished: the RunFinished event, if the run ended.
@@ -45,7 +56,7 @@ class Batch:
 
     statuses: dict[str, Status] = field(default_factory=dict)
     messages: dict[str, str] = field(default_factory=dict)
-    failures: list[tuple[str, str]] = field(default_factory=list)
+    failures: list[tuple[str, str, str]] = field(default_factory=list)
     writes: dict[str, Any] = field(default_factory=dict)
     logs: list[tuple[str, str]] = field(default_factory=list)
     finished: RunFinished | None = None
@@ -89,7 +100,7 @@ def _merge(batch: Batch, event: Event) -> None:
         batch.statuses[event.node_id] = event.new
         batch.messages[event.node_id] = event.message
         if event.new is Status.FAILURE:
-            batch.failures.append((event.node_id, event.message))
+            batch.failures.append((event.node_id, event.message, event.error))
     elif isinstance(event, BlackboardWritten):
         batch.writes[event.key] = event.value
     elif isinstance(event, LogMessage):

@@ -348,6 +348,25 @@ def node_examples() -> dict[str, PlanSpec]:
             "A motion that needs 100 ticks gets 0.3 s. Runs to FAILURE.",
             lambda m: m.node(N.TIMEOUT, "0.3 s", m.running("slow motion", 100), seconds=0.3),
         ),
+        "catch": _one(
+            "catch",
+            "Catch",
+            "A grasp fails with grasp_failed; the Catch keeps the error in CAUGHT and runs its "
+            "handler, which logs it. Runs to SUCCESS.",
+            lambda m: m.node(
+                N.CATCH,
+                "on a failed grasp",
+                m.op(
+                    "fail",
+                    "grasp",
+                    message=_fixed("nothing between the fingers", ParamType.TEXT),
+                    error=_fixed("grasp_failed", ParamType.TEXT),
+                ),
+                m.op("log", "report it", message=Binding.reference("CAUGHT")),
+                errors="grasp_failed, object_lost",
+                error="CAUGHT",
+            ),
+        ),
         "force_success": _one(
             "force_success",
             "Force success",

@@ -10,6 +10,7 @@ import pytest
 
 from capabilities.base import CapabilityRegistry
 from capabilities.sim.session import SimCellSession
+from engine.error_types import ErrorType
 from engine.spec import Binding, NodeSpec
 from engine.status import Status
 from engine.types import JointConfig, ObjectModel, ParamType, Pose, Waypoint, WaypointFrame
@@ -115,3 +116,18 @@ def test_halting_a_grasp_stops_the_arm() -> None:
         tree.reset()
         session.sim.wait_sim(0.3)
         assert max(abs(v) for v in arm.joint_velocities()) < 0.01
+
+
+def test_a_grasp_that_closes_on_nothing_fails_with_grasp_failed() -> None:
+    with SimCellSession("cup_to_bin", seed=0) as session:
+        cup = session.truth_pose("cup")
+        empty = Pose((cup.position[0], cup.position[1] + 0.15, cup.position[2]), cup.orientation)
+        run = run_plan(
+            session,
+            seq(op("gripper.grasp", "grasp", object=_object("cup"), pose=empty)),
+            CapabilityRegistry(cell=session),
+        )
+        assert run.status is Status.FAILURE
+        assert "the cup is not held" in run.messages()["grasp"]
+        grasp = next(n for n in run.tree.root.iterate() if n.name == "grasp")
+        assert grasp.error is ErrorType.GRASP_FAILED  # what a Catch with a re-grasp takes

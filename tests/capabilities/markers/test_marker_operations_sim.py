@@ -17,6 +17,7 @@ from capabilities.markers import capability
 from capabilities.markers.geometry import pose_errors
 from capabilities.sim.session import SimCellSession
 from engine.build import build_tree
+from engine.error_types import ErrorType
 from engine.executor import run_to_end
 from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
 from engine.status import Status
@@ -128,6 +129,7 @@ def test_an_object_out_of_sight_is_not_found(cell: SimCellSession) -> None:
     built = build_tree(PlanSpec(_object_pose("cup", "CUP")), registry, clock=cell.clock)
     assert run_to_end(built, 100.0, timeout=10.0).status is Status.FAILURE
     assert "cup has not been seen" in built.root.children[0].message
+    assert built.root.children[0].error is ErrorType.NOT_FOUND
 
 
 def test_markers_are_unavailable_without_cameras() -> None:

@@ -13,6 +13,7 @@ from capabilities.sim.session import SimCellSession
 from capabilities.sim.testing import down_at
 from capabilities.timing import capability as timing
 from engine.build import build_tree
+from engine.error_types import ErrorType
 from engine.operations import Job, OperationKind, OperationManifest
 from engine.spec import NodeKind, NodeSpec, PlanSpec
 from engine.status import Status
@@ -75,6 +76,7 @@ def test_wait_until_fails_after_the_timeout() -> None:
     cell.now = 2.0
     assert tree.tick() is Status.FAILURE
     assert tree.nodes[node.id].message == "timed out after 2 s waiting for probe.is_set"
+    assert tree.nodes[node.id].error is ErrorType.TIMEOUT
 
 
 def test_wait_until_checks_once_per_tick_with_the_condition_defaults() -> None:

@@ -6,9 +6,11 @@ import math
 
 import pytest
 
+from capabilities.jobs import job_from_handle
 from capabilities.ur.errors import URError
 from capabilities.ur.modes import RobotMode
 from capabilities.ur.tool_io import DigitalPin, URSuctionCup
+from engine.error_types import ErrorType
 from engine.types import Pose
 from tests.capabilities.ur.emulators import wait_for
 
@@ -103,6 +105,7 @@ def test_protective_stop_during_a_move_fails_it(start_emulator, connect) -> None
     emulator.protective_stop()
     assert handle.wait(10)
     assert handle.ok is False and "protective stop" in handle.message
+    assert job_from_handle(handle).error is ErrorType.PROTECTIVE_STOP  # a Catch can take it
     again = arm.move_joints(q, 0.5, 1.0)
     assert again.wait(10) and again.ok is False and "protective stop" in again.message
     # The operator clears it: unlock, and the control script is uploaded again.
@@ -123,6 +126,7 @@ def test_a_killed_controller_mid_move_is_connection_lost(start_emulator, connect
     emulator.kill()
     assert handle.wait(30), "the move never noticed the controller was gone"
     assert handle.ok is False and "connection lost" in handle.message
+    assert job_from_handle(handle).error is ErrorType.CONNECTION_LOST
     with pytest.raises(URError, match="connection lost"):
         arm.joint_positions()
 
@@ -185,3 +189,4 @@ def test_dead_script_then_emergency_stop_fail_moves_by_name(start_emulator, conn
     emulator.emergency_stop()
     assert handle.wait(10)
     assert handle.ok is False and "emergency stop" in handle.message
+    assert job_from_handle(handle).error is ErrorType.EMERGENCY_STOP

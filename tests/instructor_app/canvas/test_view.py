@@ -283,6 +283,21 @@ def test_set_statuses_recolours_only_the_named_items(view: CanvasView, doc: Plan
     assert view.status_of(a) is None and view.status_of(b) is None
 
 
+def test_a_failed_node_shows_its_error_type_in_its_tooltip(
+    view: CanvasView, doc: PlanDocument
+) -> None:
+    b = nid(doc, "b")
+    view.set_statuses({b: Status.FAILURE})
+    view.set_failure_tips({b: "grasp_failed: the cup is not held"})
+    assert view.item(b).toolTip().endswith("Failed: grasp_failed: the cup is not held")
+    assert view.failure_tip(b) == "grasp_failed: the cup is not held"
+    view.set_statuses({b: Status.RUNNING})  # tried again: the old failure goes
+    assert view.failure_tip(b) == "" and "Failed" not in view.item(b).toolTip()
+    view.set_failure_tips({b: "timeout: timed out after 2 s"})
+    view.clear_statuses()
+    assert view.failure_tip(b) == ""
+
+
 def test_selection_signal_select_and_center_on(
     view: CanvasView, doc: PlanDocument, qtbot: QtBot
 ) -> None:

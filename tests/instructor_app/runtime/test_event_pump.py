@@ -26,7 +26,7 @@ def test_the_newest_status_per_node_wins_but_failures_are_kept() -> None:
     batch = pump.drain()
     assert batch.started
     assert batch.statuses == {"a": Status.IDLE, "b": Status.SUCCESS}
-    assert batch.failures == [("a", "no cup")]
+    assert batch.failures == [("a", "no cup", "")]
     assert batch.writes == {"X": 2} and batch.logs == [("b", "hello")]
     assert batch.finished is None
     assert pump.drain().empty

@@ -8,7 +8,9 @@ from typing import Any
 import pytest
 from PySide6.QtCore import QObject
 
+from engine.spec import Binding
 from engine.status import Status
+from engine.types import ParamType
 from instructor_app.document.editing import PlanDocument
 from instructor_app.runtime.controller import RunController, RunOutcome
 from instructor_app.runtime.session import CellSession
@@ -159,3 +161,23 @@ def _dump(plan: Any) -> str:
     from engine.files import dump_plan
 
     return dump_plan(plan)
+
+
+def test_a_failure_shows_its_error_type_in_the_log_the_panel_and_the_canvas_tips(
+    qtbot: Any, none_session: CellSession
+) -> None:
+    plan = failing_plan()
+    broken = next(n for _, n in plan.walk() if n.name == "look for cup")
+    broken.params["error"] = Binding.fixed("not_found", ParamType.TEXT)
+    document, controller, seen = make(none_session)
+    document.load_text(_dump(plan), None)
+    described: list[dict[str, str]] = []
+    controller.failures_described.connect(described.append)
+    outcome = finish(qtbot, controller, controller.run)
+    leaf = next(n.id for _, n in document.plan.walk() if n.name == "look for cup")
+    assert seen.failures[-1] == (leaf, "not_found: no cup")
+    assert outcome.failure_message == "not_found: no cup"
+    assert ("look for cup failed (not_found): no cup", "error") in seen.logs
+    merged = {k: v for batch in described for k, v in batch.items()}
+    assert merged[leaf] == "not_found: no cup"
+    assert merged[document.plan.tree.id] == "not_found: inner failed"  # passed up the tree
