@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from engine.btcpp.errors import XmlExportError
-from engine.btcpp.logic import BUILTIN_MODELS, LOGIC
+from engine.btcpp.logic import BUILTIN_MODELS, LOGIC, LOGIC_BY_MODEL
 from engine.btcpp.names import encode_id, encode_port, readable_tree_id
 from engine.btcpp.values import MODEL_TYPE, value_text
 from engine.kinds import KIND_PORTS
@@ -75,7 +75,8 @@ class _Writer:
         self.plan = plan
         self.manifests = manifests
         self.models: dict[str, _Model] = {}
-        self.taken: set[str] = set(BUILTIN_MODELS)
+        # A tree may not take the id of a node model (BehaviorTree.CPP refuses the file).
+        self.taken: set[str] = set(BUILTIN_MODELS) | set(LOGIC_BY_MODEL)
         self.tree_ids: dict[tuple[str, int], str] = {}
 
     def fail(self, where: str, expected: str, got: str) -> XmlExportError:

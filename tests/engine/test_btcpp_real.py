@@ -4,7 +4,7 @@ Needs a checker program built against a local BehaviorTree.CPP (not part of this
 repository); set ``COSTAR_BTCPP_CHECK`` to it. Its contract:
 
 - ``CHECK MODELS.txt load TREE.xml``: registers every model of MODELS.txt as a simple
-  action, condition or decorator with its typed ports (``BT::InputPort<double>`` ...), loads
+  action, condition, control or decorator with its typed ports (``BT::InputPort<double>`` ...), loads
   the XML with ``factory.createTreeFromText`` and prints ``BT::WriteTreeToXML``; exit 0, or
   the library's error on stderr and exit 1.
 - ``CHECK MODELS.txt models``: prints ``BT::writeTreeNodesModelXML(factory)``.

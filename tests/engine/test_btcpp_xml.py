@@ -387,3 +387,12 @@ def test_nested_subtrees_and_two_versions_of_one_come_back() -> None:
     assert '<BehaviorTree ID="Inner_2" _uid="a.inner" _name="Inner" _version="2"' in text
     assert '<SubTree ID="Inner" MSG="{OUT}"' in text
     assert _round_trip(plan) == plan
+
+
+@pytest.mark.parametrize("name", ["Catch", "Iterator", "Enforce", "Sequence"])
+def test_a_tree_never_takes_the_id_of_a_node_model(name: str) -> None:
+    """BehaviorTree.CPP refuses a <BehaviorTree ID> that names a registered node."""
+    plan = PlanSpec(tree=NodeSpec(NodeKind.WAIT, params={}), name=name)
+    xml = export_xml(plan, {})
+    assert f'<BehaviorTree ID="{name}"' not in xml
+    assert import_xml(xml, "t.xml", {}).name == name

@@ -68,7 +68,7 @@ def test_the_grasp_port_offers_the_library_grasps_first_by_default() -> None:
     manifests = {d.manifest.id: d.manifest for d in capability().operations}
     port = manifests["gripper.grasp"].port("grasp")
     assert port is not None and port.default == FIRST
-    assert port.choices == (FIRST, "top", "rim", "suction")
+    assert port.choices == (FIRST, "top", "rim", "suction", "weld")
 
 
 def test_continuous_symmetry_turns_the_grasp_toward_the_wrist() -> None:

@@ -41,7 +41,7 @@ def test_a_grasp_is_picked_by_name_from_a_list(qtbot: Any, qapp: Any) -> None:
     choose_index(qtbot, row.mode_combo, MODE_VALUE)
     assert isinstance(row.editor, ChoiceEditor)
     offered = [row.editor.combo.itemText(i) for i in range(row.editor.combo.count())]
-    assert offered == ["first", "top", "rim", "suction"]
+    assert offered == ["first", "top", "rim", "suction", "weld"]
     choose(qtbot, row.editor.combo, "rim")
     assert document.node("grasp").params["grasp"] == Binding.fixed("rim", ParamType.TEXT)
 
