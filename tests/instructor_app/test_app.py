@@ -65,5 +65,7 @@ def test_scene_chooses_the_simulated_cells_scene(qapp: Any, tmp_path: Path, caps
     png = tmp_path / "scene.png"
     assert main(["--scene", "tending", "--size", "400x300", "--screenshot", str(png)]) == EXIT_OK
     assert "error" not in capsys.readouterr().err
-    assert main(["--scene", "no_such_scene", "--size", "400x300", "--screenshot", str(png)]) == EXIT_OK
+    assert (
+        main(["--scene", "no_such_scene", "--size", "400x300", "--screenshot", str(png)]) == EXIT_OK
+    )
     assert "no_such_scene" in capsys.readouterr().err  # the cell failed on that scene
