@@ -53,8 +53,17 @@ class Views:
                 title = item.group.replace("_", " ").capitalize()
                 operations.setdefault(title, []).append((item.label, item.op))
         self.canvas.set_operations(operations)
-        library = registry.cell.interfaces().get("objects")
-        self.inspector.set_object_names(library.names() if library is not None else [])
+        self.inspector.setoffered_object_names(offered_object_names(registry.cell.interfaces()))
+
+
+def offered_object_names(interfaces: Any) -> list[str]:
+    """The object models a field offers: those the cell's scene has on the table first (what a
+    plan usually handles), then the rest of the library by name."""
+    library = interfaces.get("objects")
+    names = list(library.names()) if library is not None else []
+    layout = interfaces.get("scene_layout") or {}
+    on_table = [name for name in layout.get("objects", []) if name in names]
+    return on_table + [name for name in names if name not in on_table]
 
 
 def _item_for(kind: NodeKind, op: str | None) -> PaletteItem:

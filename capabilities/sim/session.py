@@ -270,8 +270,11 @@ class SimCellSession:
         for name in library.names():
             sizes.update({m.marker_id: m.size for m in library.get(name).markers})
         table = self.sim.config.table
+        movable = [entry.model for entry in self.scene.spec.objects if not entry.fixed]
         return {
             "marker_sizes": sizes,
+            # The models the scene puts on the table (not where): what a plan handles here.
+            "objects": list(dict.fromkeys(movable)),
             "fixed_markers": {m.marker_id: m.pose for m in self.scene.fixed_markers.values()}
             | self._fixture_markers(),
             # The furniture, for views of the cell: boxes (name, centre pose, size x y z).
