@@ -1,9 +1,10 @@
 """MainWindow: wires the document, the canvas, the panels and the run together.
 
 It implements none of their logic: the canvas edits and shows the plan, the panels their
-part, the RunController runs it. What is here: menus, the toolbar, docks, files (new, open,
-save, recent, recovery), and the signal wiring, which lives in :meth:`_wire_views` and
-:meth:`_wire_run` so that an API change of a panel is adjusted in one place.
+part, the RunController runs it, CellControl switches and resets the cell, PlanFiles does
+new, open, save and recovery, and window_layout places the docks. What is here: menus, the
+toolbar, and the signal wiring, which lives in :meth:`_wire_views` and :meth:`_wire_run` so
+that an API change of a panel is adjusted in one place.
 """
 
 from __future__ import annotations
@@ -12,14 +13,10 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtCore import QSize, Qt
 from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
 from PySide6.QtWidgets import (
-    QComboBox,
-    QDockWidget,
     QLabel,
     QMainWindow,
-    QScrollArea,
     QStackedWidget,
     QWidget,
 )
@@ -27,8 +24,9 @@ from PySide6.QtWidgets import (
 from engine.executor import ExecutorState
 from engine.library import library_folder
 from engine.spec import NodeKind
-from instructor_app.dialogs import APP_TITLE, DISCARD, SAVE, Dialogs
-from instructor_app.document.autosave import DEFAULT_INTERVAL_MS, Autosaver, offer_recoveries
+from instructor_app.cell_control import CellControl
+from instructor_app.dialogs import APP_TITLE, DISCARD, Dialogs
+from instructor_app.document.autosave import DEFAULT_INTERVAL_MS, Autosaver
 from instructor_app.document.editing import PlanDocument
 from instructor_app.document.model import DocumentError
 from instructor_app.document.tree_ops import can_have_child
@@ -38,6 +36,7 @@ from instructor_app.panels.cell_views import CellViews
 from instructor_app.panels.operator import OperatorPanel
 from instructor_app.panels.scene_teach import SceneTeachLink
 from instructor_app.panels.start_page import StartPage, find_examples
+from instructor_app.plan_files import PlanFiles
 from instructor_app.runtime.controller import RunController
 from instructor_app.runtime.robot_status import RobotStatusLabel, ScriptRestartButton
 from instructor_app.runtime.run_view import (
@@ -52,30 +51,12 @@ from instructor_app.settings import (
     AppSettings,
     RecentFilesMenu,
     app_version,
-    is_shipped_example,
 )
 from instructor_app.views import Views, make_views
+from instructor_app.window_layout import arrange_cell_views, place_docks
 from instructor_app.xml_files import export_plan_xml, import_plan_xml
 
-OPEN_CELL_FILE = "Open cell file…"
-
 __all__ = ["APP_TITLE", "DISCARD", "Dialogs", "MainWindow", "Views", "make_views"]
-
-
-class _Scrolled(QScrollArea):
-    """A tall panel in a scroll area that asks for no more than a side column's width, so
-    that its tab squeezes neither the inspector nor the palette."""
-
-    def sizeHint(self) -> QSize:
-        hint = super().sizeHint()
-        return QSize(min(hint.width(), 260), hint.height())
-
-
-def _scrolled(widget: QWidget) -> QScrollArea:
-    area = _Scrolled()
-    area.setWidgetResizable(True)
-    area.setWidget(widget)
-    return area
 
 
 class MainWindow(QMainWindow):
@@ -104,7 +85,7 @@ class MainWindow(QMainWindow):
         self.setObjectName("MainWindow")
         self.session = session
         self.settings = settings if settings is not None else AppSettings()
-        self.dialogs = dialogs if dialogs is not None else Dialogs()
+        self._dialogs = dialogs if dialogs is not None else Dialogs()
         self.document = PlanDocument(self)
         self.autosaver = Autosaver(self.document, recovery_folder, autosave_interval_ms, self)
         self.controller = RunController(self.document, session, rate_hz=rate_hz, parent=self)
@@ -120,13 +101,22 @@ class MainWindow(QMainWindow):
             library_folder(setting=self.settings.library_folder()), self,
         )  # fmt: skip
         self.library.message.connect(self.show_message)
+        self.cells = CellControl(
+            session, self.controller, self.document, self.views, self.run_actions,
+            self.dialogs, self.show_message, self,
+        )  # fmt: skip
+        self.cell_combo = self.cells.combo
+        self.files = PlanFiles(
+            self.document, self.autosaver, self.dialogs, self.settings, self.show_message,
+            self.show_canvas, self,
+        )  # fmt: skip
         self._build_layout()
         self.actions_by_name: dict[str, QAction] = {}
         self._build_menus()
         self._wire_views()
         self._wire_run()
         self._restore_window()
-        self._update_title()
+        self.files.update_title()
 
     # ------------------------------------------------------------------ layout
 
@@ -139,61 +129,9 @@ class MainWindow(QMainWindow):
         self.central.addWidget(self.start_page)
         self.central.addWidget(self.views.canvas)
         self.setCentralWidget(self.central)
-        self.docks: dict[str, QDockWidget] = {}
-        area = Qt.DockWidgetArea
-        self._dock("palette", "Palette", self.views.palette, area.LeftDockWidgetArea)
-        self._dock("move", "Move", _scrolled(self.views.move), area.LeftDockWidgetArea)
-        self._dock("objects", "Objects", self.views.objects, area.LeftDockWidgetArea)
-        self.tabifyDockWidget(self.docks["palette"], self.docks["move"])
-        self.tabifyDockWidget(self.docks["move"], self.docks["objects"])
-        self.docks["palette"].raise_()
-        self._dock("inspector", "Inspector", self.views.inspector, area.RightDockWidgetArea)
-        # The cell's views; where they go depends on the window's width (arrange_cell_views).
-        self._dock("cameras", "Cameras", self.cell_views.cameras, area.RightDockWidgetArea)
-        self._dock("scene3d", "3D scene", self.cell_views.scene3d, area.RightDockWidgetArea)
-        self._dock("plan", "Plan", self.views.plan_settings, area.RightDockWidgetArea)
-        self._dock(
-            "waypoints", "Waypoints", _scrolled(self.views.waypoints), area.RightDockWidgetArea
+        self.docks = place_docks(
+            self, self.views, self.cell_views, self.operator_panel, self.running_panel
         )
-        self._dock("operator", "Operator", self.operator_panel, area.RightDockWidgetArea)
-        self._dock("library", "Library", self.views.library, area.LeftDockWidgetArea)
-        self.tabifyDockWidget(self.docks["palette"], self.docks["library"])
-        self.docks["palette"].raise_()
-        self.splitDockWidget(self.docks["inspector"], self.docks["plan"], Qt.Orientation.Vertical)
-        self.tabifyDockWidget(self.docks["plan"], self.docks["waypoints"])
-        self.tabifyDockWidget(self.docks["waypoints"], self.docks["operator"])
-        self.docks["plan"].raise_()  # the operator tab comes forward when the robot asks
-        bottom = [
-            ("validation", "Problems", self.views.validation),
-            ("log", "Log", self.views.log),
-            ("blackboard", "Blackboard", self.views.blackboard),
-            ("running", "Running nodes", self.running_panel),
-            ("inside", "Inside instance", self.views.inside),
-        ]
-        for name, title, widget in bottom:
-            self._dock(name, title, widget, area.BottomDockWidgetArea)
-        first = self.docks["validation"]
-        for name, _, _ in bottom[1:]:
-            self.tabifyDockWidget(first, self.docks[name])
-        first.raise_()
-        self.resizeDocks([first], [180], Qt.Orientation.Vertical)
-        # The inspector gets most of the right-hand column; the Plan tabs below it less.
-        self.resizeDocks(
-            [self.docks["inspector"], self.docks["plan"]], [700, 200], Qt.Orientation.Vertical
-        )
-        self.resizeDocks(
-            [self.docks["palette"], self.docks["inspector"]], [240, 320], Qt.Orientation.Horizontal
-        )
-        self.cell_label = QLabel(" Cell: ")
-        self.cell_combo = QComboBox(self)
-        self.cell_combo.setObjectName("CellCombo")
-        self.cell_combo.setToolTip(
-            "The cell plans run on: the simulated cell, none (no robot), or a cell file"
-        )
-        for name in self.session.cell_names():
-            self.cell_combo.addItem(name, name)
-        self.cell_combo.addItem(OPEN_CELL_FILE, "")  # data "": ask for a file
-        self._show_cell(self.session.name)
         self.robot_status = RobotStatusLabel(self.session, parent=self)
         self.problems_label = QLabel("")
         # permanent: a temporary status message would hide a normal status-bar widget
@@ -206,32 +144,10 @@ class MainWindow(QMainWindow):
         self.statusBar().addPermanentWidget(self.problems_label)
 
     def arrange_cell_views(self) -> None:
-        """Cameras above the 3D scene in a column of their own right of the inspector when
-        the window is wide enough for it (1700 px); tabs beside Plan, Waypoints and Operator
-        otherwise (the canvas and the inspector keep their room). Called when no saved layout is restored, and after a resize
-        for a picture."""
-        docks = self.docks
-        if self.width() >= 1700:
-            right, across = Qt.DockWidgetArea.RightDockWidgetArea, Qt.Orientation.Horizontal
-            self.addDockWidget(right, docks["cameras"], across)  # a full-height column
-            self.splitDockWidget(docks["cameras"], docks["scene3d"], Qt.Orientation.Vertical)
-            self.resizeDocks(
-                [docks["cameras"], docks["scene3d"]], [420, 480], Qt.Orientation.Vertical
-            )
-            self.resizeDocks(
-                [docks["palette"], docks["cameras"]], [240, 560], Qt.Orientation.Horizontal
-            )
-        else:
-            self.tabifyDockWidget(docks["operator"], docks["cameras"])
-            self.tabifyDockWidget(docks["cameras"], docks["scene3d"])
-            docks["plan"].raise_()
-
-    def _dock(self, name: str, title: str, widget: QWidget, area: Qt.DockWidgetArea) -> None:
-        dock = QDockWidget(title, self)
-        dock.setObjectName(f"{name}_dock")  # saveState needs names
-        dock.setWidget(widget)
-        self.addDockWidget(area, dock)
-        self.docks[name] = dock
+        """Place the cameras and the 3D scene for the window's width (see
+        window_layout.arrange_cell_views). Called when no saved layout is restored, and
+        after a resize for a picture."""
+        arrange_cell_views(self, self.docks)
 
     def _action(self, name: str, text: str, slot: Any, shortcut: str = "") -> QAction:
         action = QAction(text, self)
@@ -251,24 +167,29 @@ class MainWindow(QMainWindow):
         self.recent_menu = RecentFilesMenu(self.settings, self.open_plan, self)
         files.addMenu(self.recent_menu)
         files.addSeparator()
-        files.addAction(self._action("save", "&Save", self.save_plan, "Ctrl+S"))
-        files.addAction(self._action("save_as", "Save &As…", self.save_plan_as, "Ctrl+Shift+S"))
+        files.addAction(self._action("save", "&Save", self.files.save_plan, "Ctrl+S"))
+        files.addAction(
+            self._action("save_as", "Save &As…", self.files.save_plan_as, "Ctrl+Shift+S")
+        )
         files.addSeparator()
         files.addAction(
             self._action(
-                "export_xml", "&Export BehaviorTree.CPP XML…", lambda: export_plan_xml(self)
+                "export_xml",
+                "&Export BehaviorTree.CPP XML…",
+                lambda: export_plan_xml(self),
             )
         )
         files.addAction(
             self._action(
-                "import_xml", "&Import BehaviorTree.CPP XML…", lambda: import_plan_xml(self)
+                "import_xml",
+                "&Import BehaviorTree.CPP XML…",
+                lambda: import_plan_xml(self),
             )
         )
         files.addSeparator()
         files.addAction(self._action("quit", "&Quit", self.close, "Ctrl+Q"))
         self._build_edit_menus()
-        reset = self._action("reset_cell", "Reset &Cell", self.reset_cell, "Ctrl+R")
-        reset.setToolTip("Put the robot and the objects back where the scene starts them")
+        reset = self.actions_by_name["reset_cell"] = self.cells.reset_action
         run_menu = bar.addMenu("&Run")
         run_menu.addActions(self.run_actions.all())
         run_menu.addSeparator()
@@ -281,13 +202,16 @@ class MainWindow(QMainWindow):
         toolbar.addActions(self.run_actions.all())
         toolbar.addSeparator()
         toolbar.addAction(reset)
-        toolbar.addWidget(self.cell_label)
-        toolbar.addWidget(self.cell_combo)
+        toolbar.addWidget(self.cells.label)
+        toolbar.addWidget(self.cells.combo)
 
     def _build_edit_menus(self) -> None:
         edit = self.menuBar().addMenu("&Edit")
         stack = self.document.undo_stack
-        undo, redo = stack.createUndoAction(self, "&Undo"), stack.createRedoAction(self, "&Redo")
+        undo, redo = (
+            stack.createUndoAction(self, "&Undo"),
+            stack.createRedoAction(self, "&Redo"),
+        )
         undo.setShortcuts(QKeySequence.keyBindings(QKeySequence.StandardKey.Undo))
         redo.setShortcuts([QKeySequence("Ctrl+Shift+Z"), QKeySequence("Ctrl+Y")])
         self.actions_by_name.update(undo=undo, redo=redo)
@@ -333,16 +257,9 @@ class MainWindow(QMainWindow):
         )
         self.running_panel.node_selected.connect(self.select_node)
         self.failure_button.node_selected.connect(self.select_node)
-        self.session.registry_changed.connect(self._on_registry)
-        self.session.cell_changed.connect(self._on_cell_changed)
-        self.session.cell_failed.connect(self._on_cell_failed)
-        self.session.cell_opening.connect(self._on_cell_opening)
-        self.session.cell_ready.connect(lambda _ok: self._on_run_state(self.controller.state))
-        self.cell_combo.activated.connect(
-            lambda index: self.switch_cell(str(self.cell_combo.itemData(index) or ""))
-        )
-        document.dirty_changed.connect(lambda _: self._update_title())
-        document.path_changed.connect(lambda _: self._update_title())
+        self.cells.wire()
+        document.dirty_changed.connect(lambda _: self.files.update_title())
+        document.path_changed.connect(lambda _: self.files.update_title())
         document.plan_reset.connect(self._on_plan_reset)
         document.plan_changed.connect(self._leave_start_page_when_a_plan_shows)
         views.validation.revalidate()  # its first summary came before these connections
@@ -357,14 +274,19 @@ class MainWindow(QMainWindow):
         controller.log_message.connect(views.log.append)
         controller.running_nodes_changed.connect(self.running_panel.set_nodes)
         controller.failure_changed.connect(self.failure_button.show_failure)
-        controller.run_state_changed.connect(self._on_run_state)
+        controller.run_state_changed.connect(self.cells.follow_run_state)
         controller.run_state_changed.connect(
             lambda state: views.teacher.set_run_active(
                 state not in (ExecutorState.READY, ExecutorState.FINISHED)
             )
         )
         self.run_presenter = RunPresenter(
-            controller, views.canvas, views.blackboard, views.log, self.show_message, self
+            controller,
+            views.canvas,
+            views.blackboard,
+            views.log,
+            self.show_message,
+            self,
         )
         self.run_presenter.problems_shown.connect(lambda: self.docks["validation"].raise_())
 
@@ -476,7 +398,35 @@ class MainWindow(QMainWindow):
     def _node_path(self, node_id: str) -> str:
         return self.document.plan.path_of(node_id)
 
-    # ------------------------------------------------------------------ cell
+    # ------------------------------------------------------------------ cell and files
+    # The window's public commands; CellControl and PlanFiles implement them.
+
+    @property
+    def dialogs(self) -> Dialogs:
+        return self._dialogs
+
+    @dialogs.setter
+    def dialogs(self, dialogs: Dialogs) -> None:
+        """Replace the dialogs (a test does), also in CellControl and PlanFiles."""
+        self._dialogs = self.cells.dialogs = self.files.dialogs = dialogs
+
+    def switch_cell(self, name: str) -> None:
+        self.cells.switch_cell(name)
+
+    def reset_cell(self) -> None:
+        self.cells.reset_cell()
+
+    def maybe_save(self) -> bool:
+        return self.files.maybe_save()
+
+    def new_plan(self) -> None:
+        self.files.new_plan()
+
+    def open_plan(self, path: str | Path | None = None) -> bool:
+        return self.files.open_plan(path)
+
+    def offer_recoveries(self) -> bool:
+        return self.files.offer_recoveries()
 
     def _run_entries(self, node_id: str) -> list[tuple[str, Callable[[], None]]]:
         """The run commands of a node's context menu: resume from it after a run ended."""
@@ -487,164 +437,6 @@ class MainWindow(QMainWindow):
             self.controller.resume_from(node_id)  # a refused plan shows its problems
 
         return [("Resume from this node", resume)]
-
-    def _on_run_state(self, state: object) -> None:
-        """The cell chooser, Reset and Run follow the run's state; all wait while a cell opens."""
-        idle = state in (ExecutorState.READY, ExecutorState.FINISHED)
-        opening = bool(self.session.opening)
-        self.cell_combo.setEnabled(idle and not opening)
-        self.actions_by_name["reset_cell"].setEnabled(idle and not opening)
-        self.run_actions.update_state(state)
-        if opening:
-            self.run_actions.run.setEnabled(False)
-            self.run_actions.step.setEnabled(False)
-
-    def reset_cell(self) -> None:
-        """Put robot and objects back to the scene's start (not while a plan runs)."""
-        if self.controller.reset_cell(self.document.plan.scene):
-            self.views.canvas.clear_statuses()
-            self.show_message(f"The {self.session.name} cell was reset")
-        elif self.session.opening:
-            self.show_message(f"Wait until the {self.session.opening} cell is open.")
-        else:
-            self.show_message("Stop the run before resetting the cell.")
-
-    def _show_cell(self, name: str) -> None:
-        """Select ``name`` in the cell chooser (a cell file gets an entry of its own)."""
-        index = self.cell_combo.findData(name)
-        if index < 0:
-            index = self.cell_combo.count() - 1  # before "Open cell file…"
-            self.cell_combo.insertItem(index, Path(name).name, name)
-            self.cell_combo.setItemData(index, name, Qt.ItemDataRole.ToolTipRole)
-        self.cell_combo.setCurrentIndex(index)
-
-    def switch_cell(self, name: str) -> None:
-        """Open another cell: a name, a cell file, or "" to ask for one (not while running,
-        not while another opens). It opens in the background (see CellSession): the window
-        answers meanwhile, and the cell that was open stays in use until the new one is."""
-        if self.session.opening:
-            self._show_cell(self.session.opening)
-            self.show_message(
-                f"The {self.session.opening} cell is still opening; choose again when it is."
-            )
-            return
-        if not name:
-            folder = str(Path(self.session.name).parent) if Path(self.session.name).suffix else ""
-            name = self.dialogs.open_cell_path(self, folder)
-            if not name:
-                self._show_cell(self.session.name)
-                return
-        if name == self.session.name:
-            return
-        if self.controller.is_running:
-            self._show_cell(self.session.name)
-            self.show_message("Stop the run before switching the cell.")
-            return
-        self.session.open_in_background(name)
-
-    def _on_registry(self, registry: Any) -> None:
-        self.views.set_registry(registry)
-
-    def _on_cell_changed(self, name: str) -> None:
-        self._show_cell(name)
-        self.show_message(f"Cell in use: {name}")
-
-    def _on_cell_opening(self, name: str, words: str) -> None:
-        """(A background opening started) Say what it does until it ends; no run meanwhile."""
-        self._show_cell(name)
-        self.show_message(words, 0)
-        self._on_run_state(self.controller.state)
-
-    def _on_cell_failed(self, message: str) -> None:
-        self._show_cell(self.session.name)
-        still = f"still using the {self.session.name} cell" if self.session.cell else "no cell"
-        text = f"{message.rstrip('.')}; {still}"
-        self.show_message(text, 0)
-        self.views.log.append(text, "error")
-        self.dialogs.error(self, "Cell", message)
-
-    # ------------------------------------------------------------------ files
-
-    def _display_name(self) -> str:
-        path = self.document.path
-        return path.name if path is not None else (self.document.plan.name or "Untitled plan")
-
-    def _update_title(self) -> None:
-        marker = "*" if self.document.dirty else ""
-        self.setWindowTitle(f"{self._display_name()}{marker} — {APP_TITLE}")
-
-    def maybe_save(self) -> bool:
-        """Ask about unsaved changes; False when the user cancelled (or saving failed)."""
-        if not self.document.dirty:
-            return True
-        answer = self.dialogs.ask_save_changes(self, self._display_name())
-        if answer == SAVE:
-            return self.save_plan()
-        return answer == DISCARD
-
-    def new_plan(self) -> None:
-        if self.maybe_save():
-            self.document.new()
-            self.show_canvas()
-
-    def open_plan(self, path: str | Path | None = None) -> bool:
-        """Open a plan (asks for the file when ``path`` is None); False when not opened."""
-        if not self.maybe_save():
-            return False
-        if path is None:
-            path = self.dialogs.open_path(self, self.settings.last_dir())
-            if not path:
-                return False
-        try:
-            self.document.open(path)
-        except DocumentError as exc:
-            self.dialogs.error(self, "Cannot open the plan", str(exc))
-            return False
-        self.settings.add_recent(path)
-        self.show_message(f"Opened {path}")
-        return True
-
-    def save_plan(self) -> bool:
-        """Save to the plan's file; asks for a new one (Save As) when it has none or when
-        it is a shipped example, which stays as shipped (also after a crash recovery)."""
-        path = self.document.path
-        if path is None or is_shipped_example(path):
-            return self.save_plan_as()
-        return self._save_to(path)
-
-    def save_plan_as(self) -> bool:
-        last = self.settings.last_dir()
-        folder = Path(last) if last and not is_shipped_example(Path(last) / "x") else Path.home()
-        chosen = self.dialogs.save_path(self, str(folder / f"{self._display_name()}"))
-        if not chosen:
-            return False
-        path = Path(chosen)
-        if not path.name.endswith(".json"):
-            path = path.with_name(path.name + ".costar.json")
-        return self._save_to(path)
-
-    def _save_to(self, path: Path) -> bool:
-        try:
-            self.document.save(path)
-        except DocumentError as exc:
-            self.dialogs.error(self, "Cannot save the plan", str(exc))
-            return False
-        self.settings.add_recent(path)
-        self.show_message(f"Saved {path}")
-        return True
-
-    def offer_recoveries(self) -> bool:
-        """Offer the plans a crashed session left (newest first); True when one was restored.
-        Declined ones are deleted."""
-        restored = offer_recoveries(
-            self.document,
-            self.autosaver,
-            lambda text: self.dialogs.ask_restore(self, text),
-            lambda text: self.dialogs.error(self, "Cannot restore the plan", text),
-        )
-        if restored is not None:
-            self.show_message(f"Restored {restored.describe()}")
-        return restored is not None
 
     def _about(self) -> None:
         self.dialogs.about(
