@@ -53,7 +53,7 @@ class Views:
                 title = item.group.replace("_", " ").capitalize()
                 operations.setdefault(title, []).append((item.label, item.op))
         self.canvas.set_operations(operations)
-        self.inspector.setoffered_object_names(offered_object_names(registry.cell.interfaces()))
+        self.inspector.set_object_names(offered_object_names(registry.cell.interfaces()))
 
 
 def offered_object_names(interfaces: Any) -> list[str]:
