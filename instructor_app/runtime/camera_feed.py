@@ -152,7 +152,7 @@ class CameraFeed:
             next_due = max(next_due + 1.0 / max(self.fps, 0.1), now)
             seq += 1
             if own:
-                captured = self._capture(name, seq, lambda: camera.preview(self.size))
+                captured = self._capture(name, seq, lambda: camera.preview(self.size, ahead=True))
             else:
                 with self._cell_lock:
                     started = self._clock()
