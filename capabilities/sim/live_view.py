@@ -28,6 +28,7 @@ import socket
 import subprocess
 import sys
 import threading
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from multiprocessing.connection import Connection
@@ -44,6 +45,8 @@ __all__ = ["LiveView", "LiveViewError", "MirrorRecipe"]
 
 START_TIMEOUT = 60.0  # s: a fresh interpreter imports numpy and pybullet, builds the scene
 FRAME_TIMEOUT = 10.0  # s: one frame on a loaded machine
+# s: a frame asked for ahead and read later than this (the feed slept) is dropped for a new one
+STALE_AFTER = 0.5
 # Priority of a mirror process (added niceness): below the app's, so that the live pictures
 # take only spare CPU. Measured with bench/cell_views.py on the loaded 2-core VM (under Xvfb
 # the 3D scene's OpenGL is drawn by the CPU too): at niceness 0 the cameras got ~1.5x the
@@ -130,17 +133,50 @@ class _Mirror:
         self.process: Any = None
         self._closed = False
         self._failure = ""
+        # (when, size, believed pose) of the frame asked for ahead and not yet read
+        self._pending: tuple[float, tuple[int, int], Any] | None = None
 
-    def render(self, snapshot: Callable[[set[str]], CellSnapshot], size: tuple[int, int]) -> Any:
+    def render(
+        self,
+        snapshot: Callable[[set[str]], CellSnapshot],
+        size: tuple[int, int],
+        pose: Callable[[], Any],
+        ahead: bool = False,
+    ) -> tuple[Any, Any]:
+        """(the mirror's reply, ``pose()`` taken with its snapshot); ``ahead``: ask for the
+        next frame before returning, so that the mirror renders it while this one is shown."""
         with self._lock:
             conn = self._connection()
             try:
-                conn.send(_Request(snapshot(self.known), size))
-                if not conn.poll(FRAME_TIMEOUT):
-                    raise TimeoutError(f"no frame within {FRAME_TIMEOUT:.0f} s")
-                return conn.recv()
+                reply = self._pending_reply(conn, size, ahead)
+                if reply is None:
+                    conn.send(_Request(snapshot(self.known), size))
+                    reply = (self._receive(conn), pose())
+                if ahead:
+                    conn.send(_Request(snapshot(self.known), size))
+                    self._pending = (time.perf_counter(), size, pose())
+                return reply
             except (EOFError, OSError, TimeoutError) as exc:
                 raise self._stopped(str(exc) or type(exc).__name__) from exc
+
+    def _pending_reply(
+        self, conn: Connection, size: tuple[int, int], ahead: bool
+    ) -> tuple[Any, Any] | None:
+        """The frame asked for ahead, if this call wants one (``ahead``: a call without it
+        wants the cell now) and it has this size and is not stale."""
+        pending, self._pending = self._pending, None
+        if pending is None:
+            return None
+        asked, asked_size, pose = pending
+        reply = self._receive(conn)  # always read: the pipe holds one reply per request
+        fresh = ahead and asked_size == tuple(size) and time.perf_counter() - asked <= STALE_AFTER
+        return (reply, pose) if fresh else None
+
+    @staticmethod
+    def _receive(conn: Connection) -> Any:
+        if not conn.poll(FRAME_TIMEOUT):
+            raise TimeoutError(f"no frame within {FRAME_TIMEOUT:.0f} s")
+        return conn.recv()
 
     def _connection(self) -> Connection:
         if self._closed:
@@ -200,6 +236,7 @@ class _Mirror:
 
     def _shutdown(self) -> None:
         conn, process, self._conn = self._conn, self.process, None
+        self._pending = None
         if conn is not None:
             with contextlib.suppress(OSError):
                 conn.send(None)
@@ -235,25 +272,34 @@ class LiveView:
         self._mirrors = {name: _Mirror(recipe, camera) for name, camera in cameras.items()}
 
     def capture(
-        self, name: str, size: tuple[int, int], T_world_camera: Pose | None = None
+        self,
+        name: str,
+        size: tuple[int, int],
+        T_world_camera: Callable[[], Pose] | None = None,
+        ahead: bool = False,
     ) -> RGBDFrame:
         """A frame of camera ``name`` at ``size`` (width, height) showing the cell now.
 
         Args:
             name: the camera.
             size: image width and height.
-            T_world_camera: the pose to put on the frame (the cell's belief), default the
-                mirror's true camera pose.
+            T_world_camera: gives the pose to put on the frame (the cell's belief), taken
+                with the frame's snapshot; default the mirror's true camera pose.
+            ahead: for a live feed: ask for the next frame before returning, so that the
+                mirror renders it while this one is shown and the next call gets it at once.
+                The frame then shows the cell as it was at the previous call (its stamp
+                says when), unless that was more than ``STALE_AFTER`` seconds ago.
 
         Raises:
             LiveViewError: the mirror stopped or was closed (the message says why).
         """
         mirror = self._mirrors[name]
-        rgb, depth, true_pose, stamp = mirror.render(self._snapshot, size)
+        believed: Callable[[], Pose | None] = T_world_camera or (lambda: None)
+        (rgb, depth, true_pose, stamp), pose = mirror.render(self._snapshot, size, believed, ahead)
         config = dataclasses.replace(mirror.camera.config, width=size[0], height=size[1])
         return RGBDFrame(
             rgb=rgb, depth=depth, K=config.intrinsics(),
-            T_world_camera=T_world_camera or true_pose, stamp=stamp, camera=name,
+            T_world_camera=pose or true_pose, stamp=stamp, camera=name,
         )  # fmt: skip
 
     def pids(self) -> dict[str, int]:

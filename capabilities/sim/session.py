@@ -93,9 +93,11 @@ class SimCameraDevice:
 
         return self._cell.call(render)
 
-    def preview(self, size: tuple[int, int]) -> RGBDFrame:
+    def preview(self, size: tuple[int, int], ahead: bool = False) -> RGBDFrame:
         """A live picture at ``size`` (width, height) for a view of the cell, rendered by the
         session's mirror in another process: the physics thread only takes a snapshot.
+        ``ahead`` (a live feed): the mirror renders the next picture while this one is shown
+        (a picture then shows the cell as at the previous call; see ``LiveView.capture``).
 
         Not for perception: use :meth:`capture` (exact, rendered on the physics thread).
 
@@ -104,7 +106,7 @@ class SimCameraDevice:
         """
         if self.live is None:
             return self.capture(size)
-        return self.live.capture(self.name, size, self.extrinsics())
+        return self.live.capture(self.name, size, self.extrinsics, ahead)
 
     def _resized(self, size: tuple[int, int]) -> SimCamera:
         config = self.camera.config

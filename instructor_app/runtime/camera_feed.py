@@ -1,7 +1,7 @@
 """Live frames of the cell's RGB-D cameras for the GUI, captured on a thread of their own.
 
 A camera's ``capture()`` blocks its caller while the cell renders, so neither the GUI thread
-nor the engine's may call it. A camera that also has ``preview(size)`` (the simulated cell's:
+nor the engine's may call it. A camera that also has ``preview(size, ahead)`` (the simulated cell's:
 pictures rendered by a mirror of the cell in a process of its own, see
 ``capabilities/sim/live_view.py``) gives live pictures without holding the cell's physics
 thread; any other capture holds the cell and is limited to a share of the time.
@@ -133,8 +133,9 @@ class CameraFeed:
 
     def _run(self, name: str) -> None:
         camera = self.cameras[name]
-        # A camera with ``preview(size)`` renders its live pictures away from the cell (the
-        # simulated cell's mirror process): nothing to spare, it runs at the target rate.
+        # A camera with ``preview(size, ahead)`` renders its live pictures away from the cell
+        # (the simulated cell's mirror process): nothing to spare, it runs at the target rate.
+        # ``ahead``: the mirror renders the next frame while this thread draws and waits.
         # Any other capture holds the cell: the duty limit, shared by all such cameras.
         own = self.size is not None and callable(getattr(camera, "preview", None))
         next_due, seq = 0.0, 0
@@ -152,7 +153,7 @@ class CameraFeed:
             next_due = max(next_due + 1.0 / max(self.fps, 0.1), now)
             seq += 1
             if own:
-                captured = self._capture(name, seq, lambda: camera.preview(self.size))
+                captured = self._capture(name, seq, lambda: camera.preview(self.size, ahead=True))
             else:
                 with self._cell_lock:
                     started = self._clock()

@@ -24,6 +24,7 @@ import numpy as np
 import pytest
 
 from capabilities.bullet import pybullet as p
+from capabilities.sim import live_view
 from capabilities.sim.cameras import _CV_TO_GL, SimCamera
 from capabilities.sim.live_view import LiveViewError
 from capabilities.sim.scene import yaw_pose
@@ -129,6 +130,24 @@ def test_the_mirror_shows_what_the_physics_thread_renders_as_the_cell_changes(
     _assert_same_picture(cell, "shoulder")
     frame = _rendered(cell, "shoulder").preview(SIZE)
     assert 0.0 < frame.stamp <= cell.clock()  # stamped with the simulated time it shows
+
+
+def test_a_live_feed_gets_the_frame_it_asked_for_ahead_but_never_a_stale_one(
+    cell: SimCellSession, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    device = _rendered(cell, "wrist")
+    device.preview(SIZE, ahead=True)  # the mirror renders the next frame meanwhile
+    asked = cell.clock()
+    cell.sim.wait_sim(0.05)
+    ahead = device.preview(SIZE, ahead=True)
+    assert 0.0 < ahead.stamp <= asked  # the frame asked for at the previous call
+    assert ahead.T_world_camera == device.extrinsics()  # the belief taken with it
+    now = cell.clock()
+    assert device.preview(SIZE).stamp >= now  # a call without ``ahead`` wants the cell now
+    device.preview(SIZE, ahead=True)
+    monkeypatch.setattr(live_view, "STALE_AFTER", 0.0)
+    later = cell.clock()
+    assert device.preview(SIZE, ahead=True).stamp >= later  # the one asked for is stale
 
 
 def test_the_mirrors_end_with_the_cell() -> None:
