@@ -110,7 +110,10 @@ def _serve(conn: Connection) -> None:
         apply_snapshot(client, world, scene, request.snapshot)
         view = sized.setdefault(request.size, _resized(camera, request.size))
         frame = view.capture(client, stamp=request.snapshot.stamp)
-        conn.send((frame.rgb, frame.depth, frame.T_world_camera, frame.stamp))
+        try:
+            conn.send((frame.rgb, frame.depth, frame.T_world_camera, frame.stamp))
+        except OSError:  # the cell closed while a frame asked for ahead was on its way: end
+            break
     p.disconnect(client)
 
 
