@@ -25,8 +25,9 @@ PLAN = Path(__file__).resolve().parents[3] / "resources" / "examples" / "tending
 OPERATOR = "operator resets the cell, presses Continue"
 WATCH = "wait for the welding arm"
 # Paced: perception takes wall time, and as fast as possible a part could come and go while
-# a camera's image is searched.
-SPEED = 4.0
+# a camera's image is searched. Twice real time leaves room for a loaded CI machine (at four
+# times, two parallel test workers made the robot miss part 2 once).
+SPEED = 2.0
 
 
 class Trial:
@@ -104,7 +105,7 @@ def test_a_bad_weld_stops_the_robot_until_the_operator_resets_it(tmp_path: Path)
         trial = Trial(session, press=True)
         bender = session.bender
         assert bender is not None
-        trial.run(until=bender.plan[-1].offset + 20.0)
+        trial.run(until=bender.plan[-1].offset + 30.0)
         kinds = [(e.kind, e.part) for e in bender.events()]
         assert kinds == [("released", "part_001"), ("weld_broke", "part_001"),
                          ("released", "part_002")]  # fmt: skip
