@@ -212,7 +212,9 @@ def test_a_killed_controller_mid_move_holds_the_run_with_connection_lost(
 ) -> None:
     cell_file = tmp_path / "emulated.cell.json"
     emulator = start_emulator("5.12", write_cell=cell_file)
-    plan, _ = _plan(tmp_path, (1.2,), speed=0.5)
+    # Slow: the move must still be going when the kill lands, also on a loaded machine (at
+    # speed 0.5 it once ended first and the run finished with nothing to hold).
+    plan, _ = _plan(tmp_path, (1.2,), speed=0.1)
     events: list[Event] = []
     with open_cell(str(cell_file)) as cell:
         executor = _run(cell, plan, events)
