@@ -297,10 +297,12 @@ class EmulatedController:
         return self.cell.robot.is_moving()
 
     def _watch(self, handle: CommandHandle) -> CommandHandle:
-        """A move that fails on its own (unreachable, path error) ends the script, as on a UR."""
+        """A move that fails on its own (unreachable, path error) ends the script, as on a UR;
+        a collision is the arm's protective stop, which the next cycle raises instead."""
 
         def finished(h: CommandHandle) -> None:
-            if not h.ok and not h.cancel_requested:
+            collided = self.cell.robot.protective_stop() is not None
+            if not h.ok and not h.cancel_requested and not collided:
                 threading.Thread(
                     target=self.end_program, args=(f"script error: {h.message}",), daemon=True
                 ).start()

@@ -92,3 +92,37 @@ def test_clearing_fails_with_emergency_stop_which_a_plan_may_not_clear(
     (error, message), *_ = _failures(events, "clear")
     assert error == ErrorType.EMERGENCY_STOP.value, message
     assert "for the operator to clear" in message
+
+
+def test_a_collision_of_the_emulated_arm_is_the_controllers_protective_stop(
+    tmp_path: Path, start_emulator
+) -> None:
+    from capabilities.sim.testing import down_at
+
+    cell_file = tmp_path / "emulated.cell.json"
+    emulator = start_emulator("5.12", write_cell=cell_file)
+    subtree = load_subtree(CLEAR_STOP)
+    body = NodeSpec(NodeKind.SEQUENCE, "pick", "pick", children=[
+        NodeSpec(NodeKind.OPERATION, "above", "above", op="motion.move_to", params={
+            "target": Binding.fixed(down_at(0.5, 0.0, 0.15), ParamType.POSE)}),
+        NodeSpec(NodeKind.OPERATION, "down", "down", op="motion.move_to", params={
+            "target": Binding.fixed(down_at(0.5, 0.0, -0.05), ParamType.POSE),
+            "mode": Binding.fixed("linear", ParamType.TEXT),
+            "speed": Binding.fixed(0.4, ParamType.NUMBER)}),
+    ])  # fmt: skip
+    handler = NodeSpec(NodeKind.SUBTREE, "recover", "recover", subtree=subtree.ref)
+    catch = NodeSpec(NodeKind.CATCH, "catch", "catch", children=[body, handler], params={
+        "errors": Binding.fixed("protective_stop", ParamType.TEXT),
+    })  # fmt: skip
+    events: list[Event] = []
+    with open_cell(str(cell_file)) as cell:
+        plan = PlanSpec(catch, "into the table", subtrees=[subtree])
+        tree = build_tree(plan, CapabilityRegistry(cell=cell), clock=cell.clock)
+        executor = Executor(tree, 20.0, [events.append], hold=hold_check(cell))
+        executor.start()
+        result = executor.wait(90)
+        assert result is not None and result.status is SUCCESS, result
+    (error, message), *_ = _failures(events, "down")
+    assert error == ErrorType.PROTECTIVE_STOP.value and PROTECTIVE_STOP in message, message
+    assert any("on the table" in m for m in emulator.state()["messages"])  # the arm's cause
+    assert emulator.state()["q"] == pytest.approx(list(HOME), abs=0.01)
