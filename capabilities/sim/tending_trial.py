@@ -1,0 +1,225 @@
+"""A trial of a wire-bender tending plan on the simulated ``tending`` cell (paper, V-B).
+
+:class:`TendingTrial` runs a plan (the paper's ``tending_paper.costar.json`` or ours) through
+the engine on a :class:`SimCellSession` of a scene with a bender, for the bender's parts (or
+its first N), and scores it as Table I does (``tending_score``). As on site:
+
+- The bender starts when the robot first watches it (the first occupancy operation runs):
+  setting up the run costs none of the bender's parts.
+- An operator (:class:`OperatorModel`) answers a plan that waits for one (a
+  ``collaboration.wait_for_button``): after ``reset_s`` simulated seconds (the paper: "the
+  robot would need to be stopped and reset ... the bender kept producing parts") the operator
+  clears away what lies loose in the cell (parts and pieces at the exit or dropped: lost)
+  and presses Continue.
+- The trial ends once the bender released its last part and everything settled (every
+  part in a tote or taken away), or ``tail`` simulated seconds after that last release.
+
+Ground truth (the bender's events, object poses) is read only to score and to play the
+operator, never by the plan.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from capabilities.base import CapabilityRegistry
+from capabilities.bullet import pybullet as p
+from capabilities.sim.errors import SimError
+from capabilities.sim.session import SimCellSession
+from capabilities.sim.tending_score import TrialCounters, loose_things, score_trial
+from engine.build import build_tree
+from engine.events import Event, StatusChanged
+from engine.executor import Executor
+from engine.files import load_plan
+from engine.status import Status
+from engine.validation import has_errors, validate_plan
+
+__all__ = ["OperatorModel", "TendingTrial", "TrialError"]
+
+OPERATOR_OPS = frozenset({"collaboration.wait_for_button"})
+WATCH_PREFIX = "occupancy."  # the first of these to run starts the bender
+POLL = 0.5  # simulated seconds between the trial's looks at the cell
+SETTLE = 1.0  # simulated seconds things get to settle before the score
+
+
+class TrialError(SimError):
+    """A trial could not run (no bender, an invalid plan, out of wall time)."""
+
+
+@dataclass(frozen=True)
+class OperatorModel:
+    """The person who resets the cell when the plan stops for them.
+
+    Attributes:
+        reset_s: simulated seconds from the plan's call until Continue (walking over,
+            clearing the exit, pressing the button); the bender goes on meanwhile.
+        present: False: nobody answers (a plan that calls stays stopped).
+    """
+
+    reset_s: float = 30.0
+    present: bool = True
+
+
+class TendingTrial:
+    """One trial of ``plan`` on ``session`` (whose scene has a bender not started yet).
+
+    Args:
+        session: a session made with ``start_actors=False``.
+        plan: the plan file.
+        operator: who answers the plan's calls.
+        rate_hz: the executor's tick rate.
+
+    Attributes:
+        calls: simulated times at which the plan called the operator.
+        stops: for each call, the last operation that failed before it ("" if none).
+    """
+
+    def __init__(
+        self,
+        session: SimCellSession,
+        plan: Path,
+        operator: OperatorModel | None = None,
+        rate_hz: float = 50.0,
+    ) -> None:
+        if session.bender is None:
+            raise TrialError(f"the scene {session.scene.name!r} has no wire bender")
+        self.session = session
+        self.operator = operator or OperatorModel()
+        self.calls: list[float] = []
+        self.stops: list[str] = []
+        self._lock = threading.Lock()
+        self._pending: list[float] = []  # simulated times the operator presses Continue
+        self._removed: set[int] = set()
+        self._last_failure = ""
+        registry = CapabilityRegistry(cell=session)
+        spec = load_plan(plan, registry.aliases())
+        problems = validate_plan(spec, registry)
+        if has_errors(problems):
+            errors = "; ".join(str(x) for x in problems if x.severity == "error")
+            raise TrialError(f"{plan}: the plan is not valid: {errors}")
+        self._nodes = {node.id: (node.label, node.op or "") for _, node in spec.walk()}
+        tree = build_tree(spec, registry, clock=session.clock)
+        self.executor = Executor(tree, rate_hz, [self._heard])
+
+    # ------------------------------------------------------------------ the plan's events
+
+    def _heard(self, event: Event) -> None:
+        if not isinstance(event, StatusChanged):
+            return
+        label, op = self._nodes.get(event.node_id, ("", ""))
+        if event.new is Status.FAILURE and op and op not in OPERATOR_OPS:
+            self._last_failure = f"{label}: {event.message}"
+        if event.new is not Status.RUNNING:
+            return
+        if op.startswith(WATCH_PREFIX):
+            self.session.start_actors()  # from the first watch on; later calls do nothing
+        if op in OPERATOR_OPS:
+            now = self.session.clock()
+            with self._lock:
+                self.calls.append(now)
+                self.stops.append(self._last_failure)
+                if self.operator.present:
+                    self._pending.append(now + self.operator.reset_s)
+
+    # ------------------------------------------------------------------ the operator
+
+    def _operate(self) -> None:
+        """Reset the cell and press Continue for each call whose reset time has come."""
+        now = self.session.clock()
+        with self._lock:
+            due = [t for t in self._pending if t <= now]
+            self._pending = [t for t in self._pending if t > now]
+        for _ in due:
+            self._clear_cell()
+            self.session.operator.press("continue")
+
+    def _clear_cell(self) -> None:
+        """Take away every loose part and piece (as the operator does: they are lost)."""
+        session, bender = self.session, self.session.bender
+        assert bender is not None
+
+        def clear(client: int) -> None:
+            parts, pieces = loose_things(client, bender, session.scene)
+            for name in parts:
+                session.scene.remove(client, name)
+            for body in pieces:
+                p.removeBody(body, physicsClientId=client)
+                self._removed.add(body)
+
+        session.sim.call(clear)
+
+    def _settled(self) -> bool:
+        """Nothing loose, nothing held, no call of the operator open."""
+        session, bender = self.session, self.session.bender
+        assert bender is not None
+        with self._lock:
+            if self._pending:
+                return False
+        if session.sim.gripper.is_holding():
+            return False
+
+        def loose(client: int) -> bool:
+            parts, pieces = loose_things(client, bender, session.scene)
+            return bool(parts or [b for b in pieces if b not in self._removed])
+
+        return not session.sim.call(loose)
+
+    # ------------------------------------------------------------------ the run
+
+    def run(
+        self, parts: int | None = None, tail: float = 60.0, wall_timeout: float | None = None
+    ) -> TrialCounters:
+        """Run the trial and score it.
+
+        Args:
+            parts: only the bender's first ``parts`` parts (None: all of its plan).
+            tail: simulated seconds after the last release at which the trial ends anyway.
+            wall_timeout: wall seconds after which TrialError is raised (None: no bound).
+        """
+        bender = self.session.bender
+        assert bender is not None
+        if parts is not None:
+            if bender.start_time is not None:
+                raise TrialError("the bender already started: its parts are set")
+            bender.plan = bender.plan[:parts]
+        deadline = None if wall_timeout is None else time.monotonic() + wall_timeout
+        self.executor.start()
+        try:
+            self._run_until_done(tail, deadline)
+        finally:
+            self.executor.stop("trial over")
+            self.executor.wait(10.0)
+        self.session.sim.wait_sim(SETTLE)
+        return self.score()
+
+    def _run_until_done(self, tail: float, deadline: float | None) -> None:
+        session, bender = self.session, self.session.bender
+        assert bender is not None
+        while self.executor.result is None:
+            if deadline is not None and time.monotonic() > deadline:
+                raise TrialError(f"the trial ran out of wall time at {session.clock():.0f} s")
+            session.sim.wait_sim(POLL)
+            self._operate()
+            released = bender.produced()
+            if not bender.plan or len(released) < len(bender.plan):
+                continue
+            since = session.clock() - released[-1].time
+            if since >= tail or (since > SETTLE and self._settled()):
+                return
+
+    def score(self) -> TrialCounters:
+        """Table I's counters now (ground truth)."""
+        session, bender = self.session, self.session.bender
+        assert bender is not None
+        start = bender.start_time or 0.0
+        with self._lock:
+            calls = len(self.calls)
+
+        def count(client: int) -> TrialCounters:
+            elapsed = session.sim.time() - start
+            return score_trial(client, bender, session.scene, self._removed, calls, elapsed)
+
+        return session.sim.call(count)
