@@ -33,7 +33,7 @@ from engine.types import Pose
 __all__ = ["TrialCounters", "container_of", "loose_things", "score_trial"]
 
 RACK = "rack"  # the scene object whose tote counts as caught; other totes are scrap bins
-TOTE_TOP = 0.08  # m above a tote's frame: higher is not in it (held over it, lying on it)
+TOTE_TOP = 0.08  # m above a tote's frame when its block names no "rim": higher is not in it
 
 
 @dataclass(frozen=True)
@@ -71,7 +71,8 @@ def _in_tote(tote: Mapping[str, Any], frame: Pose, where: Pose) -> bool:
     x, y, z = frame.inverse().compose(where).position
     (cx, cy), (ix, iy) = tote["center"], tote["inner"]
     floor = float(tote["floor"])
-    return abs(x - cx) < ix / 2 and abs(y - cy) < iy / 2 and floor - 0.002 < z < TOTE_TOP
+    top = float(tote.get("rim", TOTE_TOP))  # held over it or lying on it is not in it
+    return abs(x - cx) < ix / 2 and abs(y - cy) < iy / 2 and floor - 0.002 < z < top
 
 
 def _totes(client: int, scene: SceneState) -> list[tuple[str, Mapping[str, Any], Pose]]:
