@@ -170,7 +170,11 @@ class TendingTrial:
     # ------------------------------------------------------------------ the run
 
     def run(
-        self, parts: int | None = None, tail: float = 60.0, wall_timeout: float | None = None
+        self,
+        parts: int | None = None,
+        tail: float = 60.0,
+        wall_timeout: float | None = None,
+        until: float | None = None,
     ) -> TrialCounters:
         """Run the trial and score it.
 
@@ -178,6 +182,8 @@ class TendingTrial:
             parts: only the bender's first ``parts`` parts (None: all of its plan).
             tail: simulated seconds after the last release at which the trial ends anyway.
             wall_timeout: wall seconds after which TrialError is raised (None: no bound).
+            until: end this many simulated seconds after the bender started, whatever is
+                left to do (a soak).
         """
         bender = self.session.bender
         assert bender is not None
@@ -188,14 +194,14 @@ class TendingTrial:
         deadline = None if wall_timeout is None else time.monotonic() + wall_timeout
         self.executor.start()
         try:
-            self._run_until_done(tail, deadline)
+            self._run_until_done(tail, deadline, until)
         finally:
             self.executor.stop("trial over")
             self.executor.wait(10.0)
         self.session.sim.wait_sim(SETTLE)
         return self.score()
 
-    def _run_until_done(self, tail: float, deadline: float | None) -> None:
+    def _run_until_done(self, tail: float, deadline: float | None, until: float | None) -> None:
         session, bender = self.session, self.session.bender
         assert bender is not None
         while self.executor.result is None:
@@ -203,6 +209,9 @@ class TendingTrial:
                 raise TrialError(f"the trial ran out of wall time at {session.clock():.0f} s")
             session.sim.wait_sim(POLL)
             self._operate()
+            start = bender.start_time
+            if until is not None and start is not None and session.clock() - start >= until:
+                return
             released = bender.produced()
             if not bender.plan or len(released) < len(bender.plan):
                 continue
