@@ -7,10 +7,11 @@ its first N), and scores it as Table I does (``tending_score``). As on site:
 - The bender starts when the robot first watches it (the first occupancy operation runs):
   setting up the run costs none of the bender's parts.
 - An operator (:class:`OperatorModel`) answers a plan that waits for one (a
-  ``collaboration.wait_for_button``): after ``reset_s`` simulated seconds (the paper: "the
-  robot would need to be stopped and reset ... the bender kept producing parts") the operator
-  clears away what lies loose in the cell (parts and pieces at the exit or dropped: lost)
-  and presses Continue.
+  ``collaboration.wait_for_button``) or a run held by a protective stop its plan does not
+  catch: after ``reset_s`` simulated seconds (the paper: "the robot would need to be stopped
+  and reset ... the bender kept producing parts") the operator clears away what lies loose in
+  the cell (parts and pieces at the exit or dropped: lost), unlocks a protective stop and
+  presses Continue.
 - The trial ends once the bender released its last part and everything settled (every
   part in a tote or taken away), or ``tail`` simulated seconds after that last release.
 
@@ -27,11 +28,12 @@ from pathlib import Path
 
 from capabilities.base import CapabilityRegistry
 from capabilities.bullet import pybullet as p
+from capabilities.faults import hold_check
 from capabilities.sim.errors import SimError
 from capabilities.sim.session import SimCellSession
 from capabilities.sim.tending_score import TrialCounters, loose_things, score_trial
 from engine.build import build_tree
-from engine.events import Event, StatusChanged
+from engine.events import Event, RunHeld, StatusChanged
 from engine.executor import Executor
 from engine.files import load_plan
 from engine.status import Status
@@ -73,8 +75,9 @@ class TendingTrial:
         rate_hz: the executor's tick rate.
 
     Attributes:
-        calls: simulated times at which the plan called the operator.
-        stops: for each call, the last operation that failed before it ("" if none).
+        calls: simulated times at which the plan (or a held run) called the operator.
+        stops: for each call, the last operation that failed before it ("" if none), or
+            why the run was held.
     """
 
     def __init__(
@@ -91,7 +94,7 @@ class TendingTrial:
         self.calls: list[float] = []
         self.stops: list[str] = []
         self._lock = threading.Lock()
-        self._pending: list[float] = []  # simulated times the operator presses Continue
+        self._pending: list[tuple[float, bool]] = []  # when the operator resets; press?
         self._removed: set[int] = set()
         self._last_failure = ""
         registry = CapabilityRegistry(cell=session)
@@ -102,11 +105,13 @@ class TendingTrial:
             raise TrialError(f"{plan}: the plan is not valid: {errors}")
         self._nodes = {node.id: (node.label, node.op or "") for _, node in spec.walk()}
         tree = build_tree(spec, registry, clock=session.clock)
-        self.executor = Executor(tree, rate_hz, [self._heard])
+        self.executor = Executor(tree, rate_hz, [self._heard], hold=hold_check(session))
 
     # ------------------------------------------------------------------ the plan's events
 
     def _heard(self, event: Event) -> None:
+        if isinstance(event, RunHeld) and event.reason:
+            self._call(f"held: {event.reason}", press=False)
         if not isinstance(event, StatusChanged):
             return
         label, op = self._nodes.get(event.node_id, ("", ""))
@@ -117,12 +122,17 @@ class TendingTrial:
         if op.startswith(WATCH_PREFIX):
             self.session.start_actors()  # from the first watch on; later calls do nothing
         if op in OPERATOR_OPS:
-            now = self.session.clock()
-            with self._lock:
-                self.calls.append(now)
-                self.stops.append(self._last_failure)
-                if self.operator.present:
-                    self._pending.append(now + self.operator.reset_s)
+            self._call(self._last_failure, press=True)
+
+    def _call(self, why: str, press: bool) -> None:
+        """The operator is called now (comes ``reset_s`` later if present); ``press``: the
+        plan waits for Continue (a held run does not: a press would wait for the next)."""
+        now = self.session.clock()
+        with self._lock:
+            self.calls.append(now)
+            self.stops.append(why)
+            if self.operator.present:
+                self._pending.append((now + self.operator.reset_s, press))
 
     # ------------------------------------------------------------------ the operator
 
@@ -130,11 +140,14 @@ class TendingTrial:
         """Reset the cell and press Continue for each call whose reset time has come."""
         now = self.session.clock()
         with self._lock:
-            due = [t for t in self._pending if t <= now]
-            self._pending = [t for t in self._pending if t > now]
-        for _ in due:
+            due = [press for t, press in self._pending if t <= now]
+            self._pending = [(t, press) for t, press in self._pending if t > now]
+        for press in due:
             self._clear_cell()
-            self.session.operator.press("continue")
+            if self.session.hold_reason():
+                self.session.clear()  # on the pendant: unlocks once the delay allows
+            if press:
+                self.session.operator.press("continue")
 
     def _clear_cell(self) -> None:
         """Take away every loose part and piece (as the operator does: they are lost)."""
