@@ -175,8 +175,8 @@ def _arguments(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument(
         "--speed",
         type=float,
-        default=SPEED,
-        help="tending: times real time while nothing perceives (0: unpaced)",
+        default=SPEED or 0.0,
+        help="tending: times real time at most (0: as fast as lockstep allows)",
     )
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     return parser.parse_args(argv)  # fmt: skip

@@ -141,6 +141,14 @@ class SimCell:
         """A block in which simulated time stands still (see ``PhysicsThread``)."""
         return self._physics.standing_still()
 
+    def add_gate(self, may_step: Callable[[], bool]) -> None:
+        """Step only while ``may_step()`` says True (see ``PhysicsThread.add_gate``)."""
+        self._physics.add_gate(may_step)
+
+    def nudge(self) -> None:
+        """Look at the gates again now (see ``PhysicsThread.nudge``)."""
+        self._physics.nudge()
+
     def wait_sim(self, seconds: float) -> None:
         """Block until simulated time has advanced by ``seconds`` (tests, CLI)."""
         if not self._physics.wait_sim(seconds, timeout=max(60.0, seconds * 10)):

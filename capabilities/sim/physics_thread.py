@@ -66,6 +66,7 @@ class PhysicsThread:
         self._timer_lock = threading.Lock()
         self._holds = 0  # blocks in standing_still: while above 0 the world is not stepped
         self._hold_lock = threading.Lock()
+        self._gates: list[Callable[[], bool]] = []  # all must say True for a step
         self._ready = threading.Event()
         self._stopping = threading.Event()
         self._setup_error: BaseException | None = None
@@ -159,7 +160,18 @@ class PhysicsThread:
         finally:
             with self._hold_lock:
                 self._holds -= 1
-            self._queue.put((lambda _client: None, Future()))  # wake a loop waiting on calls
+            self.nudge()  # wake a loop waiting on calls
+
+    def add_gate(self, may_step: Callable[[], bool]) -> None:
+        """Step the world only while ``may_step()`` (any thread's state; keep it cheap) says
+        True: lockstep with another loop, e.g. an engine that must not fall behind. Whoever
+        changes what the gate reads calls :meth:`nudge`."""
+        self._gates.append(may_step)
+
+    def nudge(self) -> None:
+        """Wake a loop that stands still, to look at its gates again (any thread)."""
+        if self.running:
+            self._queue.put((lambda _client: None, Future()))
 
     # ------------------------------------------------------------------ loop
 
@@ -186,7 +198,7 @@ class PhysicsThread:
         sim_start = self._time
         while not self._stopping.is_set():
             self._drain()
-            if self._holds:
+            if self._holds or not all(gate() for gate in self._gates):
                 self._stand_still()
                 continue
             self._step_once()

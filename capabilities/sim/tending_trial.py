@@ -12,6 +12,10 @@ its first N), and scores it as Table I does (``tending_score``). As on site:
   and reset ... the bender kept producing parts") the operator clears away what lies loose in
   the cell (parts and pieces at the exit or dropped: lost), unlocks a protective stop and
   presses Continue.
+- With ``lead`` the world never runs more than ``lead`` simulated seconds ahead of the
+  engine's last tick (a gate of the physics thread): with a lockstep session (time stands
+  still while perception computes) a run as fast as possible then reacts as a 50 Hz
+  controller would, however loaded the machine.
 - The trial ends once the bender released its last part and everything settled (every
   part in a tote or taken away), or ``tail`` simulated seconds after that last release.
 
@@ -36,6 +40,7 @@ from engine.build import build_tree
 from engine.events import Event, RunHeld, StatusChanged
 from engine.executor import Executor
 from engine.files import load_plan
+from engine.hold import Hold
 from engine.status import Status
 from engine.validation import has_errors, validate_plan
 
@@ -73,6 +78,7 @@ class TendingTrial:
         plan: the plan file.
         operator: who answers the plan's calls.
         rate_hz: the executor's tick rate.
+        lead: simulated seconds the world may run ahead of the engine (None: no bound).
 
     Attributes:
         calls: simulated times at which the plan (or a held run) called the operator.
@@ -86,6 +92,7 @@ class TendingTrial:
         plan: Path,
         operator: OperatorModel | None = None,
         rate_hz: float = 50.0,
+        lead: float | None = None,
     ) -> None:
         if session.bender is None:
             raise TrialError(f"the scene {session.scene.name!r} has no wire bender")
@@ -97,6 +104,7 @@ class TendingTrial:
         self._pending: list[tuple[float, bool]] = []  # when the operator resets; press?
         self._removed: set[int] = set()
         self._last_failure = ""
+        self._engine_at: float | None = None  # simulated time of the engine's last tick
         registry = CapabilityRegistry(cell=session)
         spec = load_plan(plan, registry.aliases())
         problems = validate_plan(spec, registry)
@@ -105,7 +113,23 @@ class TendingTrial:
             raise TrialError(f"{plan}: the plan is not valid: {errors}")
         self._nodes = {node.id: (node.label, node.op or "") for _, node in spec.walk()}
         tree = build_tree(spec, registry, clock=session.clock)
-        self.executor = Executor(tree, rate_hz, [self._heard], hold=hold_check(session))
+        self._cell_hold = hold_check(session)
+        self.executor = Executor(tree, rate_hz, [self._heard], hold=self._before_tick)
+        if lead is not None:
+            bound = lead
+            session.sim.add_gate(lambda: self._engine_at is None or self._lag() <= bound)
+
+    # ------------------------------------------------------------------ the engine
+
+    def _before_tick(self) -> Hold | None:
+        """The executor's hold check, asked before every tick: the engine is here now."""
+        self._engine_at = self.session.clock()
+        self.session.sim.nudge()
+        return self._cell_hold() if self._cell_hold is not None else None
+
+    def _lag(self) -> float:
+        at = self._engine_at
+        return 0.0 if at is None else self.session.clock() - at
 
     # ------------------------------------------------------------------ the plan's events
 
@@ -205,12 +229,14 @@ class TendingTrial:
                 raise TrialError("the bender already started: its parts are set")
             bender.plan = bender.plan[:parts]
         deadline = None if wall_timeout is None else time.monotonic() + wall_timeout
+        self._engine_at = self.session.clock()  # the gate holds until the engine ticks
         self.executor.start()
         try:
             self._run_until_done(tail, deadline, until)
         finally:
             self.executor.stop("trial over")
             self.executor.wait(10.0)
+            self._engine_at = None  # no engine any more: the world goes on
         self.session.sim.wait_sim(SETTLE)
         return self.score()
 
