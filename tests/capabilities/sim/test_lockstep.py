@@ -81,3 +81,18 @@ def test_the_physics_thread_cannot_hold_itself(physics: PhysicsThread) -> None:
 
     with pytest.raises(SimError, match="other threads"):
         physics.call(hold)
+
+
+def test_a_closed_gate_stops_the_world_until_it_opens_and_nudges(physics: PhysicsThread) -> None:
+    """A follower (the engine) that falls behind holds the world; its tick opens it again."""
+    engine_at = [physics.time()]
+    physics.add_gate(lambda: physics.time() - engine_at[0] <= 0.05)
+    assert physics.wait_sim(0.04, timeout=10.0)
+    time.sleep(0.2)
+    stopped = physics.time()
+    assert stopped - engine_at[0] <= 0.05 + physics.time_step
+    time.sleep(0.1)
+    assert physics.time() == stopped  # the engine did not tick: the world waits
+    engine_at[0] = stopped
+    physics.nudge()
+    assert physics.wait_sim(0.04, timeout=10.0)
