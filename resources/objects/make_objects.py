@@ -565,6 +565,7 @@ def make_rack() -> tuple[dict, Mesh]:
             "center": [_r(ledge / 2), 0.0],
             "inner": [_r(tote - 0.012), _r(width - 0.012)],
             "floor": 0.006,
+            "rim": height,
         },
     )
     return model, mesh
@@ -594,7 +595,7 @@ def make_scrap_bin() -> tuple[dict, Mesh]:
         symmetry={"kind": "discrete", "axis": [0.0, 0.0, 1.0], "order": 2},
         color=[0.45, 0.2, 0.16, 1.0],
         tote={"center": [0.0, 0.0], "inner": [_r(length - 0.008), _r(width - 0.008)],
-              "floor": 0.004},
+              "floor": 0.004, "rim": height},
     )  # fmt: skip
     return model, mesh
 
