@@ -78,11 +78,13 @@ def _total(trials: list[dict[str, Any]]) -> dict[str, Any]:
 
 def measure_tending(
     seed: int, parts: int, trials: int = 2, jobs: int = 1, reset_s: float = RESET_S,
-    speed: float | None = SPEED,
+    speed: float | None = SPEED, only: list[str] | None = None,
 ) -> dict[str, Any]:  # fmt: skip
     """{"paper": {...}, "ours": {...}}: each plan's counters over ``trials`` trials
-    (ours: {"skipped": why} while resources/examples/tending.costar.json does not exist)."""
-    plans = [name for name, path in PLANS.items() if path.is_file()]
+    (ours: {"skipped": why} while resources/examples/tending.costar.json does not exist;
+    a plan left out of ``only``: {"skipped": "not asked for"})."""
+    asked = [name for name in PLANS if only is None or name in only]
+    plans = [name for name in asked if PLANS[name].is_file()]
     work = [TendingJob(p, seed + i, parts, reset_s, speed) for p in plans for i in range(trials)]
     if jobs > 1:
         with multiprocessing.get_context("spawn").Pool(jobs) as pool:
@@ -92,7 +94,8 @@ def measure_tending(
     figures: dict[str, Any] = {}
     for name, path in PLANS.items():
         if name not in plans:
-            figures[name] = {"skipped": f"{path.name} does not exist yet"}
+            why = "not asked for" if name not in asked else f"{path.name} does not exist yet"
+            figures[name] = {"skipped": why}
             continue
         figures[name] = _total([r for j, r in zip(work, results, strict=True) if j.plan == name])
     return figures

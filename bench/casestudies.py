@@ -44,7 +44,7 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from bench._tending import RESET_S, SPEED, measure_tending, table_one  # noqa: E402
+from bench._tending import PLANS, RESET_S, SPEED, measure_tending, table_one  # noqa: E402
 from capabilities.base import CapabilityRegistry  # noqa: E402
 from capabilities.sim.session import SimCellSession  # noqa: E402
 from engine.build import build_tree  # noqa: E402
@@ -178,6 +178,8 @@ def _arguments(argv: list[str] | None) -> argparse.Namespace:
         default=SPEED or 0.0,
         help="tending: times real time at most (0: as fast as lockstep allows)",
     )
+    parser.add_argument("--plan", choices=sorted(PLANS), action="append",
+                        help="tending: only this plan (default: both)")  # fmt: skip
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     return parser.parse_args(argv)  # fmt: skip
 
@@ -202,7 +204,13 @@ def main(argv: list[str] | None = None) -> int:
     for name in args.only or [TENDING, *CASES]:
         if name == TENDING:
             figures[name] = measure_tending(
-                args.seed, args.parts, args.trials, args.jobs, args.reset_s, args.speed or None
+                args.seed,
+                args.parts,
+                args.trials,
+                args.jobs,
+                args.reset_s,
+                args.speed or None,
+                args.plan,
             )
         else:
             figures[name] = measure(name, args.runs, args.first_seed, args.jobs)
