@@ -33,7 +33,7 @@ from engine.types import Pose
 __all__ = ["TrialCounters", "container_of", "loose_things", "score_trial"]
 
 RACK = "rack"  # the scene object whose tote counts as caught; other totes are scrap bins
-TOTE_TOP = 0.08  # m above a tote's frame when its block names no "rim": higher is not in it
+OVER_RIM = 0.03  # m over a tote's rim still counts as in it (a pile); higher: held over it
 
 
 @dataclass(frozen=True)
@@ -70,17 +70,21 @@ class TrialCounters:
 def _in_tote(tote: Mapping[str, Any], frame: Pose, where: Pose) -> bool:
     x, y, z = frame.inverse().compose(where).position
     (cx, cy), (ix, iy) = tote["center"], tote["inner"]
-    floor = float(tote["floor"])
-    top = float(tote.get("rim", TOTE_TOP))  # held over it or lying on it is not in it
+    floor, top = float(tote["floor"]), float(tote["rim"]) + OVER_RIM
     return abs(x - cx) < ix / 2 and abs(y - cy) < iy / 2 and floor - 0.002 < z < top
 
 
 def _totes(client: int, scene: SceneState) -> list[tuple[str, Mapping[str, Any], Pose]]:
-    """(object name, tote block, its frame now) of every object with a tote (rack, bins)."""
+    """(object name, tote block, its frame now) of every object with a tote (rack, bins);
+    a tote without a ``rim`` height has its object's highest collision box as rim."""
     found = []
     for name in scene.names():
-        tote = scene.model(name).extra.get("tote")
+        model = scene.model(name)
+        tote = model.extra.get("tote")
         if isinstance(tote, Mapping):
+            if "rim" not in tote:
+                boxes = model.collision.boxes
+                tote = {**tote, "rim": max(b.position[2] + b.size[2] / 2 for b in boxes)}
             found.append((name, tote, scene.truth_pose(client, name)))
     return found
 

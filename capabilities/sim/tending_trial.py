@@ -7,10 +7,15 @@ its first N), and scores it as Table I does (``tending_score``). As on site:
 - The bender starts when the robot first watches it (the first occupancy operation runs):
   setting up the run costs none of the bender's parts.
 - An operator (:class:`OperatorModel`) answers a plan that waits for one (a
-  ``collaboration.wait_for_button``): after ``reset_s`` simulated seconds (the paper: "the
-  robot would need to be stopped and reset ... the bender kept producing parts") the operator
-  clears away what lies loose in the cell (parts and pieces at the exit or dropped: lost)
-  and presses Continue.
+  ``collaboration.wait_for_button``) or a run held by a protective stop its plan does not
+  catch: after ``reset_s`` simulated seconds (the paper: "the robot would need to be stopped
+  and reset ... the bender kept producing parts") the operator clears away what lies loose in
+  the cell (parts and pieces at the exit or dropped: lost), unlocks a protective stop and
+  presses Continue.
+- With ``lead`` the world never runs more than ``lead`` simulated seconds ahead of the
+  engine's last tick (a gate of the physics thread): with a lockstep session (time stands
+  still while perception computes) a run as fast as possible then reacts as a 50 Hz
+  controller would, however loaded the machine.
 - The trial ends once the bender released its last part and everything settled (every
   part in a tote or taken away), or ``tail`` simulated seconds after that last release.
 
@@ -27,13 +32,15 @@ from pathlib import Path
 
 from capabilities.base import CapabilityRegistry
 from capabilities.bullet import pybullet as p
+from capabilities.faults import hold_check
 from capabilities.sim.errors import SimError
 from capabilities.sim.session import SimCellSession
 from capabilities.sim.tending_score import TrialCounters, loose_things, score_trial
 from engine.build import build_tree
-from engine.events import Event, StatusChanged
+from engine.events import Event, RunHeld, StatusChanged
 from engine.executor import Executor
 from engine.files import load_plan
+from engine.hold import Hold
 from engine.status import Status
 from engine.validation import has_errors, validate_plan
 
@@ -71,10 +78,12 @@ class TendingTrial:
         plan: the plan file.
         operator: who answers the plan's calls.
         rate_hz: the executor's tick rate.
+        lead: simulated seconds the world may run ahead of the engine (None: no bound).
 
     Attributes:
-        calls: simulated times at which the plan called the operator.
-        stops: for each call, the last operation that failed before it ("" if none).
+        calls: simulated times at which the plan (or a held run) called the operator.
+        stops: for each call, the last operation that failed before it ("" if none), or
+            why the run was held.
     """
 
     def __init__(
@@ -83,6 +92,7 @@ class TendingTrial:
         plan: Path,
         operator: OperatorModel | None = None,
         rate_hz: float = 50.0,
+        lead: float | None = None,
     ) -> None:
         if session.bender is None:
             raise TrialError(f"the scene {session.scene.name!r} has no wire bender")
@@ -91,9 +101,10 @@ class TendingTrial:
         self.calls: list[float] = []
         self.stops: list[str] = []
         self._lock = threading.Lock()
-        self._pending: list[float] = []  # simulated times the operator presses Continue
+        self._pending: list[tuple[float, bool]] = []  # when the operator resets; press?
         self._removed: set[int] = set()
         self._last_failure = ""
+        self._engine_at: float | None = None  # simulated time of the engine's last tick
         registry = CapabilityRegistry(cell=session)
         spec = load_plan(plan, registry.aliases())
         problems = validate_plan(spec, registry)
@@ -102,11 +113,29 @@ class TendingTrial:
             raise TrialError(f"{plan}: the plan is not valid: {errors}")
         self._nodes = {node.id: (node.label, node.op or "") for _, node in spec.walk()}
         tree = build_tree(spec, registry, clock=session.clock)
-        self.executor = Executor(tree, rate_hz, [self._heard])
+        self._cell_hold = hold_check(session)
+        self.executor = Executor(tree, rate_hz, [self._heard], hold=self._before_tick)
+        if lead is not None:
+            bound = lead
+            session.sim.add_gate(lambda: self._engine_at is None or self._lag() <= bound)
+
+    # ------------------------------------------------------------------ the engine
+
+    def _before_tick(self) -> Hold | None:
+        """The executor's hold check, asked before every tick: the engine is here now."""
+        self._engine_at = self.session.clock()
+        self.session.sim.nudge()
+        return self._cell_hold() if self._cell_hold is not None else None
+
+    def _lag(self) -> float:
+        at = self._engine_at
+        return 0.0 if at is None else self.session.clock() - at
 
     # ------------------------------------------------------------------ the plan's events
 
     def _heard(self, event: Event) -> None:
+        if isinstance(event, RunHeld) and event.reason:
+            self._call(f"held: {event.reason}", press=False)
         if not isinstance(event, StatusChanged):
             return
         label, op = self._nodes.get(event.node_id, ("", ""))
@@ -117,12 +146,17 @@ class TendingTrial:
         if op.startswith(WATCH_PREFIX):
             self.session.start_actors()  # from the first watch on; later calls do nothing
         if op in OPERATOR_OPS:
-            now = self.session.clock()
-            with self._lock:
-                self.calls.append(now)
-                self.stops.append(self._last_failure)
-                if self.operator.present:
-                    self._pending.append(now + self.operator.reset_s)
+            self._call(self._last_failure, press=True)
+
+    def _call(self, why: str, press: bool) -> None:
+        """The operator is called now (comes ``reset_s`` later if present); ``press``: the
+        plan waits for Continue (a held run does not: a press would wait for the next)."""
+        now = self.session.clock()
+        with self._lock:
+            self.calls.append(now)
+            self.stops.append(why)
+            if self.operator.present:
+                self._pending.append((now + self.operator.reset_s, press))
 
     # ------------------------------------------------------------------ the operator
 
@@ -130,11 +164,14 @@ class TendingTrial:
         """Reset the cell and press Continue for each call whose reset time has come."""
         now = self.session.clock()
         with self._lock:
-            due = [t for t in self._pending if t <= now]
-            self._pending = [t for t in self._pending if t > now]
-        for _ in due:
+            due = [press for t, press in self._pending if t <= now]
+            self._pending = [(t, press) for t, press in self._pending if t > now]
+        for press in due:
             self._clear_cell()
-            self.session.operator.press("continue")
+            if self.session.hold_reason():
+                self.session.clear()  # on the pendant: unlocks once the delay allows
+            if press:
+                self.session.operator.press("continue")
 
     def _clear_cell(self) -> None:
         """Take away every loose part and piece (as the operator does: they are lost)."""
@@ -170,7 +207,11 @@ class TendingTrial:
     # ------------------------------------------------------------------ the run
 
     def run(
-        self, parts: int | None = None, tail: float = 60.0, wall_timeout: float | None = None
+        self,
+        parts: int | None = None,
+        tail: float = 60.0,
+        wall_timeout: float | None = None,
+        until: float | None = None,
     ) -> TrialCounters:
         """Run the trial and score it.
 
@@ -178,6 +219,8 @@ class TendingTrial:
             parts: only the bender's first ``parts`` parts (None: all of its plan).
             tail: simulated seconds after the last release at which the trial ends anyway.
             wall_timeout: wall seconds after which TrialError is raised (None: no bound).
+            until: end this many simulated seconds after the bender started, whatever is
+                left to do (a soak).
         """
         bender = self.session.bender
         assert bender is not None
@@ -186,16 +229,18 @@ class TendingTrial:
                 raise TrialError("the bender already started: its parts are set")
             bender.plan = bender.plan[:parts]
         deadline = None if wall_timeout is None else time.monotonic() + wall_timeout
+        self._engine_at = self.session.clock()  # the gate holds until the engine ticks
         self.executor.start()
         try:
-            self._run_until_done(tail, deadline)
+            self._run_until_done(tail, deadline, until)
         finally:
             self.executor.stop("trial over")
             self.executor.wait(10.0)
+            self._engine_at = None  # no engine any more: the world goes on
         self.session.sim.wait_sim(SETTLE)
         return self.score()
 
-    def _run_until_done(self, tail: float, deadline: float | None) -> None:
+    def _run_until_done(self, tail: float, deadline: float | None, until: float | None) -> None:
         session, bender = self.session, self.session.bender
         assert bender is not None
         while self.executor.result is None:
@@ -203,6 +248,9 @@ class TendingTrial:
                 raise TrialError(f"the trial ran out of wall time at {session.clock():.0f} s")
             session.sim.wait_sim(POLL)
             self._operate()
+            start = bender.start_time
+            if until is not None and start is not None and session.clock() - start >= until:
+                return
             released = bender.produced()
             if not bender.plan or len(released) < len(bender.plan):
                 continue
