@@ -103,6 +103,7 @@ def halt_ticks(emulator: EmulatorProcess, cell_file: Path, repeats: int) -> int:
     """The most ticks from the backend seeing a protective stop to the run held."""
     from capabilities.base import CapabilityRegistry
     from capabilities.cells import open_cell
+    from capabilities.faults import hold_check
     from engine.build import build_tree
     from engine.events import Event, RunHeld
     from engine.executor import Executor
@@ -120,7 +121,7 @@ def halt_ticks(emulator: EmulatorProcess, cell_file: Path, repeats: int) -> int:
             })  # fmt: skip
             tree = build_tree(PlanSpec(move), CapabilityRegistry(cell=cell), clock=cell.clock)
             events: list[Event] = []
-            executor = Executor(tree, 20.0, [events.append], hold=cell.hold_reason)
+            executor = Executor(tree, 20.0, [events.append], hold=hold_check(cell))
             executor.start()
             _wait(lambda: emulator.state()["moving"])
             emulator.protective_stop()

@@ -9,6 +9,11 @@ its ``robot`` block says what moves: ``{"kind": "sim"}`` (the pybullet cell, the
      (or "tool": {"kind": "robotiq"})
      "inputs": {"pedal": "standard 0"}}
 
+The simulated arm's block may set its safety limits, as a UR's safety configuration does on
+the controller: ``{"kind": "sim", "force_limit": 150, "unlock_delay": 5}`` (a contact above
+``force_limit`` N with a fixture is a protective stop, which cannot be unlocked earlier than
+``unlock_delay`` s after it happened).
+
 The mounting is the file's ``robot_base`` and the TCP its ``tcp_offsets`` entry for the tool.
 Nothing here talks to a robot: this is the file's meaning only.
 """
@@ -27,6 +32,10 @@ UR_TOOL_KINDS = ("suction", "robotiq")
 TCP_OF_TOOL = {"suction": "suction", "robotiq": "gripper"}  # the tool's tcp_offsets entry
 INPUT_ROLES = ("pedal",)
 _BANKS = {"standard": 8, "configurable": 8, "tool": 2}
+# A UR's default safety configuration: 150 N force limit (normal mode), and PolyScope refuses
+# to unlock a protective stop earlier than 5 s after it happened.
+FORCE_LIMIT = 150.0  # N
+UNLOCK_DELAY = 5.0  # s
 
 DigitalPinName = tuple[str, int]  # (bank, index): ("tool", 0)
 
@@ -66,6 +75,10 @@ class RobotSettings:
         payload: the payload set on the controller.
         tool: the tool on the flange.
         inputs: digital inputs by role ("pedal": the collaboration capability's foot pedal).
+        force_limit: (simulated arm) the contact force (N) with a fixture, the table or a
+            machine above which the arm makes a protective stop.
+        unlock_delay: (simulated arm) seconds after a protective stop before it can be
+            unlocked. A UR controller has both in its own safety configuration.
     """
 
     kind: str = "sim"
@@ -74,11 +87,16 @@ class RobotSettings:
     payload: Payload = Payload()
     tool: ToolSettings = ToolSettings()
     inputs: dict[str, DigitalPinName] = field(default_factory=dict)
+    force_limit: float = FORCE_LIMIT
+    unlock_delay: float = UNLOCK_DELAY
 
     def to_json(self) -> dict[str, object]:
         """The JSON form (what :func:`read_robot` reads)."""
         if self.kind == "sim":
-            return {"kind": "sim"}
+            limits = {"force_limit": self.force_limit, "unlock_delay": self.unlock_delay}
+            if (self.force_limit, self.unlock_delay) == (FORCE_LIMIT, UNLOCK_DELAY):
+                limits = {}
+            return {"kind": "sim", **limits}
         tool: dict[str, object] = {"kind": self.tool.kind, "vacuum": _pin_text(self.tool.vacuum)}
         if self.tool.sensor is not None:
             tool["sensor"] = _pin_text(self.tool.sensor)
@@ -119,11 +137,16 @@ def read_robot(r: JsonReader) -> RobotSettings:
     """
     if not r.has("robot"):
         return RobotSettings()
-    block = r.child("robot", ("kind", "host", "model", "payload", "tool", "inputs"), ("kind",))
+    ur_fields = ("kind", "host", "model", "payload", "tool", "inputs")
+    block = r.child("robot", (*ur_fields, "force_limit", "unlock_delay"), ("kind",))
     kind = block.choice("kind", ROBOT_KINDS)
     if kind == "sim":
-        block.as_object(("kind",))
-        return RobotSettings()
+        block.as_object(("kind", "force_limit", "unlock_delay"))
+        return RobotSettings(
+            force_limit=block.number("force_limit", FORCE_LIMIT, lo=0.0, above=True),
+            unlock_delay=block.number("unlock_delay", UNLOCK_DELAY, lo=0.0),
+        )
+    block.as_object(ur_fields)  # a UR's limits are in its own safety configuration
     host = block.text("host", nonempty=True)
     payload = block.child("payload", ("mass", "center_of_gravity"))
     tool = block.child("tool", ("kind", "vacuum", "sensor"))

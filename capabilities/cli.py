@@ -23,6 +23,7 @@ from capabilities.base import CapabilityError, CapabilityRegistry
 from capabilities.cells import CELL_NAMES, CellError, is_cell_file, open_cell
 from capabilities.collaboration.answers import CONFIRM_MODES, PromptAnswerer
 from capabilities.doctor import cmd_doctor
+from capabilities.faults import hold_check
 from capabilities.shipped_examples import cmd_examples
 from capabilities.xml_commands import add_xml_commands
 from engine.build import BuildError, build_tree
@@ -193,8 +194,7 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         listeners += [failures, _print_holds(out)]
         if args.verbose:
             listeners.append(_VerbosePrinter(plan, out))
-        hold = getattr(cell, "hold_reason", None)
-        executor = Executor(tree, args.rate, listeners, plan_name=plan.name, hold=hold)
+        executor = Executor(tree, args.rate, listeners, plan_name=plan.name, hold=hold_check(cell))
         restore = _install_interrupt(executor)
         console = cell.interfaces().get("operator")
         answerer = PromptAnswerer(console, args.confirm, args.stdin, out) if console else None

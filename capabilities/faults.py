@@ -4,13 +4,30 @@ The simulated and the UR cell finish a command that a fault ended with a message
 fault ("move_linear: protective stop"); :func:`fault_error` turns that message into the
 :class:`~engine.error_types.ErrorType` a Catch node matches, so both cells report a fault
 the same way. The UR cell's ``fault_reason`` builds its words from these constants.
+
+A cell that can stop on its own has ``hold_reason()`` (why it cannot act, in these words; ""
+when it can); :func:`hold_check` makes the executor's hold check of it (``engine.hold``), so
+the CLI and the Instructor wire every cell the same way. Its ``status()`` gives the status
+bar a :class:`CellStatus`, and ``clear()`` is the operator's clear of what the status names.
 """
 
 from __future__ import annotations
 
-from engine.error_types import ErrorType
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
 
-__all__ = ["CONNECTION_LOST", "EMERGENCY_STOP", "PROTECTIVE_STOP", "fault_error"]
+from engine.error_types import ErrorType
+from engine.hold import Hold, HoldCheck
+
+__all__ = [
+    "CONNECTION_LOST",
+    "EMERGENCY_STOP",
+    "PROTECTIVE_STOP",
+    "CellStatus",
+    "fault_error",
+    "hold_check",
+]
 
 PROTECTIVE_STOP = "protective stop"
 EMERGENCY_STOP = "emergency stop"
@@ -30,3 +47,35 @@ def fault_error(message: str) -> ErrorType:
         if words in text:
             return error
     return ErrorType.FAILED
+
+
+def hold_check(cell: Any) -> HoldCheck | None:
+    """The executor's hold check of a cell with ``hold_reason()`` (None for one without)."""
+    reason_of: Callable[[], str] | None = getattr(cell, "hold_reason", None)
+    if not callable(reason_of):
+        return None
+    ask = reason_of
+
+    def check() -> Hold | None:
+        reason = ask()
+        return Hold(reason, fault_error(reason)) if reason else None
+
+    return check
+
+
+@dataclass(frozen=True)
+class CellStatus:
+    """What the status bar shows of the robot: connection, robot mode, safety mode, program.
+
+    Attributes:
+        problem: why the robot cannot move ("" when it can).
+        clear_action: the label of the operator's clear of that problem from here ("" when
+            there is none now: it is cleared on the pendant, or not yet allowed).
+    """
+
+    connected: bool
+    robot_mode: str
+    safety_mode: str
+    program: str
+    problem: str
+    clear_action: str = ""

@@ -6,9 +6,13 @@ thread and delivered to listeners by a separate dispatcher thread, so a slow lis
 (a GUI, a file) never holds up a tick.
 
 A cell that can stop on its own (a real robot's protective stop, a lost connection) gives the
-executor a ``hold`` check, asked before every tick: while it names a reason the run is held
-(the running leaves are halted, nothing is ticked, a RunHeld event says why); once it is clear
-again the run goes on, and the composites tick the halted leaves afresh.
+executor a ``hold`` check (``engine.hold``), asked before every tick. When a stop begins and
+every running leaf sits in the body of a Catch that takes the stop's error type, the stop is
+thrown into the plan: those leaves fail with it and the handlers run (Intera), and the same
+stop does not hold the run while it lasts (the handler is clearing it). Otherwise the run is
+held (the running leaves are halted, nothing is ticked, a RunHeld event says why); once the
+cell is clear again the run goes on, and the composites tick the halted leaves afresh
+(PolyScope). A stop of no known type (``failed``: power off, a stopped script) is always held.
 """
 
 from __future__ import annotations
@@ -17,8 +21,8 @@ import collections
 import enum
 import threading
 import time
-from collections.abc import Callable
 
+from engine.error_types import ErrorType
 from engine.events import (
     BlackboardWritten,
     Event,
@@ -29,6 +33,7 @@ from engine.events import (
     RunStarted,
     StatusChanged,
 )
+from engine.hold import Hold, HoldCheck, catchers, throw
 from engine.node import Node
 from engine.status import FAILURE, RUNNING, Status
 from engine.tree import BehaviorTree
@@ -96,7 +101,8 @@ class Executor:
         rate_hz: ticks per second when nothing wakes it earlier (the paper's delta).
         listeners: callables that receive every :mod:`engine.events` event.
         plan_name: for the RunStarted event.
-        hold: asked before every tick; a non-empty answer (why, in words) holds the run.
+        hold: asked before every tick; a Hold (why, and its error type) stops the run: it is
+            thrown into the plan's Catch nodes that take it, else the run is held.
     """
 
     def __init__(
@@ -105,7 +111,7 @@ class Executor:
         rate_hz: float = 20.0,
         listeners: list[Listener] | None = None,
         plan_name: str = "",
-        hold: Callable[[], str] | None = None,
+        hold: HoldCheck | None = None,
     ) -> None:
         if rate_hz <= 0:
             raise ValueError(f"rate must be above 0 Hz, not {rate_hz}")
@@ -121,6 +127,8 @@ class Executor:
         self._state = ExecutorState.READY
         self._hold = hold
         self._held = ""  # the reason the run is held now ("" when it is not)
+        self._thrown: Hold | None = None  # a stop thrown into the plan, while it lasts
+        self._failures: list[str] = []  # leaf failure messages since the cell was last clear
         self._result: RunFinished | None = None
         self._done = threading.Event()
         self._dispatcher = _Dispatcher(self._listeners)
@@ -205,6 +213,8 @@ class Executor:
 
         def on_status(node: Node, old: Status, new: Status) -> None:
             error = node.error.value if new is FAILURE and node.error is not None else ""
+            if error and not node.children and self._hold is not None:
+                self._failures.append(node.message)
             put(StatusChanged(ctx.tick_count, node.id, old, new, node.message, clock(), error))
 
         def on_log(node_id: str, message: str) -> None:
@@ -268,13 +278,20 @@ class Executor:
         return self._held
 
     def _held_now(self) -> bool:
-        """Ask the hold check; halt the running leaves when a hold begins (engine thread)."""
+        """Ask the hold check; throw a stop into the plan, or halt the running leaves when a
+        hold begins (engine thread)."""
         if self._hold is None:
             return False
         try:
-            reason = self._hold()
+            hold = self._hold()
         except Exception as exc:  # a broken check holds the run rather than ignoring the cell
-            reason = f"the cell's safety check failed: {type(exc).__name__}: {exc}"
+            hold = Hold(f"the cell's safety check failed: {type(exc).__name__}: {exc}")
+        reason = hold.reason if hold is not None else ""
+        if not reason:
+            self._thrown = None
+            self._failures.clear()
+        elif hold == self._thrown or (not self._held and self._thrown_now(hold)):
+            reason = ""  # the plan handles this stop: tick on
         if reason == self._held:
             return bool(reason)
         if reason and not self._held:
@@ -283,6 +300,28 @@ class Executor:
         self._held = reason
         self._dispatcher.put(RunHeld(self.tree.ctx.tick_count, reason, time.monotonic()))
         return bool(reason)
+
+    def _thrown_now(self, hold: Hold | None) -> bool:
+        """Throw a stop that began into the plan when its Catch nodes take it."""
+        if hold is None or hold.error is ErrorType.FAILED:
+            return False
+        if any(hold.reason in message for message in self._failures):
+            self._thrown = hold  # a node already failed with it: the plan has seen it
+            return True
+        leaves = self.tree.running_leaves()
+        if catchers(leaves, hold.error) is None:
+            return False
+        throw(leaves, hold)
+        for leaf in leaves:
+            self._dispatcher.put(
+                LogMessage(
+                    self.tree.ctx.tick_count, leaf.id,
+                    f"the cell threw {hold.error.value} into the plan: {hold.reason}",
+                    time.monotonic(),
+                )
+            )  # fmt: skip
+        self._thrown = hold
+        return True
 
     def _halt_all(self) -> None:
         try:

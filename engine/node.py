@@ -99,6 +99,24 @@ class Node:
 
     halt = reset
 
+    def abort(self, message: str, error: ErrorType) -> None:
+        """Fail a RUNNING node from outside a tick (the executor throws a cell's stop into
+        it): its work is halted and it latches FAILURE, which its parents see on the next
+        tick. Nothing happens to a node that is not running. Never raises."""
+        status = self.status
+        if status is not RUNNING:
+            return
+        try:
+            self.on_halt()
+        except Exception as exc:  # a capability's cancel must not break the throw
+            self.ctx.log(self.id, f"error while halting: {type(exc).__name__}: {exc}")
+        self.message = message
+        self.error = error
+        self.status = FAILURE
+        sink = self.ctx.status_sink
+        if sink is not None:
+            sink(self, status, FAILURE)
+
     def recheck(self) -> Status:
         """Evaluate a finished condition afresh (reset + tick) for reactive composites.
 

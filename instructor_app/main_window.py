@@ -38,7 +38,7 @@ from instructor_app.panels.scene_teach import SceneTeachLink
 from instructor_app.panels.start_page import StartPage, find_examples
 from instructor_app.plan_files import PlanFiles
 from instructor_app.runtime.controller import RunController
-from instructor_app.runtime.robot_status import RobotStatusLabel, ScriptRestartButton
+from instructor_app.runtime.robot_status import CellClearButton, RobotStatusLabel
 from instructor_app.runtime.run_view import (
     FailureButton,
     RunActions,
@@ -135,8 +135,8 @@ class MainWindow(QMainWindow):
         self.robot_status = RobotStatusLabel(self.session, parent=self)
         self.problems_label = QLabel("")
         # permanent: a temporary status message would hide a normal status-bar widget
-        self.robot_restart = ScriptRestartButton(self.session, self.robot_status, self)
-        self.statusBar().addPermanentWidget(self.robot_restart)
+        self.robot_clear = CellClearButton(self.session, self.robot_status, self)
+        self.statusBar().addPermanentWidget(self.robot_clear)
         self.statusBar().addPermanentWidget(self.robot_status)
         self.robot_status.setVisible(self.robot_status.present)
         self.robot_status.presence_changed.connect(self.robot_status.setVisible)

@@ -61,6 +61,12 @@ class ArmBackend(Protocol):
         """Decelerate any move to a halt; the handle finishes when the arm stands."""
         ...
 
+    def clear_protective_stop(self) -> CommandHandleLike:
+        """Unlock a protective stop once the robot allows it; the handle finishes when the
+        arm can move again (at once when it is not stopped) and fails, in the fault's
+        words, on a stop only the operator may clear (an emergency stop, power off)."""
+        ...
+
 
 class DetectionLike(Protocol):
     """A detection as the world model keeps it (only what motion reads)."""

@@ -12,12 +12,14 @@ from collections.abc import Sequence
 from typing import Any
 
 from capabilities.base import Capability, CapabilityEnv, CapabilityError
+from capabilities.faults import fault_error
 from capabilities.jobs import chain_jobs, job_from_handle
 from capabilities.kit import manifest
 from capabilities.motion.backend import ARM, WORLD, ArmBackend, WorldBackend
 from capabilities.motion.geometry import format_pose_mm
 from capabilities.motion.symmetry import SymmetryTable
 from capabilities.motion.targets import TargetResolver
+from engine.error_types import ErrorType
 from engine.operations import (
     Direction,
     Job,
@@ -332,6 +334,37 @@ class IsHome:
         return Job.answer(max(abs(a - b) for a, b in zip(now, home, strict=True)) <= tolerance)
 
 
+CLEAR_PROTECTIVE_STOP = manifest(CAP, "clear_protective_stop",
+    OperationKind.ACTION,
+    "Clears a protective stop (after a collision): waits until the robot allows it (5 s "
+    "after the stop on a UR), unlocks it and waits until the arm can move again. Succeeds at "
+    "once when the arm is not stopped. An emergency stop, power off or a lost connection "
+    "fails it with its type: those are for the operator.",
+)  # fmt: skip
+
+
+class ClearProtectiveStop:
+    """motion.clear_protective_stop."""
+
+    def __init__(self, arm: ArmBackend) -> None:
+        self._arm = arm
+
+    def start(self, call: OperationCall) -> Job:
+        handle = self._arm.clear_protective_stop()
+        job = Job(on_cancel=handle.cancel)
+
+        def finished(_: Any) -> None:
+            if handle.ok:
+                job.succeed()
+                return
+            text = handle.message or "failed"
+            error = ErrorType.TIMEOUT if "timed out" in text else fault_error(text)
+            job.fail(f"clear protective stop: {text}", error)
+
+        handle.add_done_callback(finished)
+        return job
+
+
 def _world(env: CapabilityEnv) -> WorldBackend | None:
     try:
         return env.interface(WORLD)
@@ -353,6 +386,7 @@ def capability(symmetries: SymmetryTable | None = None) -> Capability:
     cap.add(MOVE_RELATIVE_TOOL, lambda env: MoveRelativeTool(arm(env)))
     cap.add(GO_HOME, lambda env: GoHome(arm(env)))
     cap.add(STOP, lambda env: Stop(arm(env)))
+    cap.add(CLEAR_PROTECTIVE_STOP, lambda env: ClearProtectiveStop(arm(env)))
     cap.add(CURRENT_POSE, lambda env: CurrentPose(arm(env)))
     cap.add(CURRENT_JOINTS, lambda env: CurrentJoints(arm(env)))
     cap.add(IS_MOVING, lambda env: IsMoving(arm(env)))

@@ -3,7 +3,9 @@
 It plays a trajectory through pybullet's POSITION_CONTROL motors (target position plus
 feed-forward velocity, forces well above gravity load) so the arm is a physical body that
 pushes objects, and finishes a move once the joints have settled on the target. Stopping
-slows trajectory time down to zero, so a stopped arm stays on its path.
+slows trajectory time down to zero, so a stopped arm stays on its path. A collision (see
+``safety.py``) is a protective stop: the arm holds where it is at once, the move fails with
+the fault's words, and every motion is refused until the stop is unlocked.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from capabilities.bullet import pybullet
 from capabilities.sim.commands import CommandHandle
 from capabilities.sim.freedrive import Freedrive
 from capabilities.sim.kinematics import UR5Kinematics
+from capabilities.sim.safety import CollisionWatch, ProtectiveStop
 from capabilities.sim.trajectory import (
     CartesianTrajectory,
     JointTrajectory,
@@ -76,6 +79,9 @@ class ArmController:
         self.q_cmd = np.asarray(self.q_actual)
         self._motion: _Motion | None = None
         self.freedrive = Freedrive(kin, dt, tcp)
+        self.watch: CollisionWatch | None = None  # set by the cell: no watch, no stops
+        self.stopped: ProtectiveStop | None = None
+        self._unlocks: list[tuple[CommandHandle, float]] = []  # (handle, unlock delay)
         self._command(self.q_cmd, np.zeros(6))
 
     @property
@@ -130,6 +136,65 @@ class ArmController:
         else:
             handle.resolve(False, f"{handle.name} cancelled")
 
+    # ---------------------------------------------------------------- protective stop
+
+    def unlock(self, now: float, delay: float) -> str:
+        """Unlock a protective stop; a refusal in words ("" when unlocked or not stopped).
+
+        Like PolyScope, it refuses earlier than ``delay`` s after the stop happened.
+        """
+        stop = self.stopped
+        if stop is None:
+            return ""
+        if now - stop.time < delay:
+            return (
+                f"cannot unlock the protective stop until {delay:g} s after it happened "
+                f"({delay - (now - stop.time):.1f} s left)"
+            )
+        self.stopped = None
+        if self.watch is not None:
+            self.watch.leave_contacts()
+        self.q_cmd = np.asarray(self.q_actual)
+        self._command(self.q_cmd, np.zeros(6))
+        return ""
+
+    def clear_when_allowed(self, handle: CommandHandle, delay: float) -> None:
+        """Unlock a protective stop as soon as ``delay`` allows; ``handle`` finishes then."""
+        if self.stopped is None:
+            handle.resolve(True, "not stopped")
+        else:
+            self._unlocks.append((handle, delay))
+
+    def _watch_safety(self, now: float) -> None:
+        if self.stopped is not None:
+            for handle, delay in list(self._unlocks):
+                if handle.cancel_requested:
+                    self._unlocks.remove((handle, delay))
+                    handle.resolve(False, f"{handle.name} cancelled")
+                elif not self.unlock(now, delay):
+                    self._unlocks.remove((handle, delay))
+                    handle.resolve(True, "unlocked")
+            return
+        for handle, _ in self._unlocks:
+            handle.resolve(True, "unlocked")
+        self._unlocks.clear()
+        if self.watch is None or self.freedrive.active:
+            return  # in freedrive the hand, not the controller, pushes the arm
+        cause = self.watch.check()
+        if cause:
+            self._protective_stop(ProtectiveStop(now, cause))
+
+    def _protective_stop(self, stop: ProtectiveStop) -> None:
+        """Hold where the arm is now and fail the move (the stop is visible before that)."""
+        self.stopped = stop
+        motion, self._motion = self._motion, None
+        self.q_cmd = np.asarray(self.q_actual)
+        self._command(self.q_cmd, np.zeros(6))
+        if motion is not None:
+            motion.handle.resolve(False, stop.message(motion.handle.name))
+            for stop_handle in motion.stop_handles:
+                stop_handle.resolve(True, "stopped")
+
     def set_freedrive(self, on: bool) -> None:
         """Enter or leave freedrive; entering halts any move at once."""
         if on:
@@ -149,6 +214,9 @@ class ArmController:
             motion.handle.resolve(False, message)
             for handle in motion.stop_handles:
                 handle.resolve(False, message)
+        for handle, _ in self._unlocks:
+            handle.resolve(False, message)
+        self._unlocks.clear()
         self.freedrive.stop()
 
     # ---------------------------------------------------------------- stepping
@@ -174,6 +242,7 @@ class ArmController:
         states = pybullet.getJointStates(self._body, self._joints, physicsClientId=self._client)
         self.q_actual = tuple(s[0] for s in states)
         self.qd_actual = tuple(s[1] for s in states)
+        self._watch_safety(_t)
         motion = self._motion
         if motion is None:
             return
@@ -188,6 +257,9 @@ class ArmController:
     def _refuse(self, handle: CommandHandle) -> bool:
         if handle.cancel_requested:
             handle.resolve(False, f"{handle.name} cancelled")
+            return True
+        if self.stopped is not None:
+            handle.resolve(False, self.stopped.message(handle.name))
             return True
         if self.freedrive.active:
             handle.resolve(False, f"{handle.name} refused: freedrive is active")

@@ -14,6 +14,7 @@ Example::
 from __future__ import annotations
 
 from collections.abc import Callable
+from contextlib import AbstractContextManager
 from pathlib import Path
 from types import TracebackType
 from typing import TypeVar
@@ -28,6 +29,7 @@ from capabilities.sim.ground_truth import GroundTruth
 from capabilities.sim.kinematics import UR5Kinematics
 from capabilities.sim.physics_thread import PhysicsThread, StepHook
 from capabilities.sim.robot import SimRobot
+from capabilities.sim.safety import CollisionWatch
 from capabilities.sim.suction import SimSuctionTool, SuctionController
 from capabilities.sim.transforms import matrix_to_pose, pose_to_matrix
 from capabilities.sim.world import World, build_world
@@ -63,6 +65,7 @@ class SimCell:
         self._arm: ArmController | None = None
         self._gripper: GripperController | None = None
         self._suction: SuctionController | None = None
+        self._namer: Callable[[int], str] | None = None
 
     # ---------------------------------------------------------------- lifecycle
 
@@ -80,7 +83,7 @@ class SimCell:
         self.table_top_z = world.table_top_z
         self.robot = SimRobot(
             self._physics, self._arm, self.kinematics, self.config.home_joints,
-            self.tcp_offset, world.robot, world.flange_link,
+            self.tcp_offset, world.robot, world.flange_link, self.config.robot.unlock_delay,
         )  # fmt: skip
         self.gripper = SimGripper(self._physics, self._gripper)
         self.suction = SimSuctionTool(
@@ -134,6 +137,18 @@ class SimCell:
         """Run ``fn(pybullet_client_id)`` on the physics thread and return its result."""
         return self._physics.call(fn)
 
+    def standing_still(self) -> AbstractContextManager[None]:
+        """A block in which simulated time stands still (see ``PhysicsThread``)."""
+        return self._physics.standing_still()
+
+    def add_gate(self, may_step: Callable[[], bool]) -> None:
+        """Step only while ``may_step()`` says True (see ``PhysicsThread.add_gate``)."""
+        self._physics.add_gate(may_step)
+
+    def nudge(self) -> None:
+        """Look at the gates again now (see ``PhysicsThread.nudge``)."""
+        self._physics.nudge()
+
     def wait_sim(self, seconds: float) -> None:
         """Block until simulated time has advanced by ``seconds`` (tests, CLI)."""
         if not self._physics.wait_sim(seconds, timeout=max(60.0, seconds * 10)):
@@ -147,6 +162,10 @@ class SimCell:
         """Stop callbacks added by :meth:`add_step_hook`."""
         self._physics.call(lambda _c: self._physics.remove_hooks(pre, post))
 
+    def name_bodies(self, namer: Callable[[int], str]) -> None:
+        """How a protective stop's message names a scene's body ("" when it does not know)."""
+        self._namer = namer
+
     def tcp_offset(self) -> Pose:
         """The TCP of the tool in use, in the flange frame."""
         return matrix_to_pose(self._tcp_matrix())
@@ -159,6 +178,19 @@ class SimCell:
             and self._world is not None
             and self._gripper.attached == self._world.suction_tool
         )
+
+    def _held_tool(self) -> int | None:
+        return self._world.suction_tool if self._world and self._suction_in_hand() else None
+
+    def _body_name(self, body: int) -> str:
+        world = self._world
+        if world is not None:
+            fixed = {world.table: "table", world.stand: "robot stand", world.floor: "floor"}
+            fixed[world.holster] = "holster"
+            if body in fixed:
+                return fixed[body]
+        name = self._namer(body) if self._namer is not None else ""
+        return name.replace("_", " ") or f"body {body}"
 
     def _tcp_matrix(self) -> np.ndarray:
         return self._tcp_matrices["suction" if self._suction_in_hand() else "gripper"]
@@ -174,6 +206,9 @@ class SimCell:
         )
         self._suction = SuctionController(
             client, world.suction_tool, world.robot, self._suction_in_hand
+        )
+        self._arm.watch = CollisionWatch(
+            client, world.robot, self._held_tool, self.config.robot.force_limit, self._body_name
         )
         arm, gripper, suction = self._arm, self._gripper, self._suction
         self._physics.add_hooks(pre=arm.pre_step, post=arm.post_step)

@@ -15,8 +15,10 @@ import numpy as np
 
 from capabilities.sim.arm_controller import ArmController
 from capabilities.sim.commands import CommandHandle
+from capabilities.sim.errors import SimError
 from capabilities.sim.kinematics import UR5Kinematics
 from capabilities.sim.physics_thread import PhysicsThread
+from capabilities.sim.safety import ProtectiveStop
 from capabilities.sim.transforms import pose_text_mm, pose_to_matrix
 from engine.types import Pose
 
@@ -35,6 +37,7 @@ class SimRobot:
         home: the configured home joints.
         tcp_pose_in_flange: returns the current tool's TCP offset (depends on the tool held).
         body: pybullet body id of the robot; flange: link index of tool0.
+        unlock_delay: simulated seconds after a protective stop before it can be unlocked.
     """
 
     def __init__(
@@ -46,6 +49,7 @@ class SimRobot:
         tcp_pose_in_flange: Callable[[], Pose],
         body: int,
         flange: int,
+        unlock_delay: float = 5.0,
     ) -> None:
         self._physics = physics
         self._ctl = controller
@@ -54,6 +58,7 @@ class SimRobot:
         self._tcp = tcp_pose_in_flange
         self.body_id = body
         self._flange = flange
+        self.unlock_delay = unlock_delay
 
     # ---------------------------------------------------------------- state
 
@@ -142,6 +147,33 @@ class SimRobot:
         """Decelerate any move to a halt (within 0.15 s); the handle finishes when halted."""
         handle = CommandHandle("stop")
         return self._post(handle, lambda: self._ctl.stop(handle, decel))
+
+    # ---------------------------------------------------------------- protective stop
+
+    def protective_stop(self) -> ProtectiveStop | None:
+        """The protective stop the arm is in (a collision), or None."""
+        return self._ctl.stopped
+
+    def unlock_protective_stop(self, delay: float | None = None) -> None:
+        """Unlock a protective stop now (nothing when there is none); blocks briefly.
+
+        Args:
+            delay: the least simulated time since the stop (default: the cell's setting).
+
+        Raises:
+            SimError: too early, as PolyScope refuses it (the message says how long is left).
+        """
+        wait = self.unlock_delay if delay is None else delay
+        refused = self._physics.call(lambda _c: self._ctl.unlock(self._physics.time(), wait))
+        if refused:
+            raise SimError(refused)
+
+    def clear_protective_stop(self) -> CommandHandle:
+        """Unlock a protective stop as soon as the unlock delay allows; the handle finishes
+        when the arm can move again (at once when it is not stopped)."""
+        handle = CommandHandle("clear_protective_stop")
+        delay = self.unlock_delay
+        return self._post(handle, lambda: self._ctl.clear_when_allowed(handle, delay))
 
     # ---------------------------------------------------------------- freedrive
 

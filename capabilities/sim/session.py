@@ -8,6 +8,12 @@ OperatorConsole: prompts and buttons). The clock is simulated time. A scene file
 ``worker`` block gets a simulated person (``session.worker``, see ``sim/worker.py``), one with
 a ``bender`` block a working 2D wire bender (``session.bender``, see ``sim/bender.py``).
 Ground truth stays on ``ground_truth`` and ``scene`` for tests and scores.
+
+A collision is a protective stop (``sim/safety.py``), reported as the UR cell reports one:
+:meth:`SimCellSession.hold_reason` names it in the same words, :meth:`SimCellSession.status`
+shows it in the status bar, whose button calls :meth:`SimCellSession.clear` once the unlock
+delay has passed, and :meth:`SimCellSession.clear_protective_stop` unlocks it as the UR
+cell's does (refused earlier than the delay).
 """
 
 from __future__ import annotations
@@ -24,6 +30,7 @@ import numpy as np
 from capabilities.camera_source import CameraSource
 from capabilities.camera_sources import open_source
 from capabilities.collaboration.console import OperatorConsole
+from capabilities.faults import PROTECTIVE_STOP, CellStatus
 from capabilities.jobs import WorkerPool
 from capabilities.sim.bender import WireBender, install_scene_bender
 from capabilities.sim.bender_spec import FaultModel
@@ -138,6 +145,10 @@ class SimCellSession:
         start_actors: start the scene's worker and bender now; False: they wait for
             :meth:`start_actors` (a run as fast as possible starts them with its plan, so
             that setting up the run costs no simulated time of theirs).
+        lockstep: simulated time stands still while a job of the worker pool (perception)
+            computes, as it does while a camera renders: a run as fast as possible (long
+            trials, benches) then sees the world as often as its plan asks, however long
+            perception takes on a loaded machine. Off: the world goes on meanwhile.
     """
 
     name = "sim"
@@ -152,10 +163,12 @@ class SimCellSession:
         wrist_size: tuple[int, int] | None = None,
         faults: FaultModel | None = None,
         start_actors: bool = True,
+        lockstep: bool = False,
     ) -> None:
         self.sim = SimCell(config, speed)
         self.world_model = WorldModel()
-        self.workers = WorkerPool(2, "costar-sim-worker")
+        around = self.sim.standing_still if lockstep else None
+        self.workers = WorkerPool(2, "costar-sim-worker", around)
         self.operator = OperatorConsole()
         self.worker: SimWorker | None = None  # the simulated person, if the scene has one
         self.live_view: LiveView | None = None  # live pictures (a mirror per camera)
@@ -179,6 +192,7 @@ class SimCellSession:
                 name: self._device(name, settings, sizes.get(name))
                 for name, settings in self.sim.config.cameras.items()
             }
+            self.sim.name_bodies(self._body_name)
             self.worker = install_scene_worker(self.sim, self.scene, path, seed, start_actors)
             self.bender = install_scene_bender(
                 self.sim, self.scene, path, seed, faults, start_actors
@@ -303,6 +317,44 @@ class SimCellSession:
 
     def clock(self) -> float:
         return self.sim.time()
+
+    # ---------------------------------------------------------------- safety
+
+    def hold_reason(self) -> str:
+        """Why the robot cannot act now ("protective stop", or ""): the executor's hold check."""
+        return PROTECTIVE_STOP if self.sim.robot.protective_stop() is not None else ""
+
+    def clear_protective_stop(self) -> None:
+        """Unlock a protective stop (blocks briefly; nothing when there is none).
+
+        Raises:
+            SimError: earlier than the unlock delay after the stop, as a UR refuses it.
+        """
+        self.sim.robot.unlock_protective_stop()
+
+    def status(self) -> CellStatus | None:
+        """The robot's state for the status bar while it is stopped (None while it can move:
+        the simulated arm has no controller state worth a permanent label)."""
+        stop = self.sim.robot.protective_stop()
+        if stop is None:
+            return None
+        allowed = self.sim.time() - stop.time >= self.sim.robot.unlock_delay
+        return CellStatus(
+            True, "RUNNING", "PROTECTIVE_STOP", "STOPPED", PROTECTIVE_STOP,
+            "Unlock protective stop" if allowed else "",
+        )  # fmt: skip
+
+    def clear(self) -> None:
+        """The operator's clear from the status bar: unlock the protective stop as soon as
+        the unlock delay allows (returns at once; the physics thread does it)."""
+        self.sim.robot.clear_protective_stop()  # finishes by itself once allowed
+
+    def _body_name(self, body: int) -> str:
+        """A scene object's name by its body (physics thread; "" when not one)."""
+        for name, spawned in self.scene.objects.items():
+            if spawned.body_id == body:
+                return name
+        return ""
 
     def capability_settings(self) -> tuple[Mapping[str, Any], str]:
         """The ``capabilities`` block of the cell file and the file's path (for errors)."""

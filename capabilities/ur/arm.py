@@ -15,6 +15,7 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import Future
 from typing import TYPE_CHECKING, Any
 
+from capabilities.faults import PROTECTIVE_STOP
 from capabilities.sim.commands import CommandHandle
 from capabilities.sim.kinematics import UR5Kinematics
 from capabilities.ur.connection import NO_SCRIPT, URConnection, URState, fault_reason
@@ -30,6 +31,8 @@ _JOINT_TOLERANCE = 0.01  # rad: a finished move this far from its target did not
 _POSITION_TOLERANCE = 0.002  # m
 _SCRIPT_GRACE = 0.06  # s: how long a stopped script must last before it is the reason
 _START_TIMEOUT = 2.0  # s for the controller to report the asynchronous move started
+_CLEAR_TIMEOUT = 20.0  # s for a protective stop to be unlocked and the script to run again
+_UNLOCK_RETRY = 0.5  # s between unlock attempts the controller refused (too early)
 
 
 def require_version(connection: URConnection, operation: str, needed: PolyScopeVersion) -> None:
@@ -139,6 +142,17 @@ class URArm:
             handle.resolve(True, "stopped")
 
         self._submit(handle, run)
+        return handle
+
+    def clear_protective_stop(self, timeout: float = _CLEAR_TIMEOUT) -> CommandHandle:
+        """Unlock a protective stop through the dashboard as soon as the controller allows
+        it (5 s after the stop on a UR), and finish when the arm runs again (the control
+        script uploaded again). At once when the arm can move. It fails with the fault's
+        words on what only the operator may clear (an emergency stop, power off, a lost
+        connection), and with "timed out" after ``timeout`` s."""
+        handle = CommandHandle("clear_protective_stop", lambda h: None)  # the monitor sees it
+        unlock = _Unlock(handle, time.monotonic() + timeout)
+        self._submit(handle, lambda: self._conn.add_monitor(unlock))
         return handle
 
     def set_speed_fraction(self, fraction: float) -> CommandHandle:
@@ -295,6 +309,40 @@ class _Monitor:
             handle.resolve(False, f"{handle.name}: the controller did not start the move")
             return True
         return False
+
+
+class _Unlock:
+    """(I/O thread) Unlocks a protective stop and waits until the arm can move again."""
+
+    def __init__(self, handle: CommandHandle, deadline: float) -> None:
+        self.handle = handle
+        self.deadline = deadline
+        self.next_try = 0.0
+        self.refused = ""
+
+    def __call__(self, conn: URConnection) -> bool:
+        handle, now = self.handle, time.monotonic()
+        problem = fault_reason(conn.state)
+        if handle.cancel_requested:
+            handle.resolve(False, f"{handle.name} cancelled")
+        elif not problem:
+            handle.resolve(True, "the arm can move")
+        elif now > self.deadline:
+            why = f" (the controller said: {self.refused})" if self.refused else ""
+            handle.resolve(False, f"{handle.name}: timed out{why}")
+        elif problem == PROTECTIVE_STOP:
+            if now >= self.next_try:
+                self.next_try = now + _UNLOCK_RETRY
+                try:
+                    conn.clear_protective_stop()  # unlock, then upload the script again
+                except Exception as exc:  # too early after the stop: the controller refuses
+                    self.refused = str(exc)
+            return False
+        elif problem == NO_SCRIPT:
+            return False  # unlocked: the script is on its way (or the recovery monitor's)
+        else:  # an emergency stop, power off, a lost connection: the operator's to clear
+            handle.resolve(False, f"{handle.name}: {problem} (for the operator to clear)")
+        return handle.done()
 
 
 if TYPE_CHECKING:  # the arm is both interfaces the capabilities ask a cell for

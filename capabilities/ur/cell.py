@@ -23,7 +23,6 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Mapping
-from dataclasses import dataclass
 from types import TracebackType
 from typing import Any
 
@@ -32,6 +31,7 @@ from capabilities.camera_sources import open_source
 from capabilities.cell_robot import TCP_OF_TOOL
 from capabilities.collaboration.console import OperatorConsole
 from capabilities.collaboration.inputs import DigitalInputButton
+from capabilities.faults import CellStatus
 from capabilities.jobs import WorkerPool
 from capabilities.object_library import ObjectLibrary
 from capabilities.sim.config import CellConfig
@@ -56,17 +56,7 @@ TEACH_BUTTON = "teach"  # the console button the pendant's teach button presses 
 _RETRY_SCRIPT = 1.0  # s between uploads of the control script while it is not running
 _RETRY_CONNECT = 2.0  # s between reconnection attempts
 _LET_UR_RTDE_TRY = 5.0  # s of a lost connection before ours (see _Recovery)
-
-
-@dataclass(frozen=True)
-class CellStatus:
-    """What the toolbar shows of the robot: connection, robot mode, safety mode, program."""
-
-    connected: bool
-    robot_mode: str
-    safety_mode: str
-    program: str
-    problem: str  # "" when the robot can move
+RESTART_SCRIPT = "Restart control script"  # the status bar's clear of a stopped script
 
 
 class URCellSession:
@@ -114,7 +104,8 @@ class URCellSession:
         except BaseException:
             self.close()
             raise
-        self.connection.watch(_Recovery())
+        self._recovery = _Recovery()
+        self.connection.watch(self._recovery)
         self._start_buttons()
 
     def _start_buttons(self) -> None:
@@ -168,15 +159,29 @@ class URCellSession:
     def hold_reason(self) -> str:
         """Why the robot cannot act now, in words ("" when it can): the executor's hold check.
 
-        Reads the snapshot the I/O thread keeps: never a call into ur_rtde.
+        Reads the snapshot the I/O thread keeps: never a call into ur_rtde. A stop lasts
+        until the arm runs again: between the unlock of a protective stop and the control
+        script's upload it still reads "protective stop" (not a new fault of its own).
         """
-        return fault_reason(self.connection.state)
+        reason = fault_reason(self.connection.state)
+        if reason == NO_SCRIPT and self._recovery.clearing:
+            return self._recovery.clearing
+        return reason
 
     def clear(self) -> None:
         """The operator's clear of a control script that ended on its own (stopped on the
         pendant, a script error): upload it again. Returns at once (the I/O thread does it);
         the hold lifts when the script runs."""
         self.connection.submit(self.connection.start_control)
+
+    def clear_protective_stop(self) -> None:
+        """Unlock a protective stop through the dashboard and upload the control script
+        again (blocks for the controller's answer; never from the engine thread).
+
+        Raises:
+            URError: the controller refused (too early after the stop, or another fault).
+        """
+        self.connection.call(self.connection.clear_protective_stop)
 
     def status(self) -> CellStatus:
         """The robot's state for the toolbar (a snapshot; never blocks)."""
@@ -189,6 +194,7 @@ class URCellSession:
             SafetyMode(state.safety_mode).name,
             "PLAYING" if state.program_running else "STOPPED",
             fault_reason(state),
+            RESTART_SCRIPT if fault_reason(state) == NO_SCRIPT else "",
         )
 
     # ---------------------------------------------------------------- lifetime
@@ -222,7 +228,7 @@ class _Recovery:
     def __init__(self) -> None:
         self._next_try = 0.0
         self._lost_since: float | None = None
-        self._fault_seen = False  # a stop or a power loss the operator must clear first
+        self.clearing = ""  # the stop or power loss being cleared ("" when none)
 
     def __call__(self, conn: URConnection) -> bool:
         now = time.monotonic()
@@ -233,9 +239,9 @@ class _Recovery:
             self._lost_since = now
         problem = fault_reason(state)
         if problem and problem != NO_SCRIPT:
-            self._fault_seen = True
+            self.clearing = problem
         elif not problem:
-            self._fault_seen = False
+            self.clearing = ""
         if now < self._next_try:
             return False
         try:
@@ -246,7 +252,7 @@ class _Recovery:
                     return False
                 self._next_try = now + _RETRY_CONNECT
                 conn.reconnect()
-            elif problem == NO_SCRIPT and self._fault_seen:
+            elif problem == NO_SCRIPT and self.clearing:
                 # The operator cleared a stop (the script ends with it): upload it again. A
                 # script that ended on its own (stopped on the pendant, a script error) waits
                 # for the operator's clear() instead.

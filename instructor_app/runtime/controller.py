@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 from PySide6.QtCore import QObject, QTimer, Signal
 
+from capabilities.faults import hold_check
 from engine.blackboard import Blackboard, BlackboardError
 from engine.build import BuildError, build_tree
 from engine.error_types import ErrorType
@@ -233,7 +234,7 @@ class RunController(QObject):
         self._last_board = tree.blackboard
         self._reset_run(plan)
         self._statuses.update({k: v for k, v in done.items() if k in self._order})
-        hold = getattr(self.session.cell, "hold_reason", None)  # a real robot's stops
+        hold = hold_check(self.session.cell)  # a robot's stops (held, or thrown to a Catch)
         self._executor = Executor(
             tree, self.rate_hz, [self._pump.put], plan_name=plan.name, hold=hold
         )

@@ -2,8 +2,11 @@
 
 A real cell (``capabilities.ur.cell.URCellSession``) keeps a snapshot of what its controller
 reports, refreshed on its own I/O thread; this widget reads that snapshot on a timer, so the
-GUI thread never waits on the robot. Cells without a robot controller (the simulated cell,
-none) have no ``status()``: the widget hides.
+GUI thread never waits on the robot. A cell without a robot controller (none) has no
+``status()``, and the simulated cell answers None while its arm can move: the widget hides.
+Next to it, the cell's clear button does the operator's clear of the problem shown
+(``cell.clear()``) when the cell names one (``CellStatus.clear_action``: "Restart control
+script" on a UR, "Unlock protective stop" on the simulated cell once the delay has passed).
 """
 
 from __future__ import annotations
@@ -15,7 +18,7 @@ from PySide6.QtWidgets import QLabel, QToolButton, QWidget
 
 from instructor_app.runtime.session import CellSession
 
-__all__ = ["RobotStatusLabel", "ScriptRestartButton"]
+__all__ = ["CellClearButton", "RobotStatusLabel"]
 
 _OK_STYLE = "QLabel { background: #d8f0d8; color: #104010; padding: 2px 6px; }"
 _FAULT_STYLE = "QLabel { background: #f6d0d0; color: #601010; padding: 2px 6px; }"
@@ -32,10 +35,12 @@ class RobotStatusLabel(QLabel):
         presence_changed(bool): the open cell has (or no longer has) a robot controller; a
             window shows or hides the label on it.
         fault_changed(str): the problem shown changed ("" when the robot can move).
+        clear_action_changed(str): the operator's clear offered changed ("" for none).
     """
 
     presence_changed = Signal(bool)
     fault_changed = Signal(str)
+    clear_action_changed = Signal(str)
 
     def __init__(
         self, session: CellSession, interval_ms: int = 100, parent: QWidget | None = None
@@ -59,10 +64,12 @@ class RobotStatusLabel(QLabel):
             return
         if (status is None) != (self._shown is None):
             self.presence_changed.emit(status is not None)
-        fault_before = self.fault
+        fault_before, action_before = self.fault, self.clear_action
         self._shown = status
         if self.fault != fault_before:
             self.fault_changed.emit(self.fault)
+        if self.clear_action != action_before:
+            self.clear_action_changed.emit(self.clear_action)
         if status is None:
             self.setText("")
             return
@@ -90,28 +97,34 @@ class RobotStatusLabel(QLabel):
         """The problem shown now ("" when the robot can move or there is no robot)."""
         return str(getattr(self._shown, "problem", ""))
 
+    @property
+    def clear_action(self) -> str:
+        """The operator's clear the cell offers now ("" for none)."""
+        return str(getattr(self._shown, "clear_action", ""))
 
-class ScriptRestartButton(QToolButton):
-    """ "Restart control script": the operator's clear of a control script that ended on its
-    own (stopped on the pendant, a script error). Shown only while that is the robot's problem;
-    the cell uploads the script on its own thread, so the click returns at once."""
+
+class CellClearButton(QToolButton):
+    """The operator's clear of the robot's problem, labelled as the cell names it ("Restart
+    control script", "Unlock protective stop"). Shown only while the cell offers one; the
+    cell does the work on its own thread, so the click returns at once and a held run goes on
+    when the robot is ready."""
 
     def __init__(
         self, session: CellSession, status: RobotStatusLabel, parent: QWidget | None = None
     ) -> None:
         super().__init__(parent)
-        self.setObjectName("RestartScript")
-        self.setText("Restart control script")
-        self.setToolTip("Upload the robot's control script again; a held run then goes on")
+        self.setObjectName("CellClear")
+        self.setToolTip("Clear the robot's stop; a held run then goes on")
         self._session = session
         self.setVisible(False)
-        status.fault_changed.connect(self._on_fault)
-        self.clicked.connect(self._restart)
+        status.clear_action_changed.connect(self._on_action)
+        self.clicked.connect(self._clear)
 
-    def _on_fault(self, fault: str) -> None:
-        self.setVisible(fault.startswith("the control script is not running"))
+    def _on_action(self, action: str) -> None:
+        self.setText(action)
+        self.setVisible(bool(action))
 
-    def _restart(self) -> None:
+    def _clear(self) -> None:
         clear = getattr(self._session.cell, "clear", None)
         if callable(clear):
             clear()

@@ -28,12 +28,20 @@ from capabilities.base import CapabilityRegistry
 from engine.build import build_tree
 from engine.composites import Parallel
 from engine.context import TreeContext
+from engine.error_types import ErrorType
 from engine.events import BlackboardWritten, LogMessage, RunFinished, RunStarted, StatusChanged
 from engine.executor import Executor, ExecutorState, run_to_end
+from engine.hold import Hold
 from engine.node import Node
 from engine.spec import NodeKind
 from engine.status import FAILURE, IDLE, RUNNING, SUCCESS, Status
 from engine.tree import BehaviorTree
+
+
+def hold_of(reason: str) -> Hold | None:
+    """A protective stop in words, as a cell's hold check answers (None when clear)."""
+    return Hold(reason, ErrorType.PROTECTIVE_STOP) if reason else None
+
 
 NO_PERIOD = 0.01  # Hz: a period of 100 s, so that only wake-ups and steps tick
 
@@ -276,7 +284,9 @@ def test_a_hold_halts_the_running_leaf_within_a_tick_and_the_run_goes_on_after()
     tree = rooted(ctx, seq)
     reason = [""]
     recorder = Recorder()
-    executor = started(Executor(tree, rate_hz=200.0, listeners=[recorder], hold=lambda: reason[0]))
+    executor = started(
+        Executor(tree, rate_hz=200.0, listeners=[recorder], hold=lambda: hold_of(reason[0]))
+    )
     assert first.started.wait(5.0)
     first.jobs[0].succeed()
     assert second.started.wait(5.0)
@@ -298,7 +308,7 @@ def test_a_hold_halts_the_running_leaf_within_a_tick_and_the_run_goes_on_after()
 def test_a_hold_check_that_raises_holds_the_run_with_its_message() -> None:
     tree, node = forever_running()
 
-    def broken() -> str:
+    def broken() -> Hold | None:
         raise RuntimeError("no state")
 
     executor = started(Executor(tree, rate_hz=200.0, hold=broken))

@@ -122,6 +122,9 @@ class EmulatedController:
                 self._program = ControlProgram(self, self._pending_script)
                 self._pending_script = None
             self.faults.check()
+            collision = self.cell.robot.protective_stop()
+            if collision is not None and self.safety_mode == SafetyMode.NORMAL:
+                self.protective_stop(collision.cause)  # the arm hit something: as a UR does
             if self._program is not None and not self._program.step():
                 self._end_program_locked("the control script ended")
             self._publish()
@@ -294,10 +297,12 @@ class EmulatedController:
         return self.cell.robot.is_moving()
 
     def _watch(self, handle: CommandHandle) -> CommandHandle:
-        """A move that fails on its own (unreachable, path error) ends the script, as on a UR."""
+        """A move that fails on its own (unreachable, path error) ends the script, as on a UR;
+        a collision is the arm's protective stop, which the next cycle raises instead."""
 
         def finished(h: CommandHandle) -> None:
-            if not h.ok and not h.cancel_requested:
+            collided = self.cell.robot.protective_stop() is not None
+            if not h.ok and not h.cancel_requested and not collided:
                 threading.Thread(
                     target=self.end_program, args=(f"script error: {h.message}",), daemon=True
                 ).start()
@@ -370,6 +375,8 @@ class EmulatedController:
                     f"Cannot unlock protective stop until {self.unlock_delay:g}s after "
                     "occurrence. Always inspect cause of protective stop before unlocking"
                 )
+            # The simulated arm's own stop (a collision) goes with it: this delay is the rule.
+            self.cell.robot.unlock_protective_stop(delay=0.0)
             self.safety_mode = SafetyMode.NORMAL
             return "Protective stop releasing"
 

@@ -18,6 +18,7 @@ import pytest
 from capabilities.base import CapabilityRegistry
 from capabilities.cells import CellError, open_cell
 from capabilities.cli import main
+from capabilities.faults import hold_check
 from capabilities.sim.config import DEFAULT_CONFIG_PATH, CellConfig, CellConfigError
 from engine.build import build_tree
 from engine.events import Event, RunHeld, StatusChanged
@@ -161,7 +162,7 @@ def _run(cell: object, plan: PlanSpec, events: list[Event]) -> Executor:
         20.0,
         [events.append],
         plan_name=plan.name,
-        hold=cell.hold_reason,  # type: ignore[attr-defined]
+        hold=hold_check(cell),
     )
     executor.start()
     return executor

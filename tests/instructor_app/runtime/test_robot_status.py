@@ -71,8 +71,8 @@ def test_the_toolbar_shows_each_robot_state(qtbot, tmp_path: Path, emulator) -> 
         emulator.kill_script()  # stopped on the pendant: the operator restarts it here
         qtbot.waitUntil(lambda: "control script is not running" in label.fault, timeout=WAIT_MS)
         assert "program STOPPED" in text()
-        restart = window.robot_restart
-        assert restart.isVisibleTo(window)
+        restart = window.robot_clear
+        assert restart.isVisibleTo(window) and restart.text() == "Restart control script"
         qtbot.mouseClick(restart, Qt.MouseButton.LeftButton)
         qtbot.waitUntil(lambda: not label.fault and "PLAYING" in text(), timeout=WAIT_MS)
         assert not restart.isVisibleTo(window)
