@@ -69,8 +69,9 @@ SHIPPED = Path(__file__).resolve().parents[2] / "resources" / "examples" / "tend
 # Counted as CountingBot counts (a click, a key, a typed text, a list opened, a file chosen, a
 # drag of the tool): 418 for the whole set-up of the 28-node plan, its 4 waypoints taught
 # by hand (each: a drag, the frame chosen, the rack typed once, a name, Record), 6 imported,
-# and one run to see the rack. Most go to the inspector: 9 subtree instances take 20
-# waypoint and 6 parameter bindings, each a mode and a value chosen from lists. A change
+# and one run to see the rack. Most go to the inspector: the 9 subtree instances and 2
+# moves take 18 waypoints and 5 parameters by name (each: a mode and a value from lists),
+# the 4 catches 7 settings, the 2 occupancy waits 5 (the region typed in mm). A change
 # that makes this set-up take more actions fails here.
 MOST_ACTIONS = 418
 TAUGHT = ("over exit", "at exit", "over rack", "into rack")  # by hand; the rest imported
