@@ -213,7 +213,6 @@ def _screenshot(args: argparse.Namespace) -> int:
         try:
             window.switch_cell(args.cell)
             _wait_for_cell(session)  # the picture shows the cell asked for, ready
-            _wait_for_camera_pictures(window)
             if args.plan:
                 try:
                     window.document.open(args.plan)
@@ -223,6 +222,7 @@ def _screenshot(args: argparse.Namespace) -> int:
             window.resize(*args.size)
             window.arrange_cell_views()  # the picture's size may give them a column
             window.show()
+            _wait_for_camera_pictures(window)  # shown: a hidden camera panel captures nothing
             code = _run_for_picture(window, args.timeout) if args.run else EXIT_OK
             _grab(window, Path(args.screenshot))
             return code
