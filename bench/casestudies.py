@@ -6,17 +6,25 @@ outcome with the simulator's ground truth (ground truth only scores; the plan pe
 through the cameras). A run succeeded when the plan returned SUCCESS *and* the scorer agrees
 that the task was done.
 
+- ``tending`` (section V-B, Table I): the paper's plan and ours tend the wire bender for two
+  trials of ``--parts`` parts from ``--seed`` on (see ``bench/_tending.py``); their counters
+  are printed side by side with the paper's Table I.
 - ``kitting``: resources/examples/kitting.costar.json on scene ``kitting_handoff`` (Figure 7):
   each of the three plates lies inside the kit bin and the bin stands at the return place.
+- ``cup_to_bin``: resources/examples/cup_to_bin_vision.costar.json on scene ``cup_to_bin``
+  (Figure 3, found by vision): the cup lies in the waste bin.
 
-To add a case study (``tending``, ``cup_to_bin``), add a :class:`CaseStudy` to ``CASES``: its
-plan, scene and a scorer ``(session) -> str`` that returns "" when the task was done, else
-what is wrong. Run from the repository root::
+To add a seeded case study, add a :class:`CaseStudy` to ``CASES``: its plan, scene and a
+scorer ``(session) -> str`` that returns "" when the task was done, else what is wrong. Run
+from the repository root::
 
-    .venv/bin/python bench/casestudies.py [--runs 100] [--only kitting] [--json]
+    .venv/bin/python bench/casestudies.py [--runs 100] [--only kitting] [--seed 1000]
+        [--parts 50] [--json]
 
-JSON: ``{"kitting": {"runs": 100, "succeeded": 99, "failures": {"seed": "why", ...},
-"wall_s_per_run": 17.2}}`` (wall seconds per run, divided by ``--jobs`` in effect).
+JSON: ``{"tending": {"paper": {"produced": 100, "caught": 80, ...}, "ours": {...}},
+"kitting": {"runs": 100, "succeeded": 99, "failures": {"seed": "why", ...},
+"wall_s_per_run": 17.2}, "cup_to_bin": {...}}`` (wall seconds per run, divided by ``--jobs``
+in effect).
 """
 
 from __future__ import annotations
@@ -36,6 +44,7 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+from bench._tending import PLANS, RESET_S, SPEED, measure_tending, table_one  # noqa: E402
 from capabilities.base import CapabilityRegistry  # noqa: E402
 from capabilities.sim.session import SimCellSession  # noqa: E402
 from engine.build import build_tree  # noqa: E402
@@ -83,9 +92,25 @@ def score_kitting(session: SimCellSession) -> str:
     return "; ".join(problems)
 
 
+CUP_IN_BIN = (0.18, 0.09, 0.22)  # m: half the waste bin's inner length and width, its height
+
+
+def score_cup_to_bin(session: SimCellSession) -> str:
+    """'' when the cup lies in the waste bin."""
+    session.sim.wait_sim(1.0)  # let the dropped cup settle
+    x, y, z = _in_frame(session.truth_pose("waste_bin"), session.truth_pose("cup"))
+    if abs(x) < CUP_IN_BIN[0] and abs(y) < CUP_IN_BIN[1] and z < CUP_IN_BIN[2]:
+        return ""
+    return f"the cup is not in the bin ({x:.3f}, {y:.3f}, {z:.3f}) m"
+
+
 CASES: dict[str, CaseStudy] = {
     "kitting": CaseStudy(EXAMPLES / "kitting.costar.json", "kitting_handoff", score_kitting),
+    "cup_to_bin": CaseStudy(
+        EXAMPLES / "cup_to_bin_vision.costar.json", "cup_to_bin", score_cup_to_bin
+    ),
 }
+TENDING = "tending"
 
 
 def run_case(case: CaseStudy, seed: int) -> str:
@@ -132,27 +157,67 @@ def measure(name: str, runs: int, first_seed: int = 0, jobs: int = 1) -> dict[st
     }
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Run every case study (or ``--only`` one) and print the figures."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--runs", type=int, default=100, help="seeds per case study")
+def _arguments(argv: list[str] | None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
+    parser.add_argument("--runs", type=int, default=100, help="seeds per seeded case study")
     parser.add_argument("--first-seed", type=int, default=0)
-    parser.add_argument("--only", choices=sorted(CASES), action="append")
+    parser.add_argument("--only", choices=sorted([TENDING, *CASES]), action="append")
     parser.add_argument("--jobs", type=int, default=1, help="cells run at once (processes)")
+    parser.add_argument("--seed", type=int, default=1000, help="tending: trial i runs seed+i")
+    parser.add_argument("--parts", type=int, default=50, help="tending: parts per trial")
+    parser.add_argument("--trials", type=int, default=2, help="tending: trials per plan")
+    parser.add_argument(
+        "--reset-s",
+        type=float,
+        default=RESET_S,
+        help="tending: simulated seconds the operator takes to reset the cell",
+    )
+    parser.add_argument(
+        "--speed",
+        type=float,
+        default=SPEED or 0.0,
+        help="tending: times real time at most (0: as fast as lockstep allows)",
+    )
+    parser.add_argument("--plan", choices=sorted(PLANS), action="append",
+                        help="tending: only this plan (default: both)")  # fmt: skip
     parser.add_argument("--json", action="store_true", help="print one JSON object")
-    args = parser.parse_args(argv)
-    figures = {
-        name: measure(name, args.runs, args.first_seed, args.jobs) for name in args.only or CASES
-    }
+    return parser.parse_args(argv)  # fmt: skip
+
+
+def _print(figures: dict[str, Any]) -> None:
+    for name, fig in figures.items():
+        if name == TENDING:
+            print(table_one(fig))
+            for plan, entry in fig.items():
+                for error in entry.get("errors", []):
+                    print(f"  tending {plan}: {error}")
+            continue
+        print(f"{name}: {fig['succeeded']}/{fig['runs']} succeeded, {fig['wall_s_per_run']} s/run")
+        for seed, why in fig["failures"].items():
+            print(f"  seed {seed}: {why}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run every case study (or ``--only`` some) and print the figures."""
+    args = _arguments(argv)
+    figures: dict[str, Any] = {}
+    for name in args.only or [TENDING, *CASES]:
+        if name == TENDING:
+            figures[name] = measure_tending(
+                args.seed,
+                args.parts,
+                args.trials,
+                args.jobs,
+                args.reset_s,
+                args.speed or None,
+                args.plan,
+            )
+        else:
+            figures[name] = measure(name, args.runs, args.first_seed, args.jobs)
     if args.json:
         print(json.dumps(figures))
     else:
-        for name, fig in figures.items():
-            print(
-                f"{name}: {fig['succeeded']}/{fig['runs']} succeeded, {fig['wall_s_per_run']} s/run"
-            )
-            for seed, why in fig["failures"].items():
-                print(f"  seed {seed}: {why}")
+        _print(figures)
     return 0
 
 

@@ -17,6 +17,9 @@ between phases with the camera and 3D docks hidden (nothing captured or drawn) a
 - ``first_picture_s``: seconds from starting the plan to the first picture of every camera
   (the live view's renderer processes start); both phases are measured after it.
 - ``load_average``: the machine's load (1, 5, 15 min) at the end: the figures depend on it.
+- ``panel_sizes``: width and height (px) of the camera panel and of the 3D scene's GL view
+  as laid out (a 1920 x 1080 window: the cameras above the 3D scene in a column of their own,
+  as the Instructor places them in a window that wide).
 
 Run it on its own or through ``bench/gui.py`` (which runs it in a process of its own with
 ``QT_QPA_PLATFORM=xcb`` when there is a display)::
@@ -85,11 +88,33 @@ def _first_pictures(window: Any, timeout: float = 60.0) -> float:
     return time.perf_counter() - started
 
 
+def _on_screen(window: Any) -> dict[str, list[int]]:
+    """Sizes of the camera panel and the 3D view; raises unless both lie inside the window
+    (tabbed away or squeezed off it, they would be drawn where nobody sees them)."""
+    inside = window.rect()
+    sizes: dict[str, list[int]] = {}
+    for name, widget in (
+        ("cameras", window.cell_views.cameras),
+        ("scene3d", window.cell_views.scene3d),
+    ):
+        corner = widget.mapTo(window, widget.rect().topLeft())
+        if not (widget.isVisible() and inside.contains(widget.rect().translated(corner))):
+            raise RuntimeError(f"the {name} panel is not on screen: the figures would not count")
+        sizes[name] = [widget.width(), widget.height()]
+    view = window.cell_views.scene3d.view
+    if view is not None:
+        sizes["scene3d_gl"] = [view.width(), view.height()]
+    return sizes
+
+
 def _phase(window: Any, shown: bool, seconds: float) -> dict[str, Any]:
     views = window.cell_views
     for name in ("cameras", "scene3d"):
         window.docks[name].setVisible(shown)
+    if shown:  # shown again, the docks come back narrower: the column of a window this wide
+        window.arrange_cell_views()
     _wait(1.0)  # settle: the feed starts or stops, the docks lay out
+    sizes = _on_screen(window) if shown else {}
     executor = window.controller._executor  # the bench reads the engine's tick counter
     cell = window.session.cell
     ticks0, sim0, wall0 = executor.tree.ctx.tick_count, cell.sim.time(), time.perf_counter()
@@ -112,6 +137,7 @@ def _phase(window: Any, shown: bool, seconds: float) -> dict[str, Any]:
             for name, frame in views.cameras.shown.items()
         },
         "app_cpu": None if app0 is None or app1 is None else (app1 - app0) / wall,
+        "sizes": sizes,
         # CPU milliseconds each renderer process spent per frame: what a frame costs whatever
         # the machine's load (1000 / it is the rate one idle core would give).
         "cpu_ms_per_frame": {
@@ -168,6 +194,7 @@ def measure_cell_views(seconds: float = 6.0) -> dict[str, Any]:
         "app_cpu_off": off["app_cpu"] and round(off["app_cpu"], 2),
         # Others' work on the machine: compare figures only with runs under a similar load.
         "load_average": [round(v, 2) for v in os.getloadavg()],
+        "panel_sizes": on["sizes"],
     }
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable, Mapping
 from concurrent.futures import Future, ThreadPoolExecutor
+from contextlib import AbstractContextManager, nullcontext
 from typing import Any, Protocol
 
 from capabilities.faults import fault_error
@@ -65,9 +66,21 @@ class WorkerPool:
 
     One pool per cell session; ``submit`` returns a Job whose result is what the function
     returns: a mapping of outputs (SUCCESS), or it raises (FAILURE with the message).
+
+    Args:
+        workers: threads.
+        name: their name prefix.
+        around: a context manager each function runs in (a simulated cell's lockstep: its
+            simulated time stands still while perception computes).
     """
 
-    def __init__(self, workers: int = 2, name: str = "costar-worker") -> None:
+    def __init__(
+        self,
+        workers: int = 2,
+        name: str = "costar-worker",
+        around: Callable[[], AbstractContextManager[Any]] | None = None,
+    ) -> None:
+        self._around = around or nullcontext
         self._pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix=name)
         self._closed = False
         self._lock = threading.Lock()
@@ -78,7 +91,8 @@ class WorkerPool:
 
         def run() -> None:
             try:
-                outputs = fn()
+                with self._around():
+                    outputs = fn()
             except OperationFailed as exc:
                 job.fail(str(exc), exc.error)
             except Exception as exc:  # a perception bug fails the node, never the engine

@@ -25,7 +25,7 @@ from typing import Any
 # its backend lookup logs noise on every start. The Instructor plays no sound.
 os.environ.setdefault("QT_LOGGING_RULES", "qt.multimedia*=false")
 
-from PySide6.QtCore import QEventLoop, QSettings, QTimer
+from PySide6.QtCore import QEvent, QEventLoop, QSettings, QTimer
 from PySide6.QtGui import QIcon
 from PySide6.QtWidgets import QApplication, QWidget
 
@@ -213,7 +213,6 @@ def _screenshot(args: argparse.Namespace) -> int:
         try:
             window.switch_cell(args.cell)
             _wait_for_cell(session)  # the picture shows the cell asked for, ready
-            _wait_for_camera_pictures(window)
             if args.plan:
                 try:
                     window.document.open(args.plan)
@@ -223,6 +222,7 @@ def _screenshot(args: argparse.Namespace) -> int:
             window.resize(*args.size)
             window.arrange_cell_views()  # the picture's size may give them a column
             window.show()
+            _wait_for_camera_pictures(window)  # shown: a hidden camera panel captures nothing
             code = _run_for_picture(window, args.timeout) if args.run else EXIT_OK
             _grab(window, Path(args.screenshot))
             return code
@@ -230,6 +230,9 @@ def _screenshot(args: argparse.Namespace) -> int:
             window.shutdown()
             window.hide()
             window.deleteLater()
+            # Now, not when the application is torn down: a window container (the 3D
+            # view's) in a window still waiting for deletion then crashes Qt.
+            QApplication.sendPostedEvents(None, QEvent.Type.DeferredDelete.value)
             session.close()
 
 
@@ -291,7 +294,9 @@ def _grab(window: MainWindow, path: Path) -> None:
     window.views.canvas.fit_all()
     QApplication.processEvents()
     path.parent.mkdir(parents=True, exist_ok=True)
-    if not window.grab().save(str(path), "PNG"):
+    picture = window.grab()
+    window.cell_views.scene3d.draw_view_into(picture, window)
+    if not picture.save(str(path), "PNG"):
         raise OSError(f"could not write {path}")
     print(f"wrote {path}")
 

@@ -21,6 +21,7 @@ import numpy as np
 
 from capabilities.bullet import pybullet as p
 from capabilities.camera_source import RGBDFrame
+from capabilities.sim.flat_surfaces import FlatSurfaces
 from capabilities.sim.objects import SceneError
 from capabilities.sim.transforms import matrix_to_pose, pose_to_matrix
 from engine.types import Pose
@@ -180,12 +181,16 @@ class SimCamera:
         )  # fmt: skip
         return Pose(state[4], state[5]).compose(self.mount.T_link_camera)
 
-    def capture(self, client: int, stamp: float | None = None) -> RGBDFrame:
+    def capture(
+        self, client: int, stamp: float | None = None, surfaces: FlatSurfaces | None = None
+    ) -> RGBDFrame:
         """Render one RGB-D frame in ``client``.
 
         Args:
             client: pybullet client id.
             stamp: the time to stamp the frame with (default: the wall clock).
+            surfaces: level surfaces the client lacks, drawn into the picture (the live
+                view's mirror: ``flat_surfaces.py``).
         """
         c = self.config
         pose = self.pose(client)
@@ -200,11 +205,14 @@ class SimCamera:
         d = np.asarray(buffer, dtype=np.float64).reshape(c.height, c.width)
         depth = c.far * c.near / (c.far - (c.far - c.near) * d)
         depth[d >= 1.0 - 1e-6] = np.nan  # float32 buffer: the far plane reads 1 - 1e-7
+        rgb, depth = np.ascontiguousarray(rgb), depth.astype(np.float32)
+        if surfaces is not None:
+            surfaces.draw(rgb, depth, self.intrinsics(), pose, c.near, c.far)
         if c.noise is not None:
             rgb, depth = self._add_noise(rgb, depth, c.noise)
         return RGBDFrame(
-            rgb=np.ascontiguousarray(rgb),
-            depth=depth.astype(np.float32),
+            rgb=rgb,
+            depth=depth,
             K=self.intrinsics(),
             T_world_camera=pose,
             stamp=time.time() if stamp is None else stamp,

@@ -14,6 +14,7 @@ Example::
 from __future__ import annotations
 
 from collections.abc import Callable
+from contextlib import AbstractContextManager
 from pathlib import Path
 from types import TracebackType
 from typing import TypeVar
@@ -135,6 +136,18 @@ class SimCell:
     def call(self, fn: Callable[[int], T]) -> T:
         """Run ``fn(pybullet_client_id)`` on the physics thread and return its result."""
         return self._physics.call(fn)
+
+    def standing_still(self) -> AbstractContextManager[None]:
+        """A block in which simulated time stands still (see ``PhysicsThread``)."""
+        return self._physics.standing_still()
+
+    def add_gate(self, may_step: Callable[[], bool]) -> None:
+        """Step only while ``may_step()`` says True (see ``PhysicsThread.add_gate``)."""
+        self._physics.add_gate(may_step)
+
+    def nudge(self) -> None:
+        """Look at the gates again now (see ``PhysicsThread.nudge``)."""
+        self._physics.nudge()
 
     def wait_sim(self, seconds: float) -> None:
         """Block until simulated time has advanced by ``seconds`` (tests, CLI)."""

@@ -4,7 +4,9 @@ Every other thread talks to pybullet through ``call`` (run a function here and g
 result) or ``post`` (fire and forget). Step hooks registered by the cell's controllers run
 before each ``stepSimulation`` (control) and after it (sensing). Simulated time advances by
 ``time_step`` per step; with a speed factor the loop is paced against the wall clock,
-without one it runs as fast as it can.
+without one it runs as fast as it can. Inside :meth:`PhysicsThread.standing_still` (lockstep:
+perception computing on another thread) the world is not stepped and simulated time stands
+still, as it already does while a call (a camera render) is served.
 """
 
 from __future__ import annotations
@@ -15,8 +17,9 @@ import logging
 import queue
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from concurrent.futures import Future
+from contextlib import contextmanager
 from typing import Any, TypeVar
 
 from capabilities.bullet import pybullet
@@ -61,6 +64,9 @@ class PhysicsThread:
         self._timers: list[tuple[float, int, threading.Event]] = []
         self._timer_ids = itertools.count()
         self._timer_lock = threading.Lock()
+        self._holds = 0  # blocks in standing_still: while above 0 the world is not stepped
+        self._hold_lock = threading.Lock()
+        self._gates: list[Callable[[], bool]] = []  # all must say True for a step
         self._ready = threading.Event()
         self._stopping = threading.Event()
         self._setup_error: BaseException | None = None
@@ -139,6 +145,34 @@ class PhysicsThread:
             heapq.heappush(self._timers, (self._time + seconds, next(self._timer_ids), event))
         return event.wait(timeout)
 
+    @contextmanager
+    def standing_still(self) -> Iterator[None]:
+        """Simulated time stands still inside this block (any thread; blocks may nest and
+        overlap): the world is not stepped, calls are still served. Lockstep for work that
+        takes wall time on another thread (perception), so that the world does not go on
+        without it, however loaded the machine."""
+        if self.in_thread():
+            raise SimError("standing_still is for other threads than the physics thread")
+        with self._hold_lock:
+            self._holds += 1
+        try:
+            yield
+        finally:
+            with self._hold_lock:
+                self._holds -= 1
+            self.nudge()  # wake a loop waiting on calls
+
+    def add_gate(self, may_step: Callable[[], bool]) -> None:
+        """Step the world only while ``may_step()`` (any thread's state; keep it cheap) says
+        True: lockstep with another loop, e.g. an engine that must not fall behind. Whoever
+        changes what the gate reads calls :meth:`nudge`."""
+        self._gates.append(may_step)
+
+    def nudge(self) -> None:
+        """Wake a loop that stands still, to look at its gates again (any thread)."""
+        if self.running:
+            self._queue.put((lambda _client: None, Future()))
+
     # ------------------------------------------------------------------ loop
 
     def _run(self) -> None:
@@ -164,6 +198,9 @@ class PhysicsThread:
         sim_start = self._time
         while not self._stopping.is_set():
             self._drain()
+            if self._holds or not all(gate() for gate in self._gates):
+                self._stand_still()
+                continue
             self._step_once()
             if self.speed is not None:
                 # Time spent serving calls (a camera frame takes 30-300 ms to render) does
@@ -175,6 +212,17 @@ class PhysicsThread:
                     self._idle(ahead)
             elif self.steps % 64 == 0:
                 time.sleep(0)  # let other Python threads have the GIL now and then
+
+    def _stand_still(self) -> None:
+        """Serve calls without stepping while a block holds time (wall time not simulated)."""
+        started, served = time.perf_counter(), self._serving_s
+        try:
+            item = self._queue.get(timeout=0.05)
+        except queue.Empty:
+            item = None
+        if item is not None:
+            self._execute(*item)
+        self._serving_s = served + (time.perf_counter() - started)
 
     def _idle(self, seconds: float) -> None:
         """Sleep while ahead of the wall clock, but wake for queued commands."""

@@ -145,6 +145,10 @@ class SimCellSession:
         start_actors: start the scene's worker and bender now; False: they wait for
             :meth:`start_actors` (a run as fast as possible starts them with its plan, so
             that setting up the run costs no simulated time of theirs).
+        lockstep: simulated time stands still while a job of the worker pool (perception)
+            computes, as it does while a camera renders: a run as fast as possible (long
+            trials, benches) then sees the world as often as its plan asks, however long
+            perception takes on a loaded machine. Off: the world goes on meanwhile.
     """
 
     name = "sim"
@@ -159,10 +163,12 @@ class SimCellSession:
         wrist_size: tuple[int, int] | None = None,
         faults: FaultModel | None = None,
         start_actors: bool = True,
+        lockstep: bool = False,
     ) -> None:
         self.sim = SimCell(config, speed)
         self.world_model = WorldModel()
-        self.workers = WorkerPool(2, "costar-sim-worker")
+        around = self.sim.standing_still if lockstep else None
+        self.workers = WorkerPool(2, "costar-sim-worker", around)
         self.operator = OperatorConsole()
         self.worker: SimWorker | None = None  # the simulated person, if the scene has one
         self.live_view: LiveView | None = None  # live pictures (a mirror per camera)

@@ -46,6 +46,10 @@ __all__ = ["CameraPanel", "camera_interfaces"]
 
 PathAsker = Callable[[QWidget], str]
 POLL_MS = 30  # the GUI looks for new frames ~33 times a second
+# Each camera is captured a little above the 15 pictures a second the panel should show: a
+# picture is shown at most once, and one that a late GUI turn finds already replaced by the
+# next is never shown, so a feed at exactly 15 shows 14-15 (bench/cell_views.py).
+LIVE_FPS = 16.0
 
 
 def camera_interfaces(cell: Any) -> dict[str, Any]:
@@ -99,7 +103,7 @@ class CameraPanel(QWidget):
     message = Signal(str)
 
     def __init__(
-        self, fps: float = 15.0, ask_path: PathAsker = _ask_png, parent: QWidget | None = None
+        self, fps: float = LIVE_FPS, ask_path: PathAsker = _ask_png, parent: QWidget | None = None
     ) -> None:
         super().__init__(parent)
         self.setObjectName("CameraPanel")

@@ -21,7 +21,8 @@ from typing import Any
 
 import numpy as np
 import pyqtgraph.opengl as gl
-from PySide6.QtCore import Qt, QTimer, Signal
+from PySide6.QtCore import QPoint, Qt, QTimer, Signal
+from PySide6.QtGui import QPainter, QPixmap
 from PySide6.QtWidgets import QCheckBox, QLabel, QPushButton, QToolBar, QVBoxLayout, QWidget
 
 from capabilities.geometry import pose_to_matrix
@@ -112,7 +113,10 @@ class Scene3DPanel(PointingMixin, QWidget):
         for widget in (self.region_button, self.cloud_box, self.truth_box):
             bar.addWidget(widget)
         layout.addWidget(bar)
-        self.view = view = SceneView(self)
+        self.view = view = SceneView()
+        # A window of its own in the panel (scene3d_view.py says why)
+        self.view_box = QWidget.createWindowContainer(view, self)
+        self.view_box.setFocusPolicy(Qt.FocusPolicy.ClickFocus)
         view.setBackgroundColor((32, 32, 36))
         # From behind the robot's left, looking at the table (the robot base is at the origin).
         view.setCameraPosition(
@@ -127,7 +131,7 @@ class Scene3DPanel(PointingMixin, QWidget):
         view.released.connect(self._on_release)
         view.gizmo_moved.connect(self._on_gizmo_moved)
         self.region_button.toggled.connect(lambda on: setattr(view, "capture_drags", on))
-        layout.addWidget(view, 1)
+        layout.addWidget(self.view_box, 1)
         self._static: list[Any] = []
 
     # ------------------------------------------------------------------ inputs
@@ -213,6 +217,15 @@ class Scene3DPanel(PointingMixin, QWidget):
             self._timer.stop()
             self._workers.shutdown(wait=False, cancel_futures=True)
             self._workers = ThreadPoolExecutor(1, "scene3d-truth")
+
+    def draw_view_into(self, picture: QPixmap, top: QWidget) -> None:
+        """Draw the 3D view into ``picture``, a ``grab()`` of ``top`` (a widget's grab leaves
+        the view out: it is a native window of its own)."""
+        if self.view is None or not self.view_box.isVisible():
+            return
+        painter = QPainter(picture)
+        painter.drawImage(self.view_box.mapTo(top, QPoint(0, 0)), self.view.grabFramebuffer())
+        painter.end()
 
     # ------------------------------------------------------------------ API for teaching
 

@@ -1,5 +1,13 @@
-"""The 3D scene's GL view: orbit, pan and zoom (pyqtgraph's GLViewWidget), plus what a
-click means: a pick ray, a region drawn by press-and-drag, and the tool gizmo's drag.
+"""The 3D scene's GL view: orbit, pan and zoom (pyqtgraph's GL view), plus what a click
+means: a pick ray, a region drawn by press-and-drag, and the tool gizmo's drag.
+
+The view is a window of its own (a QOpenGLWindow with pyqtgraph's ``GLViewMixin``, what its
+``GLViewWidget`` is made of), put in the panel by ``QWidget.createWindowContainer``. A
+QOpenGLWidget would make Qt compose the whole main window with OpenGL on every repaint of
+anything in it (a camera picture, a node's status) as well as every 3D frame: with Mesa's
+llvmpipe under Xvfb that cost ~15 ms of CPU per repaint of a 1920 x 1080 window (measured:
+18 ms per 3D frame as a widget, 3 ms as a window of its own). Its pictures come from
+:meth:`SceneView.grabFramebuffer` (a widget's ``grab`` does not see a native child window).
 
 Mouse: left drag orbits, middle drag (or Ctrl + left) pans, the wheel zooms (pyqtgraph's
 own); a left click without a drag picks a point; in region mode a left press sets the centre
@@ -13,8 +21,9 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-import pyqtgraph.opengl as gl
-from PySide6.QtCore import Qt, Signal
+from pyqtgraph.opengl.GLViewWidget import GLViewMixin
+from PySide6.QtCore import QRect, Qt, Signal
+from PySide6.QtOpenGL import QOpenGLWindow
 
 __all__ = ["OpenGLUnavailable", "SceneView", "opengl_problem"]
 
@@ -44,8 +53,16 @@ def opengl_problem() -> str | None:
     return None if ok else "an OpenGL context could not be made current"
 
 
-class SceneView(gl.GLViewWidget):
-    """A GLViewWidget that turns clicks into rays and counts the frames it draws.
+# Views alive in Qt. The panel's window container deletes its view (in C++); PySide leaves a
+# window made in Python owned by Python all the same, and a view Python deleted first leaves
+# the container a dangling window (a crash when the main window is destroyed): Python keeps
+# each view until Qt destroys it.
+_LIVE: set[SceneView] = set()
+
+
+class SceneView(GLViewMixin, QOpenGLWindow):  # type: ignore[misc]  # pyqtgraph is untyped
+    """pyqtgraph's GL view as a window (see the module's text) that turns clicks into rays
+    and counts the frames it draws.
 
     Signals:
         clicked(object, object): a plain click: (origin, direction) of the pick ray.
@@ -61,8 +78,10 @@ class SceneView(gl.GLViewWidget):
     released = Signal(object, object)
     gizmo_moved = Signal(object, bool)
 
-    def __init__(self, parent: Any = None) -> None:
-        super().__init__(parent)
+    def __init__(self) -> None:
+        super().__init__()
+        _LIVE.add(self)
+        self.destroyed.connect(lambda *_: _LIVE.discard(self))
         self.frames_drawn = 0
         self.capture_drags = False
         self.gizmo_position: Callable[[], np.ndarray | None] = lambda: None
@@ -73,6 +92,13 @@ class SceneView(gl.GLViewWidget):
     def paintGL(self) -> None:
         super().paintGL()
         self.frames_drawn += 1
+
+    # What pyqtgraph's mixin and items ask of a widget, for a window:
+    def devicePixelRatioF(self) -> float:
+        return float(self.devicePixelRatio())
+
+    def rect(self) -> QRect:
+        return QRect(0, 0, self.width(), self.height())
 
     # ------------------------------------------------------------------ geometry
 

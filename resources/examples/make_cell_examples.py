@@ -66,9 +66,9 @@ EXIT_XY = (0.55, 0.28)
 GRASP_Z, ABOVE_Z = 0.017, 0.12
 # The welding arm over the exit when it releases a part (the occupancy region).
 ARM_REGION = Region((0.6, 0.28, 0.235), 0.05)
-# Over the middle of the rack's tote (rim 80 mm high): the fingertips 55 mm above its rim.
+# Over the middle of the rack's tote (rim 200 mm high): the fingertips 20 mm above its rim.
 TOTE = (0.04, 0.0)
-RACK_DROP_Z = 0.15
+RACK_DROP_Z, OVER_RACK_Z = 0.235, 0.32
 
 
 def tending_waypoints() -> list[Waypoint]:
@@ -76,7 +76,7 @@ def tending_waypoints() -> list[Waypoint]:
         Waypoint("observe", WaypointFrame.JOINTS, joints=JointConfig(OBSERVE_JOINTS)),
         Waypoint("over exit", WaypointFrame.WORLD, Pose((*EXIT_XY, ABOVE_Z), EXIT_DOWN)),
         Waypoint("at exit", WaypointFrame.WORLD, Pose((*EXIT_XY, GRASP_Z), EXIT_DOWN)),
-        Waypoint("over rack", WaypointFrame.OBJECT, Pose((*TOTE, 0.25), DOWN),
+        Waypoint("over rack", WaypointFrame.OBJECT, Pose((*TOTE, OVER_RACK_Z), DOWN),
                  reference="tending_rack"),
         Waypoint("into rack", WaypointFrame.OBJECT, Pose((*TOTE, RACK_DROP_Z), DOWN),
                  reference="tending_rack"),

@@ -8,7 +8,7 @@ frame at the bottom centre, z up. The output is byte for byte reproducible; run
 
 Needs numpy only. Objects: the paper's cup and waste bin (transport task) and the kitting
 task's metal plates with 3, 4 and 8 holes and the kit bin; the tending task's 2D wire bender
-(its welding arm is a model of its own), two wireforms and the mobile rack. Grasps are taught
+(its welding arm is a model of its own), two wireforms, the mobile rack and the scrap bin. Grasps are taught
 here, once per model, relative to the object: the cup's and the wireforms' for the gripper,
 the plates' for the suction tool. Marker ids (DICT_4X4_50): cup 1-2, waste bin 10-15, kit
 bin 20-25, wire bender 30-31, rack 32-33; scenes use 40-49 for fixed markers.
@@ -397,6 +397,7 @@ def all_objects() -> dict[str, tuple[dict, Mesh]]:
         "wire_bender": make_bender(),
         "bender_arm": make_bender_arm(),
         "tending_rack": make_rack(),
+        "scrap_bin": make_scrap_bin(),
     }
 
 
@@ -528,9 +529,11 @@ def make_bender_arm() -> tuple[dict, Mesh]:
 
 def make_rack() -> tuple[dict, Mesh]:
     """The mobile rack's top: a ledge at -x carrying marker 32 on its top and 33 on its end,
-    and an open tote the wireforms are dropped into (they pile up there, as on a cart)."""
-    length, width, height, ledge = 0.32, 0.24, 0.08, 0.08
-    tote = length - ledge
+    and an open tote the wireforms are dropped into (they pile up there, as on a cart). The
+    tote is deep and wide enough for a trial of 50 parts dropped in its middle (their pile
+    stays under its rim)."""
+    tote, width, height, ledge, ledge_height = 0.34, 0.34, 0.2, 0.08, 0.08
+    length = tote + ledge
     parts = []
     for p in open_box_parts(tote, width, height, 0.006, 0.006):  # the tote, moved to +x
         x, y, z = p["position"]
@@ -538,8 +541,9 @@ def make_rack() -> tuple[dict, Mesh]:
             {"size": [_r(v) for v in p["size"]], "position": [_r(x + ledge / 2), _r(y), _r(z)]}
         )
     parts.append(
-        {"size": [ledge, width, height], "position": [_r((ledge - length) / 2), 0.0, height / 2]}
-    )
+        {"size": [ledge, width, ledge_height],
+         "position": [_r((ledge - length) / 2), 0.0, ledge_height / 2]}
+    )  # fmt: skip
     mesh = Mesh()
     for part in parts:
         mesh.box(part["position"], part["size"])
@@ -547,22 +551,52 @@ def make_rack() -> tuple[dict, Mesh]:
     model = _model(
         "tending_rack",
         "Top of the mobile rack of the tending task: a ledge at -x with marker 32 on its top "
-        "and 33 on its end, and an open tote (+x) the wireforms are dropped into.",
+        "and 33 on its end, and an open tote (+x, 20 cm deep) the wireforms are dropped into.",
         collision={"type": "compound", "boxes": parts},
         mass=15.0,
-        dimensions=[length, width, height],
+        dimensions=[_r(length), width, height],
         symmetry={"kind": "none"},
         markers=[
-            top_marker(32, 0.07, height, _r(end + ledge / 2)),
-            wall_marker(33, 0.05, (-1, 0, 0), (end, 0.0, height / 2)),
+            top_marker(32, 0.07, ledge_height, _r(end + ledge / 2)),
+            wall_marker(33, 0.05, (-1, 0, 0), (_r(end), 0.0, ledge_height / 2)),
         ],
         color=[0.3, 0.3, 0.34, 1.0],
         tote={
             "center": [_r(ledge / 2), 0.0],
             "inner": [_r(tote - 0.012), _r(width - 0.012)],
             "floor": 0.006,
+            "rim": height,
         },
     )
+    return model, mesh
+
+
+def make_scrap_bin() -> tuple[dict, Mesh]:
+    """The scrap bin beside the bender's exit: a low open steel box without markers (the
+    robot knows it by a taught place, as on site)."""
+    length, width, height = 0.18, 0.16, 0.1
+    parts = open_box_parts(length, width, height, 0.004, 0.012)  # thick floor: no tunnelling
+    mesh = Mesh()
+    for part in parts:
+        mesh.box(part["position"], part["size"])
+    volumes = [float(np.prod(p["size"])) for p in parts]
+    com_z = sum(v * p["position"][2] for v, p in zip(volumes, parts, strict=True)) / sum(volumes)
+    model = _model(
+        "scrap_bin",
+        "Scrap bin of the tending task, beside the bender's exit: bad parts and the pieces of "
+        "broken welds go into it; no markers (its place is taught).",
+        collision={
+            "type": "compound",
+            "boxes": [{k: [_r(x) for x in v] for k, v in p.items()} for p in parts],
+        },
+        mass=_r(sum(volumes) * STEEL_DENSITY),
+        center_of_mass=[0.0, 0.0, _r(com_z)],
+        dimensions=[length, width, height],
+        symmetry={"kind": "discrete", "axis": [0.0, 0.0, 1.0], "order": 2},
+        color=[0.45, 0.2, 0.16, 1.0],
+        tote={"center": [0.0, 0.0], "inner": [_r(length - 0.008), _r(width - 0.008)],
+              "floor": 0.012, "rim": height},
+    )  # fmt: skip
     return model, mesh
 
 

@@ -2,9 +2,10 @@
 would render for the same state (the arm moved, an object added and removed), ends with the
 cell and with the cell's process, and a mirror that crashed fails its pictures, not the cell.
 
-The mirror draws a light world (a finite floor, the arm with its collision meshes): its
-pictures match the physics thread's pixel for pixel everywhere but on the arm and the floor,
-and the arm is where the physics thread draws it (its depth, within a mesh's coarseness)."""
+The mirror draws a light world (a finite floor and the table's top drawn by numpy, the arm with
+its collision meshes): its pictures match the physics thread's pixel for pixel everywhere but
+on the arm and the floor (the table top included), and the arm is where the physics thread
+draws it (its depth, within a mesh's coarseness)."""
 
 from __future__ import annotations
 

@@ -5,82 +5,26 @@ read here only."""
 
 from __future__ import annotations
 
-import threading
-import time
 from pathlib import Path
 
-from capabilities.base import CapabilityRegistry
 from capabilities.sim.bender import read_bender
 from capabilities.sim.bender_spec import FaultModel, plan_parts
 from capabilities.sim.session import SimCellSession
-from engine.build import build_tree
-from engine.events import Event, StatusChanged
-from engine.executor import Executor
-from engine.files import load_plan
-from engine.status import Status
-from engine.validation import has_errors, validate_plan
+from capabilities.sim.tending_score import TrialCounters, container_of
+from capabilities.sim.tending_trial import OperatorModel, TendingTrial
 from tests.capabilities.sim.test_bender import tending_scene
 
 PLAN = Path(__file__).resolve().parents[3] / "resources" / "examples" / "tending_paper.costar.json"
-OPERATOR = "operator resets the cell, presses Continue"
-WATCH = "wait for the welding arm"
 # Paced: perception takes wall time, and as fast as possible a part could come and go while
 # a camera's image is searched. Twice real time leaves room for a loaded CI machine (at four
 # times, two parallel test workers made the robot miss part 2 once).
 SPEED = 2.0
 
 
-class Trial:
-    """Runs the plan on a session of the scene; starts the bender when the robot first
-    watches its arm (set up, as on site); counts the operator's waits, presses Continue for
-    each (``press``)."""
-
-    def __init__(self, session: SimCellSession, press: bool) -> None:
-        self.session = session
-        self.waits = 0
-        self._press = press
-        self._lock = threading.Lock()
-        registry = CapabilityRegistry(cell=session)
-        plan = load_plan(PLAN, registry.aliases())
-        assert not has_errors(validate_plan(plan, registry))
-        self._names = {node.id: node.name for _, node in plan.walk()}
-        tree = build_tree(plan, registry, clock=session.clock)
-        self.executor = Executor(tree, 50.0, [self._heard])
-
-    def _heard(self, event: Event) -> None:
-        if not isinstance(event, StatusChanged) or event.new is not Status.RUNNING:
-            return
-        if self._names.get(event.node_id) == WATCH:
-            self.session.start_actors()  # from the first watch on; later calls do nothing
-        if self._names.get(event.node_id) == OPERATOR:
-            with self._lock:
-                self.waits += 1
-            if self._press:
-                self.session.operator.press("continue")
-
-    def run(self, until: float) -> None:
-        """Run the plan until ``until`` simulated seconds after the bender started."""
-        self.executor.start()
-        bender = self.session.bender
-        assert bender is not None
-        deadline = time.monotonic() + 300.0  # a generous wall-time bound
-        while bender.start_time is None or self.session.clock() - bender.start_time < until:
-            assert time.monotonic() < deadline, "the trial did not reach its simulated time"
-            self.session.sim.wait_sim(0.5)
-        self.executor.stop("trial over")
-        assert self.executor.wait(10.0) is not None
-
-
-def on_rack(session: SimCellSession, part: str) -> bool:
-    """GROUND TRUTH: the part lies in the rack's tote."""
-    if part not in session.scene.objects:
-        return False
-    tote = session.scene.model("rack").extra["tote"]
-    local = session.truth_pose("rack").inverse().compose(session.truth_pose(part)).position
-    inner = tote["inner"]
-    return (abs(local[0] - tote["center"][0]) < inner[0] / 2
-            and abs(local[1] - tote["center"][1]) < inner[1] / 2
-            and tote["floor"] - 0.002 < local[2] < 0.08)  # fmt: skip
+def _where(session: SimCellSession, part: str) -> str:
+    """GROUND TRUTH: 'caught' (in the rack's tote), 'scrapped' or ''."""
+    scene = session.scene
+    return session.sim.call(lambda c: container_of(c, scene, scene.truth_pose(c, part)))
 
 
 def _seed_with(bad_welds: list[bool], faults: FaultModel, scene: Path) -> int:
@@ -102,13 +46,19 @@ def test_a_bad_weld_stops_the_robot_until_the_operator_resets_it(tmp_path: Path)
     # The shoulder camera at its full 640 x 480: at 320 x 240 the rack's marker is too small
     # to be found from some of the rack's poses.
     with SimCellSession(scene, seed, speed=SPEED, faults=faults, start_actors=False) as session:
-        trial = Trial(session, press=True)
+        trial = TendingTrial(session, PLAN, OperatorModel(reset_s=2.0))
+        counters = trial.run(tail=30.0, wall_timeout=300.0)
         bender = session.bender
         assert bender is not None
-        trial.run(until=bender.plan[-1].offset + 30.0)
         kinds = [(e.kind, e.part) for e in bender.events()]
         assert kinds == [("released", "part_001"), ("weld_broke", "part_001"),
                          ("released", "part_002")]  # fmt: skip
-        assert trial.waits == 1  # the robot stopped once, the operator let it go on
-        assert on_rack(session, "part_002")
+        assert len(trial.calls) == 1  # the robot stopped once, the operator let it go on
+        assert "part in the gripper" in trial.stops[0] or "still held" in trial.stops[0]
+        assert _where(session, "part_002") == "caught"  # on the rack
         assert not session.sim.gripper.is_holding()
+        assert counters == TrialCounters(
+            produced=2, caught=1, bad_weld=1, lost=1, operator_interventions=1,
+            sim_seconds=counters.sim_seconds,
+        )  # fmt: skip
+        assert counters.sim_seconds > bender.plan[-1].offset

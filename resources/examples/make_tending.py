@@ -1,0 +1,406 @@
+"""Write the shipped recovery library and our wire-bender tending plan, byte for byte.
+
+The paper's plan (``tending_paper.costar.json``, made by ``make_cell_examples.py``) stops for
+the operator on any failure while the bender goes on producing (Table I: 13 of 100 parts lost
+that way). Ours does the same task composed from library subtrees, with recovery:
+
+- ``resources/library/tending``: PickAtExit (take a part at the exit with taught waypoints
+  and feel it held before and after lifting) and PlaceOnRack (drop it into the rack's tote,
+  taught relative to the rack).
+- ``resources/library/recovery``: Regrasp (a grasp that closed on nothing or a part that
+  slipped: let go, look again at the exit and grasp again, a bounded number of tries),
+  DiscardToScrap (a bad part: what is still held goes to the scrap bin, and the pieces of a
+  broken weld are taken from where they fall at the exit to the scrap bin) and
+  ReRegisterRack (find the rack's marker again and give its pose, which the place
+  waypoints are taught relative to).
+- ``resources/examples/tending.costar.json``: find the rack; then for every part, forever:
+  wait for the welding arm (occupancy), pick (a Catch sends a failed pick to Regrasp, and
+  when that gives up to DiscardToScrap), re-register the rack (ReRegisterRack: it is a mobile
+  rack, a worker may have moved it), place (a Catch sends a protective stop or a rack not
+  found to ReRegisterRack and places again) and step out of view. Whatever else fails is caught around
+  the part: the robot lets go, steps back and waits for the next part, never for the
+  operator.
+
+Usage: python resources/examples/make_tending.py
+"""
+
+from __future__ import annotations
+
+import math
+import uuid
+from pathlib import Path
+from typing import Any
+
+from engine.files import save_plan
+from engine.kinds import setting
+from engine.library import dump_subtree
+from engine.plan_writer import write_atomic
+from engine.spec import (
+    Binding,
+    NodeKind,
+    NodeSpec,
+    PlanSpec,
+    RunPolicy,
+    SubtreePort,
+    SubtreeSpec,
+)
+from engine.types import JointConfig, ObjectModel, ParamType, Pose, Region, Waypoint, WaypointFrame
+
+HERE = Path(__file__).resolve().parent
+LIBRARY = HERE.parent / "library"
+_NAMESPACE = uuid.UUID("8f3e6a2c-1d4b-4e7a-9c5f-2b8d7e6a5c41")
+DATE = "2026-11-24T00:00:00Z"
+
+OBSERVE_JOINTS = (1.2, -1.9, 2.0, -1.6, -1.57, 0.0)  # out of the shoulder camera's view
+# The tool down, turned as the bender drops its parts (the weld bead along world x, the
+# fingers closing across it, along y), and the tool down with the fingers closing along x.
+EXIT_DOWN = (0.0, 1.0, 0.0, 0.0)
+ACROSS_DOWN = (math.sqrt(0.5), math.sqrt(0.5), 0.0, 0.0)
+DOWN = (1.0, 0.0, 0.0, 0.0)
+EXIT_XY = (0.55, 0.28)
+GRASP_Z, ABOVE_Z = 0.017, 0.12  # TCP: fingertips 2 mm above the table; clear of the parts
+# Where the pieces of a broken weld come to lie at the exit (world offsets from the exit
+# point, taught by watching a few break): the U's side bars and the step's end bars, all
+# along y, so the fingers close across them along x.
+PIECES = (((-0.073, -0.055), ACROSS_DOWN), ((0.075, -0.055), ACROSS_DOWN),
+          ((0.0, 0.035), ACROSS_DOWN), ((0.01, -0.04), ACROSS_DOWN))  # fmt: skip
+ARM_REGION = Region((0.6, 0.28, 0.235), 0.05)  # the welding arm over the exit when it drops
+TOTE = (0.04, 0.0)  # the middle of the rack's tote (rack frame)
+OVER_RACK_Z, RACK_DROP_Z = 0.32, 0.235  # TCP, rack frame: the fingertips 2 cm over its rim
+SCRAP_XY, SCRAP_Z = (0.42, 0.5), 0.2  # over the scrap bin (taught, world): 8 cm over its rim
+REGRASP_TRIES = 2
+ARM_TIMEOUT = 40.0  # s: longer than the bender's longest interval (20 s + 35 %) and a cycle
+PIECE_TIME = 15.0  # s: simulated seconds for one piece (a jammed finger gives up)
+
+
+def observe() -> Waypoint:
+    return Waypoint("observe", WaypointFrame.JOINTS, joints=JointConfig(OBSERVE_JOINTS))
+
+
+def _world(name: str, x: float, y: float, z: float, turn: tuple[float, ...]) -> Waypoint:
+    return Waypoint(name, WaypointFrame.WORLD, Pose((x, y, z), turn))  # type: ignore[arg-type]  # four values
+
+
+def _on_rack(name: str, z: float) -> Waypoint:
+    return Waypoint(name, WaypointFrame.OBJECT, Pose((*TOTE, z), DOWN), reference="tending_rack")
+
+
+def waypoints() -> list[Waypoint]:
+    """Every waypoint the plan uses (taught on the tending scene)."""
+    found = [
+        observe(),
+        _world("over exit", *EXIT_XY, ABOVE_Z, EXIT_DOWN),
+        _world("at exit", *EXIT_XY, GRASP_Z, EXIT_DOWN),
+        _on_rack("over rack", OVER_RACK_Z),
+        _on_rack("into rack", RACK_DROP_Z),
+        _world("over scrap", *SCRAP_XY, SCRAP_Z, DOWN),
+    ]
+    for index, ((dx, dy), turn) in enumerate(PIECES, 1):
+        found.append(_world(f"over piece {index}", EXIT_XY[0] + dx, EXIT_XY[1] + dy, ABOVE_Z, turn))
+    return found
+
+
+class _Maker:
+    """Nodes with ids that stay the same from one run of the generator to the next."""
+
+    def __init__(self, scope: str) -> None:
+        self.scope = scope
+        self.count = 0
+
+    def id(self) -> str:
+        self.count += 1
+        return uuid.uuid5(_NAMESPACE, f"{self.scope}/{self.count}").hex
+
+    def node(self, kind: NodeKind, name: str, *children: NodeSpec, **config: Any) -> NodeSpec:
+        params = {k: setting(kind, k, v) for k, v in config.items()}
+        return NodeSpec(kind, name, self.id(), params=params, children=list(children))
+
+    def op(self, op: str, name: str, **params: Binding | str) -> NodeSpec:
+        bound = {k: Binding.reference(v) if isinstance(v, str) else v for k, v in params.items()}
+        return NodeSpec(NodeKind.OPERATION, name, self.id(), op=op, params=bound)
+
+    def move(
+        self, name: str, target: Waypoint | str, reference: str = "", linear: bool = False
+    ) -> NodeSpec:
+        params: dict[str, Binding | str] = {
+            "target": target if isinstance(target, str) else _fixed(target, ParamType.WAYPOINT)
+        }
+        if reference:
+            params["reference"] = reference
+        if linear:
+            params["mode"] = _fixed("linear", ParamType.TEXT)
+        return self.op("motion.move_to", name, **params)
+
+    def instance(self, subtree: SubtreeSpec, name: str, **params: Binding | str) -> NodeSpec:
+        bound = {k: Binding.reference(v) if isinstance(v, str) else v for k, v in params.items()}
+        return NodeSpec(NodeKind.SUBTREE, name, self.id(), params=bound, subtree=subtree.ref)
+
+    def take(self, name: str, above: str, at: str) -> NodeSpec:
+        """Down from ``above`` to ``at``, close, feel it held, lift, feel it still held."""
+        return self.node(
+            NodeKind.SEQUENCE, name,
+            self.move("over it", above),
+            self.move("down to it", at, linear=True),
+            self.op("gripper.close", "close on it"),
+            self.op("gripper.is_holding", "in the gripper"),
+            self.move("lift it", above, linear=True),
+            self.op("gripper.is_holding", "still held"),
+        )  # fmt: skip
+
+
+def _fixed(value: Any, ptype: ParamType) -> Binding:
+    return Binding.fixed(value, ptype)
+
+
+def _wp(waypoint: Waypoint) -> Binding:
+    return _fixed(waypoint, ParamType.WAYPOINT)
+
+
+def _port(name: str, ptype: ParamType, doc: str, default: Any = None) -> SubtreePort:
+    return SubtreePort(name, ptype, doc, default)
+
+
+def _subtree(key: str, name: str, description: str, tree: NodeSpec, **ports: Any) -> SubtreeSpec:
+    return SubtreeSpec(
+        key, name, tree, 1, DATE, description,
+        inputs=ports.get("inputs", []), outputs=ports.get("outputs", []),
+    )  # fmt: skip
+
+
+def _exit_ports() -> list[SubtreePort]:
+    return [_port("ABOVE", ParamType.WAYPOINT, "the tool over the exit, clear of the parts"),
+            _port("AT", ParamType.WAYPOINT, "the tool where it closes on a part at the exit")]  # fmt: skip
+
+
+def pick_at_exit() -> SubtreeSpec:
+    m = _Maker("pick_at_exit")
+    tree = m.take("PickAtExit", "ABOVE", "AT")
+    return _subtree(
+        "tending.pick_at_exit", "PickAtExit",
+        "Takes a part where a machine dropped it, with taught waypoints: over it, straight "
+        "down, close, feel it held, lift, feel it still held (fails when it is not).",
+        tree, inputs=_exit_ports(),
+    )  # fmt: skip
+
+
+def place_on_rack() -> SubtreeSpec:
+    m = _Maker("place_on_rack")
+    tree = m.node(
+        NodeKind.SEQUENCE, "PlaceOnRack",
+        m.move("over the rack", "OVER", "RACK"),
+        m.move("down over the tote", "INTO", "RACK", linear=True),
+        m.op("gripper.open", "let go into the tote"),
+        m.move("up from the rack", "OVER", "RACK", linear=True),
+    )  # fmt: skip
+    return _subtree(
+        "tending.place_on_rack", "PlaceOnRack",
+        "Drops what the gripper holds into the rack's tote, with waypoints taught relative to "
+        "the rack.",
+        tree,
+        inputs=[_port("RACK", ParamType.POSE, "where the rack is"),
+                _port("OVER", ParamType.WAYPOINT, "the tool over the tote, relative to the rack"),
+                _port("INTO", ParamType.WAYPOINT, "where the tool lets go, relative to the rack")],
+    )  # fmt: skip
+
+
+def regrasp() -> SubtreeSpec:
+    m = _Maker("regrasp")
+    tree = m.node(
+        NodeKind.RETRY, "Regrasp",
+        m.node(NodeKind.SEQUENCE, "grasp again",
+               m.op("gripper.open", "let go"),
+               m.take("take it", "ABOVE", "AT")),
+        count=REGRASP_TRIES,
+    )  # fmt: skip
+    return _subtree(
+        "recovery.regrasp", "Regrasp",
+        f"After a grasp that closed on nothing or a part that slipped out: let go and take the "
+        f"part again where it lies at the exit, feeling it held before and after lifting, "
+        f"{REGRASP_TRIES} tries at most. Fails when it is never held (nothing there, or a "
+        f"broken part).",
+        tree, inputs=_exit_ports(),
+    )  # fmt: skip
+
+
+def discard_to_scrap() -> SubtreeSpec:
+    m = _Maker("discard_to_scrap")
+    held = m.node(
+        NodeKind.FORCE_SUCCESS, "what is held, into the scrap bin",
+        m.node(NodeKind.SEQUENCE, "drop it over the bin",
+               m.op("gripper.is_holding", "something held"),
+               m.move("over the scrap bin", "SCRAP"),
+               m.op("gripper.open", "drop it into the bin")),
+    )  # fmt: skip
+
+    def piece(key: str) -> NodeSpec:
+        # No "held?" check: the gripper's sensor reads the thin, light pieces as nothing
+        # held, yet the fingers lift them. A time limit: a finger that jams on a piece
+        # lying askew must not hold the robot up.
+        down = _fixed(GRASP_Z - ABOVE_Z, ParamType.NUMBER)
+        return m.node(
+            NodeKind.FORCE_SUCCESS, f"{key.lower()}, if it lies there",
+            m.node(NodeKind.TIMEOUT, f"{key.lower()}, {PIECE_TIME:g} s at most",
+                   m.node(NodeKind.SEQUENCE, f"{key.lower()} into the scrap bin",
+                          m.op("gripper.open", "open"),
+                          m.move("over it", key),
+                          m.op("motion.move_relative", "down to it", dz=down),
+                          m.op("gripper.close", "close on it"),
+                          m.op("motion.move_relative", "lift it",
+                               dz=_fixed(-down.value, ParamType.NUMBER)),
+                          m.move("over the scrap bin", "SCRAP"),
+                          m.op("gripper.open", "drop it into the bin")),
+                   seconds=PIECE_TIME),
+        )  # fmt: skip
+
+    tree = m.node(
+        NodeKind.SEQUENCE, "DiscardToScrap",
+        held,
+        m.op("gripper.open", "let go"),
+        m.move("up from the exit", "ABOVE"),
+        *(piece(f"PIECE_{i}") for i in range(1, 5)),
+        m.move("step out of view", observe()),
+    )  # fmt: skip
+    return _subtree(
+        "recovery.discard_to_scrap", "DiscardToScrap",
+        "A bad part: whatever the gripper still holds goes into the scrap bin, then the "
+        "pieces of a broken weld are taken where they fall at the exit (taught spots, one after "
+        "the other; where nothing lies the fingers close on nothing) and dropped into the "
+        "scrap bin.",
+        tree,
+        inputs=[_port("ABOVE", ParamType.WAYPOINT, "the tool over the exit, clear of the parts"),
+                _port("SCRAP", ParamType.WAYPOINT, "the tool over the scrap bin (taught)"),
+                *(_port(f"PIECE_{i}", ParamType.WAYPOINT,
+                        "the tool over where a piece of a broken part lies (it goes straight "
+                        f"down {ABOVE_Z - GRASP_Z:.3f} m to take it)") for i in range(1, 5))],
+    )  # fmt: skip
+
+
+def reregister_rack() -> SubtreeSpec:
+    m = _Maker("reregister_rack")
+    tree = m.node(
+        NodeKind.SEQUENCE, "ReRegisterRack",
+        m.move("step out of view", observe()),
+        m.op("markers.detect_markers", "look at the rack", camera=_fixed("shoulder", ParamType.TEXT)),
+        m.op("markers.object_pose", "pose of the rack", object="RACK", pose="RACK_POSE"),
+    )  # fmt: skip
+    return _subtree(
+        "recovery.reregister_rack", "ReRegisterRack",
+        "Finds the rack again by its marker (the arm out of the shoulder camera's view) and "
+        "gives its pose now: waypoints taught relative to the rack follow it when it was "
+        "moved. Fails (not_found) when its marker is not seen.",
+        tree,
+        inputs=[_port("RACK", ParamType.OBJECT, "the rack", ObjectModel("tending_rack"))],
+        outputs=[_port("RACK_POSE", ParamType.POSE, "where the rack is now")],
+    )  # fmt: skip
+
+
+def library() -> dict[str, list[SubtreeSpec]]:
+    """The shipped subtrees by library folder."""
+    return {
+        "tending": [pick_at_exit(), place_on_rack()],
+        "recovery": [regrasp(), discard_to_scrap(), reregister_rack()],
+    }
+
+
+PICK_ERRORS = "failed, grasp_failed, object_lost"
+PLACE_ERRORS = "protective_stop, collision, not_found"
+
+
+def _part_cycle(m: _Maker, subs: dict[str, SubtreeSpec], wps: dict[str, Waypoint]) -> NodeSpec:
+    """One part: wait for the welding arm, pick (with recovery), find the rack (a worker may
+    have moved it; the arm steps out of the camera's view anyway), place (with recovery)."""
+    region = _fixed(ARM_REGION, ParamType.REGION)
+    period = _fixed(0.25, ParamType.DURATION)  # four looks a second see the arm come and go
+    exit_wps = {"ABOVE": _wp(wps["over exit"]), "AT": _wp(wps["at exit"])}
+    scrap = m.instance(
+        subs["DiscardToScrap"], "DiscardToScrap", ABOVE=_wp(wps["over exit"]),
+        SCRAP=_wp(wps["over scrap"]),
+        **{f"PIECE_{i}": _wp(wps[f"over piece {i}"]) for i in range(1, 5)},
+    )  # fmt: skip
+    pick = m.node(
+        NodeKind.CATCH, "pick, with recovery",
+        m.instance(subs["PickAtExit"], "PickAtExit", **exit_wps),
+        m.node(NodeKind.SELECTOR, "regrasp, else scrap it",
+               m.instance(subs["Regrasp"], "Regrasp", **exit_wps),
+               m.node(NodeKind.FORCE_FAILURE, "scrapped: nothing to place", scrap)),
+        errors=PICK_ERRORS, error="PICK_ERROR",
+    )  # fmt: skip
+    rack = {"RACK": "RACK_POSE", "OVER": _wp(wps["over rack"]), "INTO": _wp(wps["into rack"])}
+    place = m.node(
+        NodeKind.CATCH, "place, with recovery",
+        m.instance(subs["PlaceOnRack"], "PlaceOnRack", **rack),
+        m.node(NodeKind.SEQUENCE, "find the rack, place again",
+               m.instance(subs["ReRegisterRack"], "ReRegisterRack", RACK_POSE="RACK_POSE"),
+               m.instance(subs["PlaceOnRack"], "PlaceOnRack again", **rack)),
+        errors=PLACE_ERRORS, error="PLACE_ERROR",
+    )  # fmt: skip
+    watch = m.node(
+        NodeKind.CATCH, "wait for the welding arm, else feel at the exit",
+        m.node(NodeKind.SEQUENCE, "the welding arm swings down and back up",
+               m.op("occupancy.wait_until_occupied", "wait for the welding arm", region=region,
+                    timeout=_fixed(ARM_TIMEOUT, ParamType.DURATION), period=period),
+               m.op("occupancy.wait_until_empty", "wait until the arm is back up",
+                    region=region, period=period)),
+        # A swing the camera missed (a busy computer) leaves a part at the exit that the
+        # camera cannot see (flat on the table): after the longest interval, feel for it.
+        m.instance(subs["PickAtExit"], "feel for a part that came unseen", **exit_wps),
+        errors="timeout",
+    )  # fmt: skip
+    return m.node(
+        NodeKind.SEQUENCE, "one part",
+        watch,
+        m.node(NodeKind.SELECTOR, "a part in the gripper",
+               m.op("gripper.is_holding", "holding it already"), pick),
+        m.instance(subs["ReRegisterRack"], "where is the rack now", RACK_POSE="RACK_POSE"),
+        place,
+        m.move("step out of view", observe()),
+    )  # fmt: skip
+
+
+def tending() -> PlanSpec:
+    subs = {s.name: s for folder in library().values() for s in folder}
+    wps = {w.name: w for w in waypoints()}
+    m = _Maker("tending")
+    never_stop = m.node(
+        NodeKind.SEQUENCE, "let go, step back, next part",
+        m.op("gripper.open", "let go"),
+        m.move("step back", observe()),
+    )  # fmt: skip
+    tree = m.node(
+        NodeKind.SEQUENCE, "tend the wire bender",
+        m.instance(subs["ReRegisterRack"], "find the rack", RACK_POSE="RACK_POSE"),
+        m.node(NodeKind.ITERATOR, "every part",
+               m.node(NodeKind.CATCH, "part, whatever happens",
+                      _part_cycle(m, subs, wps), never_stop, errors="any", error="LAST_ERROR")),
+    )  # fmt: skip
+    return PlanSpec(
+        tree, "Wire-bender tending with recovery (section V-B, simulated cell)",
+        "The paper's wire-bender task composed from the shipped library, with recovery instead "
+        "of the operator: the rack is found by its marker; for each part the robot waits until "
+        "the bender's welding arm swings into an occupancy region and back out, picks the "
+        "wireform at the exit (PickAtExit) and drops it into the rack's tote (PlaceOnRack). A "
+        "failed pick goes to Regrasp (a slipped grasp) and, when that gives up, to "
+        "DiscardToScrap (a broken weld: its pieces go to the scrap bin); a failed place to "
+        "ReRegisterRack and a second place; before each place the rack is found again (it may "
+        "have been moved). Anything else is caught around the part: the robot lets go, steps "
+        "back and waits for the next one. Runs until stopped, on the simulated scene tending. "
+        "Run it with: costar run example:tending.",
+        RunPolicy.ONCE, waypoints=waypoints(), objects=["tending_rack"], reset_cell=True,
+        scene="tending", id=uuid.uuid5(_NAMESPACE, "tending").hex, subtrees=list(subs.values()),
+    )  # fmt: skip
+
+
+def main() -> None:
+    for folder, subtrees in library().items():
+        (LIBRARY / folder).mkdir(parents=True, exist_ok=True)
+        for subtree in subtrees:
+            path = LIBRARY / folder / f"{subtree.name}.subtree.json"
+            write_atomic(path, dump_subtree(subtree).encode("utf-8"))
+            print(f"wrote {path.relative_to(HERE.parent)}")
+    plan = HERE / "tending.costar.json"
+    save_plan(tending(), plan)
+    print(f"wrote {plan.name}")
+
+
+if __name__ == "__main__":
+    main()

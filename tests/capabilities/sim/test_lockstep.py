@@ -1,0 +1,98 @@
+"""Lockstep: simulated time stands still while perception computes on another thread (a
+``standing_still`` block of the physics thread; a lockstep session's worker pool runs every
+job in one), and goes on as before outside such blocks."""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Iterator
+
+import pytest
+
+from capabilities.jobs import WorkerPool
+from capabilities.sim.errors import SimError
+from capabilities.sim.physics_thread import PhysicsThread
+from engine.status import RUNNING, SUCCESS
+
+
+@pytest.fixture
+def physics() -> Iterator[PhysicsThread]:
+    thread = PhysicsThread(lambda _client: None)
+    thread.start()
+    yield thread
+    thread.stop()
+
+
+def test_time_stands_still_in_a_block_and_calls_are_still_served(physics: PhysicsThread) -> None:
+    assert physics.wait_sim(0.05, timeout=10.0)
+    with physics.standing_still():
+        held = physics.time()
+        assert physics.call(lambda client: client) == physics.client  # a render is served
+        time.sleep(0.2)
+        assert physics.time() == held
+    assert physics.wait_sim(0.05, timeout=10.0)
+    assert physics.time() > held
+
+
+def test_blocks_of_several_threads_overlap(physics: PhysicsThread) -> None:
+    first_in, second_out = threading.Event(), threading.Event()
+
+    def second() -> None:
+        with physics.standing_still():
+            first_in.wait(5.0)
+        second_out.set()
+
+    with physics.standing_still():
+        helper = threading.Thread(target=second)
+        helper.start()
+        first_in.set()
+        assert second_out.wait(5.0)
+        held = physics.time()
+        time.sleep(0.1)
+        assert physics.time() == held  # the other block ended, this one still holds
+    helper.join()
+    assert physics.wait_sim(0.05, timeout=10.0)
+
+
+def test_a_lockstep_pool_holds_the_clock_while_a_job_runs(physics: PhysicsThread) -> None:
+    pool = WorkerPool(1, "test-lockstep", around=physics.standing_still)
+    seen: list[float] = []
+
+    def perceive() -> dict[str, float]:
+        seen.append(physics.time())
+        time.sleep(0.2)  # wall time a loaded machine takes
+        seen.append(physics.time())
+        return {}
+
+    job = pool.submit(perceive)
+    deadline = time.monotonic() + 10.0
+    while job.poll() is RUNNING and time.monotonic() < deadline:
+        time.sleep(0.01)
+    pool.close()
+    assert job.poll() is SUCCESS
+    assert seen[0] == seen[1]
+
+
+def test_the_physics_thread_cannot_hold_itself(physics: PhysicsThread) -> None:
+    def hold(_client: int) -> None:
+        with physics.standing_still():
+            pass
+
+    with pytest.raises(SimError, match="other threads"):
+        physics.call(hold)
+
+
+def test_a_closed_gate_stops_the_world_until_it_opens_and_nudges(physics: PhysicsThread) -> None:
+    """A follower (the engine) that falls behind holds the world; its tick opens it again."""
+    engine_at = [physics.time()]
+    physics.add_gate(lambda: physics.time() - engine_at[0] <= 0.05)
+    assert physics.wait_sim(0.04, timeout=10.0)
+    time.sleep(0.2)
+    stopped = physics.time()
+    assert stopped - engine_at[0] <= 0.05 + physics.time_step
+    time.sleep(0.1)
+    assert physics.time() == stopped  # the engine did not tick: the world waits
+    engine_at[0] = stopped
+    physics.nudge()
+    assert physics.wait_sim(0.04, timeout=10.0)
