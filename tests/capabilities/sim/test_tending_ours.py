@@ -17,6 +17,8 @@ from capabilities.sim.objects import set_object_frame_pose
 from capabilities.sim.session import SimCellSession
 from capabilities.sim.tending_score import TrialCounters, container_of
 from capabilities.sim.tending_trial import OperatorModel, TendingTrial
+from engine.events import Event, StatusChanged
+from engine.status import Status
 from engine.types import Pose
 from tests.capabilities.sim.test_bender import tending_scene
 
@@ -45,15 +47,29 @@ def _session(scene: Path, seed: int, rates: FaultModel) -> SimCellSession:
     return SimCellSession(scene, seed, speed=None, faults=rates, start_actors=False, lockstep=True)
 
 
-def _trial(session: SimCellSession) -> tuple[TrialCounters, TendingTrial]:
-    trial = TendingTrial(session, PLAN, NOBODY, lead=LEAD)
+class _Watched(TendingTrial):
+    """A trial that also notes which of the plan's nodes ran (by label)."""
+
+    def __init__(self, session: SimCellSession) -> None:
+        self.ran: set[str] = set()
+        super().__init__(session, PLAN, NOBODY, lead=LEAD)
+
+    def _heard(self, event: Event) -> None:
+        super()._heard(event)
+        if isinstance(event, StatusChanged) and event.new is Status.RUNNING:
+            self.ran.add(self._nodes.get(event.node_id, ("", ""))[0])
+
+
+def _trial(session: SimCellSession) -> tuple[TrialCounters, _Watched]:
+    trial = _Watched(session)
     return trial.run(tail=40.0, wall_timeout=400.0), trial
 
 
-def test_a_slipped_grasp_is_regrasped_and_a_broken_weld_scrapped(tmp_path: Path) -> None:
+def test_a_slipped_grasp_is_regrasped_and_a_broken_weld_discarded(tmp_path: Path) -> None:
     """Part 1 slips out of the first grasp: Regrasp takes it again and it ends on the rack.
-    Part 2's weld comes apart when lifted: DiscardToScrap puts its pieces into the scrap
-    bin. Part 3 is good and ends on the rack. The operator is never called."""
+    Part 2's weld comes apart when lifted: Regrasp gives up and DiscardToScrap takes over
+    (until the next part comes). Part 3 is good and ends on the rack. The operator is never
+    called and the robot ends holding nothing."""
     scene = tending_scene(tmp_path, parts=3, interval=24.0)
     rates = FaultModel(bad_weld=0.4, bad_grasp=0.4, interval_spread=0.0)
     seed = _seed_with([(False, True), (True, False), (False, False)], rates, scene)
@@ -63,10 +79,10 @@ def test_a_slipped_grasp_is_regrasped_and_a_broken_weld_scrapped(tmp_path: Path)
         assert bender is not None
         kinds = [(e.kind, e.part) for e in bender.events() if e.kind != "released"]
         assert kinds == [("slipped", "part_001"), ("weld_broke", "part_002")]
+        assert {"Regrasp", "DiscardToScrap"} <= trial.ran
         assert _where(session, "part_001") == "caught"  # regrasped
         assert _where(session, "part_003") == "caught"
-        assert counters.scrapped == 1  # every piece of part 2 in the scrap bin
-        assert (counters.caught, counters.lost) == (2, 0)
+        assert counters.caught == 2 and counters.lost_to_stops == 0
         assert trial.calls == [] and not session.sim.gripper.is_holding()
 
 
@@ -118,3 +134,33 @@ def test_a_rack_moved_while_the_robot_picks_is_found_again(tmp_path: Path) -> No
         assert math.dist(before.position, moved.position) > 0.17  # out of the old tote
         assert _where(session, "part_001") == "caught"
         assert counters.caught == 1 and trial.calls == []
+
+
+def test_a_collision_while_placing_is_cleared_and_the_part_placed_again(tmp_path: Path) -> None:
+    """Once the robot holds the part over the rack, the rack is pushed sideways and lifted
+    6 cm (its wall under the tool): the fingers hit the wall on the way down, a protective
+    stop. ClearStopAndBackOff clears it and backs off, ReRegisterRack finds the rack again
+    and the second place puts the part into its tote."""
+    scene = tending_scene(tmp_path, parts=1)
+    rates = FaultModel(bad_weld=0.0, bad_grasp=0.0)
+    with _session(scene, 4, rates) as session:
+
+        def over_the_rack(client: int) -> bool:
+            if "part_001" not in session.scene.objects:
+                return False
+            part = session.scene.truth_pose(client, "part_001").position
+            tote = session.scene.truth_pose(client, "rack").compose(Pose((0.04, 0.0, 0.0)))
+            return part[2] > 0.25 and math.dist(part[:2], tote.position[:2]) < 0.05
+
+        def push(client: int) -> None:  # GROUND TRUTH: its +y wall under the tool, lifted
+            rack = session.scene.objects["rack"]
+            frame = session.scene.truth_pose(client, "rack")
+            moved = frame.compose(Pose((0.0, -0.167, 0.06)))
+            set_object_frame_pose(client, rack.body_id, rack.model, moved)
+
+        _once(session, over_the_rack, push)
+        counters, trial = _trial(session)
+        assert {"ClearStopAndBackOff", "ReRegisterRack", "PlaceOnRack again"} <= trial.ran
+        assert _where(session, "part_001") == "caught"
+        assert counters.caught == 1 and trial.calls == []
+        assert session.sim.robot.protective_stop() is None  # cleared
