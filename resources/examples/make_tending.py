@@ -338,7 +338,11 @@ def _part_cycle(m: _Maker, subs: dict[str, SubtreeSpec], wps: dict[str, Waypoint
                              success="any"))),
         errors=PICK_ERRORS, error="PICK_ERROR",
     )  # fmt: skip
-    rack = {"RACK": "RACK_POSE", "OVER": _wp(wps["over rack"]), "INTO": _wp(wps["into rack"])}
+    rack: dict[str, Binding | str] = {
+        "RACK": "RACK_POSE",
+        "OVER": _wp(wps["over rack"]),
+        "INTO": _wp(wps["into rack"]),
+    }
     place = m.node(
         NodeKind.CATCH, "place, with recovery",
         m.instance(subs["PlaceOnRack"], "PlaceOnRack", **rack),
@@ -378,7 +382,11 @@ def tending() -> PlanSpec:
     wps = {w.name: w for w in waypoints()}
     m = _Maker("tending")
     exit_wps = {"ABOVE": _wp(wps["over exit"]), "AT": _wp(wps["at exit"])}
-    rack = {"RACK": "RACK_POSE", "OVER": _wp(wps["over rack"]), "INTO": _wp(wps["into rack"])}
+    rack: dict[str, Binding | str] = {
+        "RACK": "RACK_POSE",
+        "OVER": _wp(wps["over rack"]),
+        "INTO": _wp(wps["into rack"]),
+    }
     # Whatever else went wrong (a collision with the welding arm, ...): let go, clear a
     # protective stop if there is one (at once if not) and back off; a part may have come
     # meanwhile and lie at the exit where the camera cannot see it: feel for it.
