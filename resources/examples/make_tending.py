@@ -406,9 +406,14 @@ def tending() -> PlanSpec:
         m.instance(subs["ReRegisterRack"], "find the rack", RACK_POSE="RACK_POSE"),
         m.node(NodeKind.ITERATOR, "every part",
                m.node(NodeKind.FORCE_SUCCESS, "never stop",
-                      m.node(NodeKind.CATCH, "part, whatever happens",
-                             _part_cycle(m, subs, wps), go_on, errors="any",
-                             error="LAST_ERROR"))),
+                      m.node(NodeKind.CATCH, "a collision while recovering",
+                             m.node(NodeKind.CATCH, "part, whatever happens",
+                                    _part_cycle(m, subs, wps), go_on, errors="any",
+                                    error="LAST_ERROR"),
+                             # The welding arm may come down on the robot feeling at the exit.
+                             m.instance(subs["ClearStopAndBackOff"], "clear it, back off",
+                                        SAFE=_wp(observe())),
+                             errors="protective_stop"))),
     )  # fmt: skip
     return PlanSpec(
         tree, "Wire-bender tending with recovery (section V-B, simulated cell)",
