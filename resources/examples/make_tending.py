@@ -72,7 +72,8 @@ OVER_RACK_Z, RACK_DROP_Z = 0.32, 0.235  # TCP, rack frame: the fingertips 2 cm o
 SCRAP_XY, SCRAP_Z = (0.42, 0.5), 0.2  # over the scrap bin (taught, world): 8 cm over its rim
 REGRASP_TRIES = 1  # more tries scatter the pieces of a broken weld
 ARM_TIMEOUT = 40.0  # s: longer than the bender's longest interval (20 s + 35 %) and a cycle
-PIECE_TIME = 15.0  # s: simulated seconds for one piece (a jammed finger gives up)
+PIECE_TIME = 15.0
+TAKE_TIME = 15.0  # s: simulated seconds for a pick (its moves take about 5)  # s: simulated seconds for one piece (a jammed finger gives up)
 
 
 def observe() -> Waypoint:
@@ -138,9 +139,13 @@ class _Maker:
         return NodeSpec(NodeKind.SUBTREE, name, self.id(), params=bound, subtree=subtree.ref)
 
     def take(self, name: str, above: str, at: str) -> NodeSpec:
-        """Down from ``above`` to ``at``, close, feel it held, lift, feel it still held."""
+        """Down from ``above`` to ``at``, close, feel it held, lift, feel it still held; in
+        ``TAKE_TIME`` (a finger that jams on a part lying askew must not hold the robot up)."""
+        return self.node(NodeKind.TIMEOUT, name, self._take(above, at), seconds=TAKE_TIME)
+
+    def _take(self, above: str, at: str) -> NodeSpec:
         return self.node(
-            NodeKind.SEQUENCE, name,
+            NodeKind.SEQUENCE, "take it",
             self.move("over it", above),
             self.move("down to it", at, linear=True),
             self.op("gripper.close", "close on it"),
@@ -309,7 +314,7 @@ def library() -> dict[str, list[SubtreeSpec]]:
     }
 
 
-PICK_ERRORS = "failed, grasp_failed, object_lost"
+PICK_ERRORS = "failed, grasp_failed, object_lost, timeout"
 PLACE_ERRORS = "protective_stop"  # the rack moved into the way: a collision
 
 
