@@ -16,10 +16,12 @@ that way). Ours does the same task composed from library subtrees, with recovery
 - ``resources/examples/tending.costar.json``: find the rack; then for every part, forever:
   wait for the welding arm (occupancy), pick (a Catch sends a failed pick to Regrasp, and
   when that gives up to DiscardToScrap), re-register the rack (ReRegisterRack: it is a mobile
-  rack, a worker may have moved it), place (a Catch sends a protective stop or a rack not
-  found to ReRegisterRack and places again) and step out of view. Whatever else fails is caught around
-  the part: the robot lets go, steps back and waits for the next part, never for the
-  operator.
+  rack, a worker may have moved it), place (a Catch sends a protective stop, the rack moved
+  into the way, to ClearStopAndBackOff and ReRegisterRack and places again) and step out of
+  view. ClearStopAndBackOff is shipped by ``make_clear_stop.py`` and read here from the
+  library. Whatever else fails (a collision with the welding arm, ...) is caught around
+  the part: the robot lets go, clears a protective stop, backs off and feels for a part
+  left at the exit (a flat part the camera cannot see); it never waits for the operator.
 
 Usage: python resources/examples/make_tending.py
 """
@@ -33,7 +35,7 @@ from typing import Any
 
 from engine.files import save_plan
 from engine.kinds import setting
-from engine.library import dump_subtree
+from engine.library import dump_subtree, load_subtree
 from engine.plan_writer import write_atomic
 from engine.spec import (
     Binding,
@@ -68,9 +70,10 @@ ARM_REGION = Region((0.6, 0.28, 0.235), 0.05)  # the welding arm over the exit w
 TOTE = (0.04, 0.0)  # the middle of the rack's tote (rack frame)
 OVER_RACK_Z, RACK_DROP_Z = 0.32, 0.235  # TCP, rack frame: the fingertips 2 cm over its rim
 SCRAP_XY, SCRAP_Z = (0.42, 0.5), 0.2  # over the scrap bin (taught, world): 8 cm over its rim
-REGRASP_TRIES = 2
+REGRASP_TRIES = 1  # more tries scatter the pieces of a broken weld
 ARM_TIMEOUT = 40.0  # s: longer than the bender's longest interval (20 s + 35 %) and a cycle
-PIECE_TIME = 15.0  # s: simulated seconds for one piece (a jammed finger gives up)
+PIECE_TIME = 15.0
+TAKE_TIME = 15.0  # s: simulated seconds for a pick (its moves take about 5)  # s: simulated seconds for one piece (a jammed finger gives up)
 
 
 def observe() -> Waypoint:
@@ -136,9 +139,13 @@ class _Maker:
         return NodeSpec(NodeKind.SUBTREE, name, self.id(), params=bound, subtree=subtree.ref)
 
     def take(self, name: str, above: str, at: str) -> NodeSpec:
-        """Down from ``above`` to ``at``, close, feel it held, lift, feel it still held."""
+        """Down from ``above`` to ``at``, close, feel it held, lift, feel it still held; in
+        ``TAKE_TIME`` (a finger that jams on a part lying askew must not hold the robot up)."""
+        return self.node(NodeKind.TIMEOUT, name, self._take(above, at), seconds=TAKE_TIME)
+
+    def _take(self, above: str, at: str) -> NodeSpec:
         return self.node(
-            NodeKind.SEQUENCE, name,
+            NodeKind.SEQUENCE, "take it",
             self.move("over it", above),
             self.move("down to it", at, linear=True),
             self.op("gripper.close", "close on it"),
@@ -215,9 +222,9 @@ def regrasp() -> SubtreeSpec:
     return _subtree(
         "recovery.regrasp", "Regrasp",
         f"After a grasp that closed on nothing or a part that slipped out: let go and take the "
-        f"part again where it lies at the exit, feeling it held before and after lifting, "
-        f"{REGRASP_TRIES} tries at most. Fails when it is never held (nothing there, or a "
-        f"broken part).",
+        f"part again where it lies at the exit, feeling it held before and after lifting "
+        f"(tries: {REGRASP_TRIES}, the Retry's count). Fails when it is never held (nothing "
+        f"there, or a broken part).",
         tree, inputs=_exit_ports(),
     )  # fmt: skip
 
@@ -294,16 +301,21 @@ def reregister_rack() -> SubtreeSpec:
     )  # fmt: skip
 
 
+def clear_stop() -> SubtreeSpec:
+    """ClearStopAndBackOff as shipped (written by make_clear_stop.py)."""
+    return load_subtree(LIBRARY / "recovery" / "ClearStopAndBackOff.subtree.json")
+
+
 def library() -> dict[str, list[SubtreeSpec]]:
-    """The shipped subtrees by library folder."""
+    """The shipped subtrees this generator writes, by library folder."""
     return {
         "tending": [pick_at_exit(), place_on_rack()],
         "recovery": [regrasp(), discard_to_scrap(), reregister_rack()],
     }
 
 
-PICK_ERRORS = "failed, grasp_failed, object_lost"
-PLACE_ERRORS = "protective_stop, collision, not_found"
+PICK_ERRORS = "failed, grasp_failed, object_lost, timeout"
+PLACE_ERRORS = "protective_stop"  # the rack moved into the way: a collision
 
 
 def _part_cycle(m: _Maker, subs: dict[str, SubtreeSpec], wps: dict[str, Waypoint]) -> NodeSpec:
@@ -322,14 +334,26 @@ def _part_cycle(m: _Maker, subs: dict[str, SubtreeSpec], wps: dict[str, Waypoint
         m.instance(subs["PickAtExit"], "PickAtExit", **exit_wps),
         m.node(NodeKind.SELECTOR, "regrasp, else scrap it",
                m.instance(subs["Regrasp"], "Regrasp", **exit_wps),
-               m.node(NodeKind.FORCE_FAILURE, "scrapped: nothing to place", scrap)),
+               m.node(NodeKind.FORCE_FAILURE, "scrapped: nothing to place",
+                      m.node(NodeKind.PARALLEL, "scrap it until the next part comes",
+                             scrap,
+                             m.op("occupancy.wait_until_occupied", "the welding arm comes",
+                                  region=region, timeout=_fixed(600.0, ParamType.DURATION),
+                                  period=period),
+                             success="any"))),
         errors=PICK_ERRORS, error="PICK_ERROR",
     )  # fmt: skip
-    rack = {"RACK": "RACK_POSE", "OVER": _wp(wps["over rack"]), "INTO": _wp(wps["into rack"])}
+    rack: dict[str, Binding | str] = {
+        "RACK": "RACK_POSE",
+        "OVER": _wp(wps["over rack"]),
+        "INTO": _wp(wps["into rack"]),
+    }
     place = m.node(
         NodeKind.CATCH, "place, with recovery",
         m.instance(subs["PlaceOnRack"], "PlaceOnRack", **rack),
-        m.node(NodeKind.SEQUENCE, "find the rack, place again",
+        m.node(NodeKind.SEQUENCE, "clear the stop, find the rack, place again",
+               m.instance(subs["ClearStopAndBackOff"], "ClearStopAndBackOff",
+                          SAFE=_wp(observe())),
                m.instance(subs["ReRegisterRack"], "ReRegisterRack", RACK_POSE="RACK_POSE"),
                m.instance(subs["PlaceOnRack"], "PlaceOnRack again", **rack)),
         errors=PLACE_ERRORS, error="PLACE_ERROR",
@@ -359,19 +383,42 @@ def _part_cycle(m: _Maker, subs: dict[str, SubtreeSpec], wps: dict[str, Waypoint
 
 def tending() -> PlanSpec:
     subs = {s.name: s for folder in library().values() for s in folder}
+    subs["ClearStopAndBackOff"] = clear_stop()
     wps = {w.name: w for w in waypoints()}
     m = _Maker("tending")
-    never_stop = m.node(
-        NodeKind.SEQUENCE, "let go, step back, next part",
+    exit_wps = {"ABOVE": _wp(wps["over exit"]), "AT": _wp(wps["at exit"])}
+    rack: dict[str, Binding | str] = {
+        "RACK": "RACK_POSE",
+        "OVER": _wp(wps["over rack"]),
+        "INTO": _wp(wps["into rack"]),
+    }
+    # Whatever else went wrong (a collision with the welding arm, ...): let go, clear a
+    # protective stop if there is one (at once if not) and back off; a part may have come
+    # meanwhile and lie at the exit where the camera cannot see it: feel for it.
+    go_on = m.node(
+        NodeKind.SEQUENCE, "recover and go on",
         m.op("gripper.open", "let go"),
-        m.move("step back", observe()),
+        m.instance(subs["ClearStopAndBackOff"], "ClearStopAndBackOff", SAFE=_wp(observe())),
+        m.node(NodeKind.FORCE_SUCCESS, "a part left at the exit, if any",
+               m.node(NodeKind.SEQUENCE, "take it to the rack",
+                      m.instance(subs["PickAtExit"], "feel for a part at the exit", **exit_wps),
+                      m.instance(subs["ReRegisterRack"], "where is the rack", RACK_POSE="RACK_POSE"),
+                      m.instance(subs["PlaceOnRack"], "PlaceOnRack", **rack),
+                      m.move("step out of view", observe()))),
     )  # fmt: skip
     tree = m.node(
         NodeKind.SEQUENCE, "tend the wire bender",
         m.instance(subs["ReRegisterRack"], "find the rack", RACK_POSE="RACK_POSE"),
         m.node(NodeKind.ITERATOR, "every part",
-               m.node(NodeKind.CATCH, "part, whatever happens",
-                      _part_cycle(m, subs, wps), never_stop, errors="any", error="LAST_ERROR")),
+               m.node(NodeKind.FORCE_SUCCESS, "never stop",
+                      m.node(NodeKind.CATCH, "a collision while recovering",
+                             m.node(NodeKind.CATCH, "part, whatever happens",
+                                    _part_cycle(m, subs, wps), go_on, errors="any",
+                                    error="LAST_ERROR"),
+                             # The welding arm may come down on the robot feeling at the exit.
+                             m.instance(subs["ClearStopAndBackOff"], "clear it, back off",
+                                        SAFE=_wp(observe())),
+                             errors="protective_stop"))),
     )  # fmt: skip
     return PlanSpec(
         tree, "Wire-bender tending with recovery (section V-B, simulated cell)",
@@ -380,10 +427,12 @@ def tending() -> PlanSpec:
         "the bender's welding arm swings into an occupancy region and back out, picks the "
         "wireform at the exit (PickAtExit) and drops it into the rack's tote (PlaceOnRack). A "
         "failed pick goes to Regrasp (a slipped grasp) and, when that gives up, to "
-        "DiscardToScrap (a broken weld: its pieces go to the scrap bin); a failed place to "
-        "ReRegisterRack and a second place; before each place the rack is found again (it may "
-        "have been moved). Anything else is caught around the part: the robot lets go, steps "
-        "back and waits for the next one. Runs until stopped, on the simulated scene tending. "
+        "DiscardToScrap (a broken weld: its pieces go to the scrap bin); a collision while "
+        "placing (the rack moved into the way) to ClearStopAndBackOff, ReRegisterRack and a "
+        "second place; before each place the rack is found again (it may have been moved). "
+        "Anything else (a collision with the welding arm, ...) is caught around the part: the "
+        "robot lets go, clears a protective stop, backs off and feels for a part left at the "
+        "exit; it never waits for the operator. Runs until stopped, on the simulated scene tending. "
         "Run it with: costar run example:tending.",
         RunPolicy.ONCE, waypoints=waypoints(), objects=["tending_rack"], reset_cell=True,
         scene="tending", id=uuid.uuid5(_NAMESPACE, "tending").hex, subtrees=list(subs.values()),
