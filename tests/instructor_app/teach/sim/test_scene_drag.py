@@ -58,7 +58,9 @@ def test_drag_the_tool_record_and_run(qtbot: Any, fast_sim: CellSession, tmp_pat
     link = SceneTeachLink(scene, teacher, panel)
     qtbot.waitUntil(lambda: scene.gizmo is not None)
     start = arm.tcp_pose()
-    assert scene.gizmo.position == pytest.approx(start.position, abs=1e-4)
+    gizmo = scene.gizmo  # the waitUntil above saw it set
+    assert gizmo is not None
+    assert gizmo.position == pytest.approx(start.position, abs=1e-4)
     # The hand drags the ball 8 cm along y and 4 cm down, in small steps, then lets go.
     path = [
         Pose(
