@@ -59,6 +59,8 @@ def run_trial(job: TendingJob) -> dict[str, Any]:
             trial = TendingTrial(session, PLANS[job.plan], operator, lead=LEAD)
             counters = trial.run(parts=job.parts, wall_timeout=300.0 * job.parts)
             out: dict[str, Any] = counters.as_dict() | {"stops": trial.stops}
+            if trial.ended():  # the plan ended before the trial did
+                out["plan_ended"] = trial.ended()
     except Exception as exc:  # one broken trial must not end the bench
         out = {"error": f"{type(exc).__name__}: {exc}"}
     out |= {"seed": job.seed, "wall_s": round(time.perf_counter() - started, 1)}

@@ -117,7 +117,7 @@ class TendingTrial:
         self.executor = Executor(tree, rate_hz, [self._heard], hold=self._before_tick)
         if lead is not None:
             bound = lead
-            session.sim.add_gate(lambda: self._engine_at is None or self._lag() <= bound)
+            session.sim.add_gate(lambda: self._lag() <= bound)
 
     # ------------------------------------------------------------------ the engine
 
@@ -128,8 +128,18 @@ class TendingTrial:
         return self._cell_hold() if self._cell_hold is not None else None
 
     def _lag(self) -> float:
+        """How far the world is ahead of the engine (0 before it starts, once it ended)."""
         at = self._engine_at
-        return 0.0 if at is None else self.session.clock() - at
+        if at is None or self.executor.result is not None:
+            return 0.0
+        return self.session.clock() - at
+
+    def ended(self) -> str:
+        """How the plan's run ended ("" while it runs or when the trial stopped it)."""
+        result = self.executor.result
+        if result is None or result.reason == "trial over":
+            return ""
+        return f"{result.status.value} ({result.reason}): {result.message}"
 
     # ------------------------------------------------------------------ the plan's events
 
