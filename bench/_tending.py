@@ -59,8 +59,9 @@ def run_trial(job: TendingJob) -> dict[str, Any]:
             trial = TendingTrial(session, PLANS[job.plan], operator, lead=LEAD)
             counters = trial.run(parts=job.parts, wall_timeout=300.0 * job.parts)
             out: dict[str, Any] = counters.as_dict() | {"stops": trial.stops}
-            if trial.ended():  # the plan ended before the trial did
+            if trial.ended():  # the plan ended before the trial did: what failed last
                 out["plan_ended"] = trial.ended()
+                out["last_failures"] = trial.failures[-5:]
     except Exception as exc:  # one broken trial must not end the bench
         out = {"error": f"{type(exc).__name__}: {exc}"}
     out |= {"seed": job.seed, "wall_s": round(time.perf_counter() - started, 1)}

@@ -84,6 +84,7 @@ class TendingTrial:
         calls: simulated times at which the plan (or a held run) called the operator.
         stops: for each call, the last operation that failed before it ("" if none), or
             why the run was held.
+        failures: every operation that failed: (simulated time, "label: message").
     """
 
     def __init__(
@@ -100,6 +101,7 @@ class TendingTrial:
         self.operator = operator or OperatorModel()
         self.calls: list[float] = []
         self.stops: list[str] = []
+        self.failures: list[tuple[float, str]] = []
         self._lock = threading.Lock()
         self._pending: list[tuple[float, bool]] = []  # when the operator resets; press?
         self._removed: set[int] = set()
@@ -151,6 +153,7 @@ class TendingTrial:
         label, op = self._nodes.get(event.node_id, ("", ""))
         if event.new is Status.FAILURE and op and op not in OPERATOR_OPS:
             self._last_failure = f"{label}: {event.message}"
+            self.failures.append((round(self.session.clock(), 1), self._last_failure))
         if event.new is not Status.RUNNING:
             return
         if op.startswith(WATCH_PREFIX):
