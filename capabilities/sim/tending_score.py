@@ -90,8 +90,11 @@ def _totes(client: int, scene: SceneState) -> list[tuple[str, Mapping[str, Any],
 
 
 def _body_pose(client: int, body: int) -> Pose:
-    position, orientation = p.getBasePositionAndOrientation(body, physicsClientId=client)
-    return Pose(tuple(position), tuple(orientation))
+    """Where a piece is: the middle of its bounding box (its base frame is the frame of the
+    part it broke off, which may lie outside the piece)."""
+    lo, hi = p.getAABB(body, physicsClientId=client)
+    middle = tuple((a + b) / 2 for a, b in zip(lo, hi, strict=True))
+    return Pose(middle, (0.0, 0.0, 0.0, 1.0))
 
 
 def container_of(client: int, scene: SceneState, where: Pose) -> str:

@@ -15,11 +15,13 @@ that way). Ours does the same task composed from library subtrees, with recovery
   waypoints are taught relative to).
 - ``resources/examples/tending.costar.json``: find the rack; then for every part, forever:
   wait for the welding arm (occupancy), pick (a Catch sends a failed pick to Regrasp, and
-  when that gives up to DiscardToScrap), place (a Catch sends a protective stop or a rack
-  not found to ReRegisterRack and places again), step out of view and re-register the rack
-  (it is a mobile rack: a worker may have moved it). Whatever else fails is caught around
-  the part: the robot lets go, steps back and waits for the next part, never for the
-  operator.
+  when that gives up to DiscardToScrap), re-register the rack (ReRegisterRack: it is a mobile
+  rack, a worker may have moved it), place (a Catch sends a protective stop, the rack moved
+  into the way, to ClearStopAndBackOff and ReRegisterRack and places again) and step out of
+  view. ClearStopAndBackOff is shipped by ``make_clear_stop.py`` and read here from the
+  library. Whatever else fails (a collision with the welding arm, ...) is caught around
+  the part: the robot lets go, clears a protective stop, backs off and feels for a part
+  left at the exit (a flat part the camera cannot see); it never waits for the operator.
 
 Usage: python resources/examples/make_tending.py
 """
@@ -33,7 +35,7 @@ from typing import Any
 
 from engine.files import save_plan
 from engine.kinds import setting
-from engine.library import dump_subtree
+from engine.library import dump_subtree, load_subtree
 from engine.plan_writer import write_atomic
 from engine.spec import (
     Binding,
@@ -67,8 +69,10 @@ PIECES = (((-0.073, -0.055), ACROSS_DOWN), ((0.075, -0.055), ACROSS_DOWN),
 ARM_REGION = Region((0.6, 0.28, 0.235), 0.05)  # the welding arm over the exit when it drops
 TOTE = (0.04, 0.0)  # the middle of the rack's tote (rack frame)
 OVER_RACK_Z, RACK_DROP_Z = 0.32, 0.235  # TCP, rack frame: the fingertips 2 cm over its rim
-SCRAP_XY, SCRAP_Z = (0.42, 0.5), 0.24  # over the scrap bin (taught, world)
-REGRASP_TRIES = 2
+SCRAP_XY, SCRAP_Z = (0.42, 0.5), 0.2  # over the scrap bin (taught, world): 8 cm over its rim
+REGRASP_TRIES = 1  # more tries scatter the pieces of a broken weld
+ARM_TIMEOUT = 40.0  # s: longer than the bender's longest interval (20 s + 35 %) and a cycle
+PIECE_TIME = 15.0  # s: simulated seconds for one piece (a jammed finger gives up)
 
 
 def observe() -> Waypoint:
@@ -213,9 +217,9 @@ def regrasp() -> SubtreeSpec:
     return _subtree(
         "recovery.regrasp", "Regrasp",
         f"After a grasp that closed on nothing or a part that slipped out: let go and take the "
-        f"part again where it lies at the exit, feeling it held before and after lifting, "
-        f"{REGRASP_TRIES} tries at most. Fails when it is never held (nothing there, or a "
-        f"broken part).",
+        f"part again where it lies at the exit, feeling it held before and after lifting "
+        f"(tries: {REGRASP_TRIES}, the Retry's count). Fails when it is never held (nothing "
+        f"there, or a broken part).",
         tree, inputs=_exit_ports(),
     )  # fmt: skip
 
@@ -231,17 +235,23 @@ def discard_to_scrap() -> SubtreeSpec:
     )  # fmt: skip
 
     def piece(key: str) -> NodeSpec:
+        # No "held?" check: the gripper's sensor reads the thin, light pieces as nothing
+        # held, yet the fingers lift them. A time limit: a finger that jams on a piece
+        # lying askew must not hold the robot up.
         down = _fixed(GRASP_Z - ABOVE_Z, ParamType.NUMBER)
         return m.node(
             NodeKind.FORCE_SUCCESS, f"{key.lower()}, if it lies there",
-            m.node(NodeKind.SEQUENCE, f"{key.lower()} into the scrap bin",
-                   m.move("over it", key),
-                   m.op("motion.move_relative", "down to it", dz=down),
-                   m.op("gripper.close", "close on it"),
-                   m.op("gripper.is_holding", "in the gripper"),
-                   m.op("motion.move_relative", "lift it", dz=_fixed(-down.value, ParamType.NUMBER)),
-                   m.move("over the scrap bin", "SCRAP"),
-                   m.op("gripper.open", "drop it into the bin")),
+            m.node(NodeKind.TIMEOUT, f"{key.lower()}, {PIECE_TIME:g} s at most",
+                   m.node(NodeKind.SEQUENCE, f"{key.lower()} into the scrap bin",
+                          m.op("gripper.open", "open"),
+                          m.move("over it", key),
+                          m.op("motion.move_relative", "down to it", dz=down),
+                          m.op("gripper.close", "close on it"),
+                          m.op("motion.move_relative", "lift it",
+                               dz=_fixed(-down.value, ParamType.NUMBER)),
+                          m.move("over the scrap bin", "SCRAP"),
+                          m.op("gripper.open", "drop it into the bin")),
+                   seconds=PIECE_TIME),
         )  # fmt: skip
 
     tree = m.node(
@@ -255,8 +265,9 @@ def discard_to_scrap() -> SubtreeSpec:
     return _subtree(
         "recovery.discard_to_scrap", "DiscardToScrap",
         "A bad part: whatever the gripper still holds goes into the scrap bin, then the "
-        "pieces of a broken weld are taken where they fall at the exit (taught spots; a spot "
-        "where the gripper closes on nothing is passed) and dropped into the scrap bin.",
+        "pieces of a broken weld are taken where they fall at the exit (taught spots, one after "
+        "the other; where nothing lies the fingers close on nothing) and dropped into the "
+        "scrap bin.",
         tree,
         inputs=[_port("ABOVE", ParamType.WAYPOINT, "the tool over the exit, clear of the parts"),
                 _port("SCRAP", ParamType.WAYPOINT, "the tool over the scrap bin (taught)"),
@@ -285,8 +296,13 @@ def reregister_rack() -> SubtreeSpec:
     )  # fmt: skip
 
 
+def clear_stop() -> SubtreeSpec:
+    """ClearStopAndBackOff as shipped (written by make_clear_stop.py)."""
+    return load_subtree(LIBRARY / "recovery" / "ClearStopAndBackOff.subtree.json")
+
+
 def library() -> dict[str, list[SubtreeSpec]]:
-    """The shipped subtrees by library folder."""
+    """The shipped subtrees this generator writes, by library folder."""
     return {
         "tending": [pick_at_exit(), place_on_rack()],
         "recovery": [regrasp(), discard_to_scrap(), reregister_rack()],
@@ -294,11 +310,12 @@ def library() -> dict[str, list[SubtreeSpec]]:
 
 
 PICK_ERRORS = "failed, grasp_failed, object_lost"
-PLACE_ERRORS = "protective_stop, collision, not_found"
+PLACE_ERRORS = "protective_stop"  # the rack moved into the way: a collision
 
 
 def _part_cycle(m: _Maker, subs: dict[str, SubtreeSpec], wps: dict[str, Waypoint]) -> NodeSpec:
-    """One part: wait for the welding arm, pick (with recovery), place (with recovery)."""
+    """One part: wait for the welding arm, pick (with recovery), find the rack (a worker may
+    have moved it; the arm steps out of the camera's view anyway), place (with recovery)."""
     region = _fixed(ARM_REGION, ParamType.REGION)
     period = _fixed(0.25, ParamType.DURATION)  # four looks a second see the arm come and go
     exit_wps = {"ABOVE": _wp(wps["over exit"]), "AT": _wp(wps["at exit"])}
@@ -312,45 +329,91 @@ def _part_cycle(m: _Maker, subs: dict[str, SubtreeSpec], wps: dict[str, Waypoint
         m.instance(subs["PickAtExit"], "PickAtExit", **exit_wps),
         m.node(NodeKind.SELECTOR, "regrasp, else scrap it",
                m.instance(subs["Regrasp"], "Regrasp", **exit_wps),
-               m.node(NodeKind.FORCE_FAILURE, "scrapped: nothing to place", scrap)),
+               m.node(NodeKind.FORCE_FAILURE, "scrapped: nothing to place",
+                      m.node(NodeKind.PARALLEL, "scrap it until the next part comes",
+                             scrap,
+                             m.op("occupancy.wait_until_occupied", "the welding arm comes",
+                                  region=region, timeout=_fixed(600.0, ParamType.DURATION),
+                                  period=period),
+                             success="any"))),
         errors=PICK_ERRORS, error="PICK_ERROR",
     )  # fmt: skip
-    rack = {"RACK": "RACK_POSE", "OVER": _wp(wps["over rack"]), "INTO": _wp(wps["into rack"])}
+    rack: dict[str, Binding | str] = {
+        "RACK": "RACK_POSE",
+        "OVER": _wp(wps["over rack"]),
+        "INTO": _wp(wps["into rack"]),
+    }
     place = m.node(
         NodeKind.CATCH, "place, with recovery",
         m.instance(subs["PlaceOnRack"], "PlaceOnRack", **rack),
-        m.node(NodeKind.SEQUENCE, "find the rack, place again",
+        m.node(NodeKind.SEQUENCE, "clear the stop, find the rack, place again",
+               m.instance(subs["ClearStopAndBackOff"], "ClearStopAndBackOff",
+                          SAFE=_wp(observe())),
                m.instance(subs["ReRegisterRack"], "ReRegisterRack", RACK_POSE="RACK_POSE"),
                m.instance(subs["PlaceOnRack"], "PlaceOnRack again", **rack)),
         errors=PLACE_ERRORS, error="PLACE_ERROR",
     )  # fmt: skip
+    watch = m.node(
+        NodeKind.CATCH, "wait for the welding arm, else feel at the exit",
+        m.node(NodeKind.SEQUENCE, "the welding arm swings down and back up",
+               m.op("occupancy.wait_until_occupied", "wait for the welding arm", region=region,
+                    timeout=_fixed(ARM_TIMEOUT, ParamType.DURATION), period=period),
+               m.op("occupancy.wait_until_empty", "wait until the arm is back up",
+                    region=region, period=period)),
+        # A swing the camera missed (a busy computer) leaves a part at the exit that the
+        # camera cannot see (flat on the table): after the longest interval, feel for it.
+        m.instance(subs["PickAtExit"], "feel for a part that came unseen", **exit_wps),
+        errors="timeout",
+    )  # fmt: skip
     return m.node(
         NodeKind.SEQUENCE, "one part",
-        m.op("occupancy.wait_until_occupied", "wait for the welding arm", region=region,
-             timeout=_fixed(600.0, ParamType.DURATION), period=period),
-        m.op("occupancy.wait_until_empty", "wait until the arm is back up", region=region,
-             period=period),
-        pick,
-        place,
+        watch,
+        m.node(NodeKind.SELECTOR, "a part in the gripper",
+               m.op("gripper.is_holding", "holding it already"), pick),
         m.instance(subs["ReRegisterRack"], "where is the rack now", RACK_POSE="RACK_POSE"),
+        place,
+        m.move("step out of view", observe()),
     )  # fmt: skip
 
 
 def tending() -> PlanSpec:
     subs = {s.name: s for folder in library().values() for s in folder}
+    subs["ClearStopAndBackOff"] = clear_stop()
     wps = {w.name: w for w in waypoints()}
     m = _Maker("tending")
-    never_stop = m.node(
-        NodeKind.SEQUENCE, "let go, step back, next part",
+    exit_wps = {"ABOVE": _wp(wps["over exit"]), "AT": _wp(wps["at exit"])}
+    rack: dict[str, Binding | str] = {
+        "RACK": "RACK_POSE",
+        "OVER": _wp(wps["over rack"]),
+        "INTO": _wp(wps["into rack"]),
+    }
+    # Whatever else went wrong (a collision with the welding arm, ...): let go, clear a
+    # protective stop if there is one (at once if not) and back off; a part may have come
+    # meanwhile and lie at the exit where the camera cannot see it: feel for it.
+    go_on = m.node(
+        NodeKind.SEQUENCE, "recover and go on",
         m.op("gripper.open", "let go"),
-        m.move("step back", observe()),
+        m.instance(subs["ClearStopAndBackOff"], "ClearStopAndBackOff", SAFE=_wp(observe())),
+        m.node(NodeKind.FORCE_SUCCESS, "a part left at the exit, if any",
+               m.node(NodeKind.SEQUENCE, "take it to the rack",
+                      m.instance(subs["PickAtExit"], "feel for a part at the exit", **exit_wps),
+                      m.instance(subs["ReRegisterRack"], "where is the rack", RACK_POSE="RACK_POSE"),
+                      m.instance(subs["PlaceOnRack"], "PlaceOnRack", **rack),
+                      m.move("step out of view", observe()))),
     )  # fmt: skip
     tree = m.node(
         NodeKind.SEQUENCE, "tend the wire bender",
         m.instance(subs["ReRegisterRack"], "find the rack", RACK_POSE="RACK_POSE"),
         m.node(NodeKind.ITERATOR, "every part",
-               m.node(NodeKind.CATCH, "part, whatever happens",
-                      _part_cycle(m, subs, wps), never_stop, errors="any", error="LAST_ERROR")),
+               m.node(NodeKind.FORCE_SUCCESS, "never stop",
+                      m.node(NodeKind.CATCH, "a collision while recovering",
+                             m.node(NodeKind.CATCH, "part, whatever happens",
+                                    _part_cycle(m, subs, wps), go_on, errors="any",
+                                    error="LAST_ERROR"),
+                             # The welding arm may come down on the robot feeling at the exit.
+                             m.instance(subs["ClearStopAndBackOff"], "clear it, back off",
+                                        SAFE=_wp(observe())),
+                             errors="protective_stop"))),
     )  # fmt: skip
     return PlanSpec(
         tree, "Wire-bender tending with recovery (section V-B, simulated cell)",
@@ -359,10 +422,12 @@ def tending() -> PlanSpec:
         "the bender's welding arm swings into an occupancy region and back out, picks the "
         "wireform at the exit (PickAtExit) and drops it into the rack's tote (PlaceOnRack). A "
         "failed pick goes to Regrasp (a slipped grasp) and, when that gives up, to "
-        "DiscardToScrap (a broken weld: its pieces go to the scrap bin); a failed place to "
-        "ReRegisterRack and a second place; after each part the rack is found again (it may "
-        "have been moved). Anything else is caught around the part: the robot lets go, steps "
-        "back and waits for the next one. Runs until stopped, on the simulated scene tending. "
+        "DiscardToScrap (a broken weld: its pieces go to the scrap bin); a collision while "
+        "placing (the rack moved into the way) to ClearStopAndBackOff, ReRegisterRack and a "
+        "second place; before each place the rack is found again (it may have been moved). "
+        "Anything else (a collision with the welding arm, ...) is caught around the part: the "
+        "robot lets go, clears a protective stop, backs off and feels for a part left at the "
+        "exit; it never waits for the operator. Runs until stopped, on the simulated scene tending. "
         "Run it with: costar run example:tending.",
         RunPolicy.ONCE, waypoints=waypoints(), objects=["tending_rack"], reset_cell=True,
         scene="tending", id=uuid.uuid5(_NAMESPACE, "tending").hex, subtrees=list(subs.values()),

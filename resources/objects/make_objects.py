@@ -575,7 +575,7 @@ def make_scrap_bin() -> tuple[dict, Mesh]:
     """The scrap bin beside the bender's exit: a low open steel box without markers (the
     robot knows it by a taught place, as on site)."""
     length, width, height = 0.18, 0.16, 0.1
-    parts = open_box_parts(length, width, height, 0.004, 0.004)
+    parts = open_box_parts(length, width, height, 0.004, 0.012)  # thick floor: no tunnelling
     mesh = Mesh()
     for part in parts:
         mesh.box(part["position"], part["size"])
@@ -595,7 +595,7 @@ def make_scrap_bin() -> tuple[dict, Mesh]:
         symmetry={"kind": "discrete", "axis": [0.0, 0.0, 1.0], "order": 2},
         color=[0.45, 0.2, 0.16, 1.0],
         tote={"center": [0.0, 0.0], "inner": [_r(length - 0.008), _r(width - 0.008)],
-              "floor": 0.004, "rim": height},
+              "floor": 0.012, "rim": height},
     )  # fmt: skip
     return model, mesh
 

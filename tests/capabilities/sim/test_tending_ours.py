@@ -1,24 +1,30 @@
 """Our wire-bender tending plan (resources/examples/tending.costar.json) in short trials on
 the ``tending`` scene: each fault is recovered by its library subtree with no operator (a
-slipped grasp by Regrasp, a broken weld by DiscardToScrap, a moved rack by ReRegisterRack).
-Ground truth is read here only, to set the faults up and to score."""
+slipped grasp by Regrasp, a broken weld by DiscardToScrap, a moved rack by ReRegisterRack,
+a collision while placing by ClearStopAndBackOff and ReRegisterRack). The cell runs in
+lockstep (its time stands while perception computes), as the benches run it. Ground truth
+is read here only, to set the faults up and to score."""
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from pathlib import Path
 
 from capabilities.sim.bender import read_bender
 from capabilities.sim.bender_spec import FaultModel, plan_parts
 from capabilities.sim.objects import set_object_frame_pose
 from capabilities.sim.session import SimCellSession
-from capabilities.sim.tending_score import container_of
+from capabilities.sim.tending_score import TrialCounters, container_of
 from capabilities.sim.tending_trial import OperatorModel, TendingTrial
+from engine.events import Event, StatusChanged
+from engine.status import Status
 from engine.types import Pose
 from tests.capabilities.sim.test_bender import tending_scene
-from tests.capabilities.sim.test_tending_paper import SPEED
 
 PLAN = Path(__file__).resolve().parents[3] / "resources" / "examples" / "tending.costar.json"
+LEAD = 0.1  # s the world may run ahead of the engine (as bench/_tending.py)
+NOBODY = OperatorModel(present=False)  # ours never calls the operator
 
 
 def _where(session: SimCellSession, part: str) -> str:
@@ -37,22 +43,124 @@ def _seed_with(faults: list[tuple[bool, bool]], rates: FaultModel, scene: Path) 
     raise AssertionError(f"no seed gives faults {faults}")
 
 
-def test_a_slipped_grasp_is_regrasped_and_a_broken_weld_scrapped(tmp_path: Path) -> None:
+def _session(scene: Path, seed: int, rates: FaultModel) -> SimCellSession:
+    return SimCellSession(scene, seed, speed=None, faults=rates, start_actors=False, lockstep=True)
+
+
+class _Watched(TendingTrial):
+    """A trial that also notes which of the plan's nodes ran (by label)."""
+
+    def __init__(self, session: SimCellSession) -> None:
+        self.ran: set[str] = set()
+        super().__init__(session, PLAN, NOBODY, lead=LEAD)
+
+    def _heard(self, event: Event) -> None:
+        super()._heard(event)
+        if isinstance(event, StatusChanged) and event.new is Status.RUNNING:
+            self.ran.add(self._nodes.get(event.node_id, ("", ""))[0])
+
+
+def _trial(session: SimCellSession) -> tuple[TrialCounters, _Watched]:
+    trial = _Watched(session)
+    return trial.run(tail=40.0, wall_timeout=400.0), trial
+
+
+def test_a_slipped_grasp_is_regrasped_and_a_broken_weld_discarded(tmp_path: Path) -> None:
     """Part 1 slips out of the first grasp: Regrasp takes it again and it ends on the rack.
-    Part 2's weld comes apart when lifted: DiscardToScrap puts its pieces into the scrap bin.
-    Part 3 is good and ends on the rack. The operator is never called."""
+    Part 2's weld comes apart when lifted: Regrasp gives up and DiscardToScrap takes over
+    (until the next part comes). Part 3 is good and ends on the rack. The operator is never
+    called and the robot ends holding nothing."""
     scene = tending_scene(tmp_path, parts=3, interval=24.0)
     rates = FaultModel(bad_weld=0.4, bad_grasp=0.4, interval_spread=0.0)
     seed = _seed_with([(False, True), (True, False), (False, False)], rates, scene)
-    with SimCellSession(scene, seed, speed=SPEED, faults=rates, start_actors=False) as session:
-        trial = TendingTrial(session, PLAN, OperatorModel(present=False))
-        counters = trial.run(tail=40.0, wall_timeout=400.0)
+    with _session(scene, seed, rates) as session:
+        counters, trial = _trial(session)
         bender = session.bender
         assert bender is not None
-        kinds = [(e.kind, e.part) for e in bender.events()]
-        assert ("slipped", "part_001") in kinds and ("weld_broke", "part_002") in kinds
-        print(counters)
-        assert _where(session, "part_001") == "caught"
+        kinds = [(e.kind, e.part) for e in bender.events() if e.kind != "released"]
+        assert kinds == [("slipped", "part_001"), ("weld_broke", "part_002")]
+        assert {"Regrasp", "DiscardToScrap"} <= trial.ran
+        assert _where(session, "part_001") == "caught"  # regrasped
         assert _where(session, "part_003") == "caught"
-        assert counters.scrapped == 1 and counters.caught == 2 and counters.lost == 0
-        assert trial.calls == []  # no operator
+        assert counters.caught == 2 and counters.lost_to_stops == 0
+        assert trial.calls == [] and not session.sim.gripper.is_holding()
+
+
+def _once(session: SimCellSession, when: Callable[[int], bool], act: Callable[[int], None]) -> None:
+    """On the physics thread: ``act`` once, at the first step where ``when`` holds."""
+    client = session.sim.call(lambda c: c)
+    done = [False]
+
+    def hook(_now: float) -> None:
+        if not done[0] and when(client):
+            done[0] = True
+            act(client)
+
+    session.sim.add_step_hook(post=hook)
+
+
+def _move_rack(session: SimCellSession, client: int, dx: float, dy: float, dyaw: float) -> None:
+    """GROUND TRUTH: a worker moves the rack (by dx, dy in the world, turned by dyaw)."""
+    rack = session.scene.objects["rack"]
+    (x, y, z), turn = session.scene.truth_pose(client, "rack").position, _yaw(dyaw)
+    pose = Pose((x + dx, y + dy, z), turn.orientation)
+    pose = Pose(pose.position, _multiply(turn, session.scene.truth_pose(client, "rack")))
+    set_object_frame_pose(client, rack.body_id, rack.model, pose)
+
+
+def _yaw(yaw: float) -> Pose:
+    return Pose((0.0, 0.0, 0.0), (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)))
+
+
+def _multiply(turn: Pose, pose: Pose) -> tuple[float, float, float, float]:
+    """The orientation of ``pose`` turned by ``turn`` about the world's vertical."""
+    return turn.compose(Pose((0.0, 0.0, 0.0), pose.orientation)).orientation
+
+
+def test_a_rack_moved_while_the_robot_picks_is_found_again(tmp_path: Path) -> None:
+    """The rack is pushed 19 cm away from the robot and turned while the robot takes the part
+    at the exit: a drop where the rack was would miss its tote; ReRegisterRack finds it again before the
+    place and the part ends in the tote."""
+    scene = tending_scene(tmp_path, parts=1)
+    rates = FaultModel(bad_weld=0.0, bad_grasp=0.0)
+    with _session(scene, 4, rates) as session:
+        bender = session.bender
+        assert bender is not None
+        before = session.truth_pose("rack")
+        _once(session, lambda c: bool(bender.produced()),
+              lambda c: _move_rack(session, c, 0.0, -0.19, -0.3))  # fmt: skip
+        counters, trial = _trial(session)
+        moved = session.truth_pose("rack")
+        assert math.dist(before.position, moved.position) > 0.17  # out of the old tote
+        assert _where(session, "part_001") == "caught"
+        assert counters.caught == 1 and trial.calls == []
+
+
+def test_a_collision_while_placing_is_cleared_and_the_part_placed_again(tmp_path: Path) -> None:
+    """Once the robot holds the part over the rack, the rack is pushed sideways and lifted
+    6 cm (its wall under the tool): the fingers hit the wall on the way down, a protective
+    stop. ClearStopAndBackOff clears it and backs off, ReRegisterRack finds the rack again
+    and the second place puts the part into its tote."""
+    scene = tending_scene(tmp_path, parts=1)
+    rates = FaultModel(bad_weld=0.0, bad_grasp=0.0)
+    with _session(scene, 4, rates) as session:
+
+        def over_the_rack(client: int) -> bool:
+            if "part_001" not in session.scene.objects:
+                return False
+            part = session.scene.truth_pose(client, "part_001").position
+            tote = session.scene.truth_pose(client, "rack").compose(Pose((0.04, 0.0, 0.0)))
+            return part[2] > 0.25 and math.dist(part[:2], tote.position[:2]) < 0.05
+
+        def push(client: int) -> None:  # GROUND TRUTH: its +y wall under the tool, lifted
+            rack = session.scene.objects["rack"]
+            frame = session.scene.truth_pose(client, "rack")
+            moved = frame.compose(Pose((0.0, -0.167, 0.06)))
+            set_object_frame_pose(client, rack.body_id, rack.model, moved)
+
+        _once(session, over_the_rack, push)
+        counters, trial = _trial(session)
+        assert {"ClearStopAndBackOff", "ReRegisterRack", "PlaceOnRack again"} <= trial.ran
+        assert _where(session, "part_001") == "caught"
+        assert counters.caught == 1 and trial.calls == []
+        assert session.sim.robot.protective_stop() is None  # cleared
