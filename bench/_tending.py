@@ -13,8 +13,11 @@ real time.
 from __future__ import annotations
 
 import multiprocessing
+import os
 import sys
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -23,7 +26,7 @@ from capabilities.sim.session import SimCellSession
 from capabilities.sim.tending_score import TrialCounters
 from capabilities.sim.tending_trial import OperatorModel, TendingTrial
 
-__all__ = ["PAPER", "PLANS", "TendingJob", "measure_tending", "table_one"]
+__all__ = ["PAPER", "PLANS", "TendingJob", "c_output_to_stderr", "measure_tending", "table_one"]
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "resources" / "examples"
 PLANS = {"paper": EXAMPLES / "tending_paper.costar.json", "ours": EXAMPLES / "tending.costar.json"}
@@ -34,6 +37,21 @@ RESET_S = 30.0  # simulated seconds the operator takes to reset the cell (see th
 SPEED: float | None = None  # as fast as lockstep and LEAD allow
 LEAD = 0.1  # simulated s the world may run ahead of the engine's last tick
 PERCEPTION_S = 0.1  # simulated s a perception job takes in lockstep (a frame and its cloud)
+
+
+@contextmanager
+def c_output_to_stderr() -> Iterator[None]:
+    """Send what C code prints to stdout (pybullet's warnings) to stderr meanwhile, so that
+    stdout keeps the one JSON object of ``--json`` (cells of a pool started inside too)."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    os.dup2(2, 1)
+    try:
+        yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)
 
 
 @dataclass(frozen=True)
