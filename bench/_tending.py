@@ -4,8 +4,8 @@ Each plan (the paper's ``tending_paper.costar.json`` and ours, ``tending.costar.
 ``trials`` trials of ``parts`` parts on the ``tending`` scene (trial i on seed ``seed + i``;
 the same seeds, hence the same parts and faults, for both plans) through
 ``capabilities/sim/tending_trial.py``; the counters of the trials are added up as Table I
-does. The simulated cell runs in lockstep: its time stands still while perception computes,
-and it never runs more than ``LEAD`` simulated seconds ahead of the engine's last tick (a
+does. The simulated cell runs in lockstep: its time stands still while perception computes
+(each job then takes ``PERCEPTION_S`` simulated seconds), and it never runs more than ``LEAD`` simulated seconds ahead of the engine's last tick (a
 50 Hz controller's view of the world); otherwise as fast as it can, or at ``speed`` times
 real time.
 """
@@ -13,8 +13,11 @@ real time.
 from __future__ import annotations
 
 import multiprocessing
+import os
 import sys
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -23,7 +26,7 @@ from capabilities.sim.session import SimCellSession
 from capabilities.sim.tending_score import TrialCounters
 from capabilities.sim.tending_trial import OperatorModel, TendingTrial
 
-__all__ = ["PAPER", "PLANS", "TendingJob", "measure_tending", "table_one"]
+__all__ = ["PAPER", "PLANS", "TendingJob", "c_output_to_stderr", "measure_tending", "table_one"]
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "resources" / "examples"
 PLANS = {"paper": EXAMPLES / "tending_paper.costar.json", "ours": EXAMPLES / "tending.costar.json"}
@@ -33,6 +36,22 @@ PAPER_PROJECTED = 93  # % the authors projected with better error handling
 RESET_S = 30.0  # simulated seconds the operator takes to reset the cell (see the README)
 SPEED: float | None = None  # as fast as lockstep and LEAD allow
 LEAD = 0.1  # simulated s the world may run ahead of the engine's last tick
+PERCEPTION_S = 0.1  # simulated s a perception job takes in lockstep (a frame and its cloud)
+
+
+@contextmanager
+def c_output_to_stderr() -> Iterator[None]:
+    """Send what C code prints to stdout (pybullet's warnings) to stderr meanwhile, so that
+    stdout keeps the one JSON object of ``--json`` (cells of a pool started inside too)."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    os.dup2(2, 1)
+    try:
+        yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)
 
 
 @dataclass(frozen=True)
@@ -52,12 +71,15 @@ def run_trial(job: TendingJob) -> dict[str, Any]:
     started = time.perf_counter()
     try:
         with SimCellSession(
-            "tending", job.seed, speed=job.speed, start_actors=False, lockstep=True
+            "tending", job.seed, speed=job.speed, start_actors=False, lockstep=PERCEPTION_S
         ) as session:
             operator = OperatorModel(reset_s=job.reset_s)
             trial = TendingTrial(session, PLANS[job.plan], operator, lead=LEAD)
             counters = trial.run(parts=job.parts, wall_timeout=300.0 * job.parts)
             out: dict[str, Any] = counters.as_dict() | {"stops": trial.stops}
+            if trial.ended():  # the plan ended before the trial did: what failed last
+                out["plan_ended"] = trial.ended()
+                out["last_failures"] = trial.failures[-5:]
     except Exception as exc:  # one broken trial must not end the bench
         out = {"error": f"{type(exc).__name__}: {exc}"}
     out |= {"seed": job.seed, "wall_s": round(time.perf_counter() - started, 1)}

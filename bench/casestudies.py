@@ -44,7 +44,14 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from bench._tending import PLANS, RESET_S, SPEED, measure_tending, table_one  # noqa: E402
+from bench._tending import (  # noqa: E402
+    PLANS,
+    RESET_S,
+    SPEED,
+    c_output_to_stderr,
+    measure_tending,
+    table_one,
+)
 from capabilities.base import CapabilityRegistry  # noqa: E402
 from capabilities.sim.session import SimCellSession  # noqa: E402
 from engine.build import build_tree  # noqa: E402
@@ -197,23 +204,24 @@ def _print(figures: dict[str, Any]) -> None:
             print(f"  seed {seed}: {why}")
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Run every case study (or ``--only`` some) and print the figures."""
-    args = _arguments(argv)
+def _measure_all(args: argparse.Namespace) -> dict[str, Any]:
     figures: dict[str, Any] = {}
     for name in args.only or [TENDING, *CASES]:
         if name == TENDING:
+            speed = args.speed or None
             figures[name] = measure_tending(
-                args.seed,
-                args.parts,
-                args.trials,
-                args.jobs,
-                args.reset_s,
-                args.speed or None,
-                args.plan,
+                args.seed, args.parts, args.trials, args.jobs, args.reset_s, speed, args.plan
             )
         else:
             figures[name] = measure(name, args.runs, args.first_seed, args.jobs)
+    return figures
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run every case study (or ``--only`` some) and print the figures."""
+    args = _arguments(argv)
+    with c_output_to_stderr():
+        figures = _measure_all(args)
     if args.json:
         print(json.dumps(figures))
     else:

@@ -39,7 +39,14 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from bench._tending import LEAD, PLANS, RESET_S, SPEED  # noqa: E402
+from bench._tending import (  # noqa: E402
+    LEAD,
+    PERCEPTION_S,
+    PLANS,
+    RESET_S,
+    SPEED,
+    c_output_to_stderr,
+)
 from capabilities.sim.scene import default_scene_path  # noqa: E402
 from capabilities.sim.session import SimCellSession  # noqa: E402
 from capabilities.sim.tending_trial import OperatorModel, TendingTrial  # noqa: E402
@@ -145,7 +152,9 @@ def soak(plan: str, hours: float, seed: int, stall_s: float, sample_s: float) ->
     started = time.perf_counter()
     with tempfile.TemporaryDirectory() as folder:
         scene = soak_scene(Path(folder), hours)
-        with SimCellSession(scene, seed, speed=SPEED, start_actors=False, lockstep=True) as s:
+        with SimCellSession(
+            scene, seed, speed=SPEED, start_actors=False, lockstep=PERCEPTION_S
+        ) as s:
             trial = TendingTrial(s, PLANS[plan], OperatorModel(reset_s=RESET_S), lead=LEAD)
             ticks = TickClock(trial.executor.tree, trial.executor.period)
             watch, done = Watch(s, ticks, stall_s), threading.Event()
@@ -176,7 +185,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--json", action="store_true", help="print one JSON object at the end")
     args = parser.parse_args(argv)
     plan = args.plan or ("ours" if PLANS["ours"].is_file() else "paper")
-    fig = soak(plan, args.hours, args.seed, args.stall_s, args.sample_s)
+    with c_output_to_stderr():
+        fig = soak(plan, args.hours, args.seed, args.stall_s, args.sample_s)
     if args.json:
         print(json.dumps(fig))
         return 0

@@ -13,8 +13,8 @@ Example::
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from contextlib import AbstractContextManager
+from collections.abc import Callable, Iterator
+from contextlib import AbstractContextManager, contextmanager
 from pathlib import Path
 from types import TracebackType
 from typing import TypeVar
@@ -140,6 +140,18 @@ class SimCell:
     def standing_still(self) -> AbstractContextManager[None]:
         """A block in which simulated time stands still (see ``PhysicsThread``)."""
         return self._physics.standing_still()
+
+    @contextmanager
+    def perceiving(self, latency: float) -> Iterator[None]:
+        """A perception job in lockstep (another thread): simulated time stands still while
+        the block runs, then goes on until ``latency`` simulated seconds have passed since it
+        began (so that perception polled without pause still lets time pass)."""
+        started = self.time()
+        with self._physics.standing_still():
+            yield
+        left = started + latency - self.time()
+        if left > 0 and not self._physics.wait_sim(left, timeout=max(60.0, left * 10)):
+            raise SimError(f"simulated time did not advance by {left:.3f} s")
 
     def add_gate(self, may_step: Callable[[], bool]) -> None:
         """Step only while ``may_step()`` says True (see ``PhysicsThread.add_gate``)."""

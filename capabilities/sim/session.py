@@ -145,10 +145,12 @@ class SimCellSession:
         start_actors: start the scene's worker and bender now; False: they wait for
             :meth:`start_actors` (a run as fast as possible starts them with its plan, so
             that setting up the run costs no simulated time of theirs).
-        lockstep: simulated time stands still while a job of the worker pool (perception)
-            computes, as it does while a camera renders: a run as fast as possible (long
-            trials, benches) then sees the world as often as its plan asks, however long
-            perception takes on a loaded machine. Off: the world goes on meanwhile.
+        lockstep: None: off (the world goes on while perception computes). A number: the
+            simulated seconds each job of the worker pool (perception) takes: simulated time
+            stands still while it computes, as it does while a camera renders, then goes on
+            for the rest of that time before the job finishes. A run as fast as possible
+            (long trials, benches) then sees the world as its plan asks however loaded the
+            machine, and a plan that polls perception without pause still lets time pass.
     """
 
     name = "sim"
@@ -163,11 +165,12 @@ class SimCellSession:
         wrist_size: tuple[int, int] | None = None,
         faults: FaultModel | None = None,
         start_actors: bool = True,
-        lockstep: bool = False,
+        lockstep: float | None = None,
     ) -> None:
         self.sim = SimCell(config, speed)
         self.world_model = WorldModel()
-        around = self.sim.standing_still if lockstep else None
+        latency = lockstep
+        around = None if latency is None else (lambda: self.sim.perceiving(latency))
         self.workers = WorkerPool(2, "costar-sim-worker", around)
         self.operator = OperatorConsole()
         self.worker: SimWorker | None = None  # the simulated person, if the scene has one

@@ -84,6 +84,7 @@ class TendingTrial:
         calls: simulated times at which the plan (or a held run) called the operator.
         stops: for each call, the last operation that failed before it ("" if none), or
             why the run was held.
+        failures: every operation that failed: (simulated time, "label: message").
     """
 
     def __init__(
@@ -100,6 +101,7 @@ class TendingTrial:
         self.operator = operator or OperatorModel()
         self.calls: list[float] = []
         self.stops: list[str] = []
+        self.failures: list[tuple[float, str]] = []
         self._lock = threading.Lock()
         self._pending: list[tuple[float, bool]] = []  # when the operator resets; press?
         self._removed: set[int] = set()
@@ -117,7 +119,7 @@ class TendingTrial:
         self.executor = Executor(tree, rate_hz, [self._heard], hold=self._before_tick)
         if lead is not None:
             bound = lead
-            session.sim.add_gate(lambda: self._engine_at is None or self._lag() <= bound)
+            session.sim.add_gate(lambda: self._lag() <= bound)
 
     # ------------------------------------------------------------------ the engine
 
@@ -128,8 +130,18 @@ class TendingTrial:
         return self._cell_hold() if self._cell_hold is not None else None
 
     def _lag(self) -> float:
+        """How far the world is ahead of the engine (0 before it starts, once it ended)."""
         at = self._engine_at
-        return 0.0 if at is None else self.session.clock() - at
+        if at is None or self.executor.result is not None:
+            return 0.0
+        return self.session.clock() - at
+
+    def ended(self) -> str:
+        """How the plan's run ended ("" while it runs or when the trial stopped it)."""
+        result = self.executor.result
+        if result is None or result.reason == "trial over":
+            return ""
+        return f"{result.status.value} ({result.reason}): {result.message}"
 
     # ------------------------------------------------------------------ the plan's events
 
@@ -141,6 +153,7 @@ class TendingTrial:
         label, op = self._nodes.get(event.node_id, ("", ""))
         if event.new is Status.FAILURE and op and op not in OPERATOR_OPS:
             self._last_failure = f"{label}: {event.message}"
+            self.failures.append((round(self.session.clock(), 1), self._last_failure))
         if event.new is not Status.RUNNING:
             return
         if op.startswith(WATCH_PREFIX):

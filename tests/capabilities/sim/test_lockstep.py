@@ -13,6 +13,7 @@ import pytest
 from capabilities.jobs import WorkerPool
 from capabilities.sim.errors import SimError
 from capabilities.sim.physics_thread import PhysicsThread
+from capabilities.sim.session import SimCellSession
 from engine.status import RUNNING, SUCCESS
 
 
@@ -96,3 +97,24 @@ def test_a_closed_gate_stops_the_world_until_it_opens_and_nudges(physics: Physic
     engine_at[0] = stopped
     physics.nudge()
     assert physics.wait_sim(0.04, timeout=10.0)
+
+
+def test_a_lockstep_session_charges_each_perception_job_its_simulated_time() -> None:
+    """Time stands still while the job computes, then goes on to its latency before the job
+    finishes: a plan polling perception without pause still sees time pass."""
+    with SimCellSession("empty", 0, lockstep=0.5) as session:
+        seen: list[float] = []
+
+        def perceive() -> dict[str, float]:
+            seen.append(session.clock())
+            time.sleep(0.2)
+            seen.append(session.clock())
+            return {}
+
+        job = session.interfaces()["workers"].submit(perceive)
+        deadline = time.monotonic() + 30.0
+        while job.poll() is RUNNING and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert job.poll() is SUCCESS
+        assert seen[0] == seen[1]
+        assert session.clock() >= seen[0] + 0.5

@@ -5,7 +5,9 @@ read here only."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
+from typing import Any
 
 from capabilities.sim.bender import read_bender
 from capabilities.sim.bender_spec import FaultModel, plan_parts
@@ -62,3 +64,24 @@ def test_a_bad_weld_stops_the_robot_until_the_operator_resets_it(tmp_path: Path)
             sim_seconds=counters.sim_seconds,
         )  # fmt: skip
         assert counters.sim_seconds > bender.plan[-1].offset
+
+
+def test_a_plan_that_ends_early_ends_the_trial_even_in_lockstep(tmp_path: Path) -> None:
+    """The engine stops ticking when its plan ends: the world must not wait for it (lead)."""
+    paper = json.loads(PLAN.read_text(encoding="utf-8"))
+    watch = next(n for n in _nodes(paper["tree"]) if n.get("name") == "wait for the welding arm")
+    fail = {"id": "f" * 32, "kind": "operation", "name": "give up", "op": "debug.fail"}
+    paper["tree"] = {"id": "e" * 32, "kind": "sequence", "name": "watch, fail",
+                     "children": [watch, fail]}  # fmt: skip
+    plan = tmp_path / "ends_early.costar.json"
+    plan.write_text(json.dumps(paper), encoding="utf-8")
+    scene = tending_scene(tmp_path, parts=2)
+    with SimCellSession(scene, 3, start_actors=False, lockstep=0.1) as session:
+        trial = TendingTrial(session, plan, OperatorModel(), lead=0.1)
+        counters = trial.run(wall_timeout=120.0)
+        assert trial.ended().startswith("FAILURE")
+        assert counters.produced == 1  # the trial ended with the plan, at the first part
+
+
+def _nodes(node: dict[str, Any]) -> list[dict[str, Any]]:
+    return [node, *(n for child in node.get("children", []) for n in _nodes(child))]
