@@ -129,7 +129,7 @@ class _Reader(ReaderBase):
         children = [self._node(child, layout) for child in element.children]
         if node is None:
             return None
-        node.name = element.attrs.get("name", "")
+        node.name = element.attrs.get("_name", element.attrs.get("name", ""))
         if self.foreign and node.name == (element.attrs.get("ID") or element.tag):
             node.name = ""  # BehaviorTree.CPP names an unnamed node after its type
         node.id = element.attrs.get("_uid") or new_id()

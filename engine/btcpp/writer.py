@@ -98,6 +98,7 @@ class _Writer:
         root.append(self._plan_data(main_id))
         main = ET.SubElement(root, "BehaviorTree", {"ID": main_id})
         main.append(self._node(plan.tree, plan.layout, plan.tree.label))
+        _unique_subtree_names(main)
         for sub in plan.subtrees:
             root.append(self._subtree_tree(sub))
         root.append(self._models())
@@ -162,6 +163,7 @@ class _Writer:
             },
         )
         element.append(self._node(sub.tree, sub.layout, f"{sub.name}:{sub.tree.label}"))
+        _unique_subtree_names(element)
         ports = {p.name: _port_of_spec(Direction.IN, p.type, p.default, p.doc) for p in sub.inputs}
         for port in sub.outputs:
             ports[port.name] = _port_of_spec(Direction.OUT, port.type, None, port.doc)
@@ -338,3 +340,26 @@ def export_xml(plan: PlanSpec, manifests: Mapping[str, OperationManifest]) -> st
     ET.indent(root, space="  ")
     body = ET.tostring(root, encoding="unicode", short_empty_elements=True)
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + body + "\n"
+
+
+def _unique_subtree_names(tree: ET.Element) -> None:
+    """Give the SubTree instances of one BehaviorTree distinct ``name`` attributes.
+
+    BehaviorTree.CPP 4.10 refuses two SubTree nodes of one tree with the same name (it builds
+    each instance's path from the names of the SubTree nodes above it, not of other nodes);
+    the later ones are written as "NAME (2)", ... and keep their own name in ``_name``, which
+    the reader prefers.
+    """
+    taken: set[str] = set()
+    for child in tree.iter("SubTree"):
+        name = child.get("name")
+        if child.tag != "SubTree" or name is None:
+            continue
+        unique, count = name, 1
+        while unique in taken:
+            count += 1
+            unique = f"{name} ({count})"
+        if unique != name:
+            child.set("name", unique)
+            child.set("_name", name)
+        taken.add(unique)

@@ -107,6 +107,19 @@ def test_subtrees_are_behavior_trees_and_instances_remap_their_ports() -> None:
     assert dump_plan(again) == dump_plan(plan)
 
 
+def test_sibling_instances_of_one_name_get_names_btcpp_accepts_and_come_back() -> None:
+    """BehaviorTree.CPP 4.10 refuses two SubTree siblings with one name (their paths)."""
+    plan = _kitting()
+    for instance in plan.tree.children:
+        instance.name = "Transfer"
+    text = export_xml(plan, {})
+    names = re.findall(r'<SubTree ID="Transfer" name="([^"]*)"', text)
+    assert names == ["Transfer", "Transfer (2)"]
+    again = import_xml(text, "kitting.xml")
+    assert [c.name for c in again.tree.children] == ["Transfer", "Transfer"]
+    assert dump_plan(again) == dump_plan(plan)
+
+
 def test_an_instance_without_its_definition_is_not_exported() -> None:
     plan = _kitting()
     plan.subtrees = []
