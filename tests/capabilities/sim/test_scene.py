@@ -29,7 +29,7 @@ from engine.types import Pose
 SCENES = ("empty", "cup_to_bin", "kitting")
 MODELS = (
     "bender_arm", "cup", "kit_bin", "plate_3_holes", "plate_4_holes", "plate_8_holes",
-    "tending_rack", "waste_bin", "wire_bender", "wireform_step", "wireform_u",
+    "scrap_bin", "tending_rack", "waste_bin", "wire_bender", "wireform_step", "wireform_u",
 )  # fmt: skip
 
 
