@@ -7,6 +7,7 @@ import math
 import pytest
 
 from capabilities.jobs import job_from_handle
+from capabilities.ur.connection import fault_reason
 from capabilities.ur.errors import URError
 from capabilities.ur.modes import RobotMode
 from capabilities.ur.tool_io import DigitalPin, URSuctionCup
@@ -110,7 +111,9 @@ def test_protective_stop_during_a_move_fails_it(start_emulator, connect) -> None
     assert again.wait(10) and again.ok is False and "protective stop" in again.message
     # The operator clears it: unlock, and the control script is uploaded again.
     connection.call(connection.clear_protective_stop)
-    assert wait_for(lambda: connection.state.program_running)
+    # The arm moves again once the script runs and the safety mode read back is normal (a
+    # loaded machine may see the script before the next RTDE frame says so).
+    assert wait_for(lambda: connection.state.program_running and not fault_reason(connection.state))
     back = arm.move_joints(q, 1.0, 1.4)
     assert back.wait(20) and back.ok, back.message
 
