@@ -4,6 +4,11 @@
 When the fingers close on an object and both touch it, the object is fixed to the gripper
 body (see ``tools.attach``); opening releases it. ``is_holding`` is judged like a real
 gripper's position sensor: closed, yet the fingers stopped apart.
+
+A command ends as a Robotiq's does: when the fingers reach the requested position or stop on
+an object. Stopped means stalled, or making no headway over ``_STALL_WINDOW`` (a finger jammed
+on a part lying askew trembles in its contacts but gets no further), and no command outlasts
+``_MAX_TIME`` (the firmware's end of a motion that cannot finish).
 """
 
 from __future__ import annotations
@@ -22,6 +27,9 @@ _SPEED = 0.15  # m/s per finger
 _HOLD_GAP = 0.002  # m: closed with a larger gap means an object is between the fingers
 _STALLED = 1e-4  # m/s
 _MIN_TIME = 0.05  # s before a stalled finger counts as done
+_STALL_WINDOW = 0.1  # s: a finger that moved less than _STALL_TRAVEL in this long has stopped
+_STALL_TRAVEL = 5e-4  # m
+_MAX_TIME = 2 * OPEN_POSITION / _SPEED + 0.5  # s: twice a full stroke, then the motion ends
 
 
 class GripperController:
@@ -38,6 +46,7 @@ class GripperController:
         self._constraint: int | None = None
         self._handle: CommandHandle | None = None
         self._elapsed = 0.0
+        self._mark: tuple[float, float, float] = (0.0, OPEN_POSITION, OPEN_POSITION)
         for finger in fingers:
             pybullet.resetJointState(robot, finger, OPEN_POSITION, physicsClientId=client)
         self._drive(OPEN_POSITION)
@@ -53,6 +62,7 @@ class GripperController:
             self._handle.resolve(False, f"{self._handle.name} preempted by {handle.name}")
         self.closed = close
         self._handle, self._elapsed = handle, 0.0
+        self._mark = (0.0, *self._positions())
         if not close:
             self.release()
         self._drive(0.0 if close else OPEN_POSITION)
@@ -70,8 +80,13 @@ class GripperController:
         self._constraint, self.attached = None, None
 
     def pre_step(self, _t: float) -> None:
-        """Attach an object both closing fingers touch."""
-        if self.closed and self.attached is None:
+        """Forget a hold that is gone; attach an object both closing fingers touch.
+
+        A hold is gone when its constraint is (the part came apart or slipped out); the
+        fingers then close on, but grasp anew only during a close command."""
+        if self._constraint is not None and not self._hold_exists():
+            self._constraint, self.attached = None, None
+        if self.closed and self._handle is not None and self.attached is None:
             body = self._grasped_body()
             if body is not None:
                 self._constraint = attach(self._client, self._robot, self._body_link, body)
@@ -81,15 +96,43 @@ class GripperController:
         """Update the gap sensor and finish a command whose fingers have stopped."""
         states = pybullet.getJointStates(self._robot, self._fingers, physicsClientId=self._client)
         self.gap = float(states[0][0] + states[1][0])
+        if self.attached is not None and self.gap < _HOLD_GAP:
+            self.release()  # the fingers closed past it: it squeezed out from between them
         if self._handle is None:
             return
         self._elapsed += dt
         target = 0.0 if self.closed else OPEN_POSITION
         arrived = all(abs(s[0] - target) < 5e-4 for s in states)
         stalled = self._elapsed > _MIN_TIME and all(abs(s[1]) < _STALLED for s in states)
-        if arrived or stalled:
-            handle, self._handle = self._handle, None
-            handle.resolve(True, f"gap {self.gap * 1000:.1f} mm")
+        if arrived or stalled or self._no_headway(states[0][0], states[1][0]):
+            self._finish("")
+        elif self._elapsed > _MAX_TIME:
+            self._finish(" (the fingers did not settle)")
+
+    def _no_headway(self, left: float, right: float) -> bool:
+        """True once neither finger got further than _STALL_TRAVEL over a _STALL_WINDOW."""
+        since, left_then, right_then = self._mark
+        if self._elapsed - since < _STALL_WINDOW:
+            return False
+        self._mark = (self._elapsed, left, right)
+        return abs(left - left_then) < _STALL_TRAVEL and abs(right - right_then) < _STALL_TRAVEL
+
+    def _finish(self, note: str) -> None:
+        handle, self._handle = self._handle, None
+        if handle is not None:
+            handle.resolve(True, f"gap {self.gap * 1000:.1f} mm{note}")
+
+    def _positions(self) -> tuple[float, float]:
+        states = pybullet.getJointStates(self._robot, self._fingers, physicsClientId=self._client)
+        return float(states[0][0]), float(states[1][0])
+
+    def _hold_exists(self) -> bool:
+        """False once the attachment's constraint is gone (its body was removed or let go)."""
+        try:
+            pybullet.getConstraintInfo(self._constraint, physicsClientId=self._client)
+        except pybullet.error:
+            return False
+        return True
 
     def _grasped_body(self) -> int | None:
         touching = []

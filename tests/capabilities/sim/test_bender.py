@@ -193,6 +193,8 @@ def test_a_lifted_part_is_held_unless_its_weld_or_its_grasp_is_bad(
         events = [e for e in bender.events() if e.kind != "released"]
         assert [e.kind for e in events] == ([kind] if kind else [])
         assert gripper.is_holding() is (kind is None)  # found by the gripper's sensor
+        held = session.ground_truth.gripper_attached()  # a hold that is gone is forgotten
+        assert (held is None) is (kind is not None)
         if kind == "weld_broke":
             assert part not in session.scene.objects  # it came apart into its pieces
             pieces = bender.pieces()

@@ -2,12 +2,17 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
+import pytest
+
+from capabilities.bullet import pybullet
 from capabilities.sim.cell import SimCell
-from capabilities.sim.testing import down_at, run
+from capabilities.sim.testing import add_box, down_at, run
 
 APPROACH = 0.15
+PAD_BELOW_TCP = 0.016  # m: the finger pads reach this far below the TCP
 
 
 def test_closing_on_nothing_is_closed_but_not_holding(cell: SimCell) -> None:
@@ -43,3 +48,50 @@ def test_grasp_move_and_release_a_box_where_asked(
     x, y, z = truth.body_pose(box).position
     assert abs(x - 0.4) < 0.02 and abs(y + 0.2) < 0.02
     assert abs(z - (cell.table_top_z + 0.025)) < 0.005  # resting on the table
+
+
+def _wire_askew(cell: SimCell, yaw: float) -> int:
+    """An 8 mm square wire, 12 cm long, on the table at (0.5, 0.1), turned ``yaw`` from
+    lying across the fingers (as a wireform's piece lies at the bender's exit)."""
+    wire = add_box(cell, (0.12, 0.008, 0.008), (0.5, 0.1), mass=0.05)
+    at = (0.5, 0.1, cell.table_top_z + 0.0041)
+    turn = (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2))
+    cell.call(lambda c: pybullet.resetBasePositionAndOrientation(wire, at, turn, physicsClientId=c))
+    cell.wait_sim(0.3)
+    return wire
+
+
+def _close_low_over(cell: SimCell, pad_clearance: float) -> float:
+    """Go down over (0.5, 0.1) and close; returns the simulated seconds the close took."""
+    robot, gripper = cell.robot, cell.gripper
+    run(robot.move_pose_joint_space(down_at(0.5, 0.1, APPROACH)))
+    run(robot.move_linear(down_at(0.5, 0.1, cell.table_top_z + PAD_BELOW_TCP + pad_clearance)))
+    start = cell.time()
+    run(gripper.close(), timeout=20.0)
+    return cell.time() - start
+
+
+def test_a_close_on_a_wire_lying_askew_ends_with_it_held(cell: SimCell) -> None:
+    # The fingers met this wire on its edges and trembled on it for good: the close never
+    # ended (a velocity-only stall check); a Robotiq ends it as the fingers stop on it.
+    wire = _wire_askew(cell, yaw=0.5)
+    took = _close_low_over(cell, pad_clearance=0.001)
+    assert took < 1.2  # a full stroke takes 0.57 s
+    assert cell.gripper.is_holding() and cell.ground_truth.gripper_attached() == wire
+    assert cell.gripper.gap() > 0.008  # stopped on the wire, across it at a slant
+    run(cell.robot.move_linear(down_at(0.5, 0.1, APPROACH)))
+    assert cell.ground_truth.body_pose(wire).position[2] > cell.table_top_z + 0.05
+
+
+@pytest.mark.parametrize(("yaw", "pad_clearance"), [(0.0, 0.005), (1.0, 0.001)])
+def test_fingers_that_close_past_a_wire_hold_nothing(
+    cell: SimCell, yaw: float, pad_clearance: float
+) -> None:
+    # Only the pads' lower edge reaches the wire, or the wire lies nearly along the fingers:
+    # they squeeze it out and close; the sensor and the world agree nothing is held.
+    wire = _wire_askew(cell, yaw)
+    assert _close_low_over(cell, pad_clearance) < 1.2
+    assert not cell.gripper.is_holding() and cell.gripper.gap() < 0.002
+    assert cell.ground_truth.gripper_attached() is None
+    run(cell.robot.move_linear(down_at(0.5, 0.1, APPROACH)))
+    assert cell.ground_truth.body_pose(wire).position[2] < cell.table_top_z + 0.02
