@@ -312,15 +312,20 @@ def _spawn_piece(client: int, model: ObjectModelSpec, boxes: list[int], frame: P
         shapeTypes=[p.GEOM_BOX] * len(parts), halfExtents=half, visualFramePositions=where,
         rgbaColors=[list(model.color)] * len(parts), physicsClientId=client,
     )  # fmt: skip
-    volume = sum(b.size[0] * b.size[1] * b.size[2] for b in parts)
+    volumes = [b.size[0] * b.size[1] * b.size[2] for b in parts]
     total = sum(b.size[0] * b.size[1] * b.size[2] for b in model.collision.boxes)
+    # Its centre of mass is the middle of its own wire, not the part's frame: with the mass
+    # at the frame (off an L-shaped piece) the piece toppled onto its edge into the surface.
+    centroid = [sum(v * w[i] for v, w in zip(volumes, where, strict=True)) / sum(volumes)
+                for i in range(3)]  # fmt: skip
     return int(
         p.createMultiBody(
-            baseMass=model.mass * volume / total,
+            baseMass=model.mass * sum(volumes) / total,
             baseCollisionShapeIndex=col,
             baseVisualShapeIndex=vis,
             basePosition=list(frame.position),
             baseOrientation=list(frame.orientation),
+            baseInertialFramePosition=centroid,
             physicsClientId=client,
         )
     )

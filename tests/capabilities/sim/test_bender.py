@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 import math
 import re
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -15,9 +16,11 @@ import numpy as np
 import pytest
 
 from capabilities.base import CapabilityRegistry
+from capabilities.bullet import pybullet as p
 from capabilities.markers import capability as markers_capability
 from capabilities.markers.geometry import pose_errors
 from capabilities.occupancy import capability as occupancy_capability
+from capabilities.sim.bender import _spawn_piece
 from capabilities.sim.bender_spec import FaultModel, parse_bender, plan_parts
 from capabilities.sim.objects import SceneError
 from capabilities.sim.scene import default_scene_path
@@ -315,3 +318,55 @@ def test_the_bender_waits_for_the_run_when_asked(tmp_path: Path) -> None:
         assert started is not None and started >= 3.0
         session.sim.wait_sim(1.5)
         assert [e.time for e in bender.produced()] == pytest.approx([started + 1.0], abs=2 / 240)
+
+
+def _heights(session: SimCellSession, body: int) -> tuple[float, float]:
+    """GROUND TRUTH: the lowest and highest z of a body's collision shape."""
+
+    def aabb(client: int) -> tuple[float, float]:
+        low, high = p.getAABB(body, physicsClientId=client)
+        return float(low[2]), float(high[2])
+
+    return session.sim.call(aabb)
+
+
+def _remove(body: int, client: int) -> None:
+    p.removeBody(body, physicsClientId=client)
+
+
+def _tilt(pose: Pose) -> float:
+    """How far a body's z axis leans from the vertical (rad)."""
+    x, y, _, _ = pose.orientation
+    return 2 * math.asin(min(1.0, math.hypot(x, y)))
+
+
+def test_the_pieces_of_a_broken_weld_rest_flat_on_the_table_and_the_scrap_bin_floor(
+    tmp_path: Path,
+) -> None:
+    scene = tending_scene(tmp_path, parts=1, first_at=[300.0, 300.0])  # no part meanwhile
+    with SimCellSession(scene, seed=3) as session:
+        top = session.scene.table_top_z
+        scrap = session.truth_pose("scrap").position
+        floor = scrap[2] + session.scene.model("scrap").extra["tote"]["floor"]
+        spots = {(0.33, 0.12): top, (0.68, 0.05): top, scrap[:2]: floor}
+        dropped: list[tuple[int, float]] = []
+        for shape in sorted(SHAPES):
+            model = session.scene.library.get(shape)
+            for boxes in model.extra["weld"]["pieces"]:
+                middle = np.mean([model.collision.boxes[b].position for b in boxes], axis=0)
+                for (x, y), surface in spots.items():  # the piece's middle over the spot
+                    at = (x - middle[0], y - middle[1], surface + 0.02)
+                    frame = Pose(at, (0.0, 0.0, 0.0, 1.0))
+
+                    def spawn(client: int, b: list[int] = boxes, f: Pose = frame,
+                              m: Any = model) -> int:  # fmt: skip
+                        return _spawn_piece(client, m, b, f)
+
+                    dropped.append((session.sim.call(spawn), surface))
+                session.sim.wait_sim(1.0)
+                for body, surface in dropped:  # a piece lies on its 8 mm wire: 0 to 8 mm up
+                    low, high = _heights(session, body)
+                    assert surface - 0.002 < low and high < surface + 0.010, (shape, boxes)
+                    assert _tilt(session.ground_truth.body_pose(body)) < math.radians(3)
+                    session.sim.call(partial(_remove, body))
+                dropped.clear()
