@@ -86,10 +86,8 @@ def test_a_slipped_grasp_is_regrasped(tmp_path: Path) -> None:
 
 def test_a_broken_weld_is_discarded_without_the_operator(tmp_path: Path) -> None:
     """Part 1's weld comes apart when lifted: Regrasp gives up and DiscardToScrap takes over
-    (the pieces toward the scrap bin) until the next part comes. The run goes on: the
-    operator is never called and no protective stop holds it. (Where part 2 ends is not
-    asserted: a take at the exit right after the scrapping sometimes jams the simulated
-    gripper's close, see the CHANGELOG.)"""
+    (the pieces into the scrap bin) until the next part comes, which is caught. The run
+    goes on: the operator is never called and no protective stop holds it."""
     scene = tending_scene(tmp_path, parts=2, interval=24.0)
     rates = FaultModel(bad_weld=0.5, bad_grasp=0.0, interval_spread=0.0)
     seed = _seed_with([(True, False), (False, False)], rates, scene)
@@ -103,6 +101,7 @@ def test_a_broken_weld_is_discarded_without_the_operator(tmp_path: Path) -> None
         assert {"Regrasp", "DiscardToScrap", "recover and go on"} <= trial.ran
         assert trial.calls == [] and counters.operator_interventions == 0
         assert counters.produced == 2
+        assert (counters.scrapped, counters.caught) == (1, 1)
 
 
 def _once(session: SimCellSession, when: Callable[[int], bool], act: Callable[[int], None]) -> None:
