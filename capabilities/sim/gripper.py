@@ -86,6 +86,8 @@ class GripperController:
         fingers then close on, but grasp anew only during a close command."""
         if self._constraint is not None and not self._hold_exists():
             self._constraint, self.attached = None, None
+            if self.closed:
+                self._drive(0.0)  # nothing left between them: they close on, as a real one's
         if self.closed and self._handle is not None and self.attached is None:
             body = self._grasped_body()
             if body is not None:
@@ -118,9 +120,14 @@ class GripperController:
         return abs(left - left_then) < _STALL_TRAVEL and abs(right - right_then) < _STALL_TRAVEL
 
     def _finish(self, note: str) -> None:
+        if self.closed and self.attached is not None:
+            # Stay where they stopped on it. Driven on, the fingers crept into the held part
+            # and in the end past it, so what they held depended on when the next command came.
+            for finger, position in zip(self._fingers, self._positions(), strict=True):
+                self._drive(position, (finger,))
         handle, self._handle = self._handle, None
         if handle is not None:
-            handle.resolve(True, f"gap {self.gap * 1000:.1f} mm{note}")
+            handle.resolve(True, f"gap {self.gap * 1000:.1f} mm after {self._elapsed:.2f} s{note}")
 
     def _positions(self) -> tuple[float, float]:
         states = pybullet.getJointStates(self._robot, self._fingers, physicsClientId=self._client)
@@ -146,8 +153,8 @@ class GripperController:
                 return int(body)
         return None
 
-    def _drive(self, position: float) -> None:
-        for finger in self._fingers:
+    def _drive(self, position: float, fingers: tuple[int, ...] | None = None) -> None:
+        for finger in fingers or self._fingers:
             pybullet.setJointMotorControl2(
                 self._robot,
                 finger,
