@@ -20,24 +20,19 @@ from pathlib import Path
 from typing import Any
 
 from engine.files import save_plan
-from engine.kinds import setting
-from engine.library import dump_subtree
-from engine.plan_writer import write_atomic
 from engine.spec import (
-    Binding,
     NodeKind,
     NodeSpec,
     PlanSpec,
     RunPolicy,
-    SubtreePort,
     SubtreeSpec,
 )
 from engine.types import JointConfig, ObjectModel, ParamType, Pose, Region, Waypoint, WaypointFrame
+from resources.examples.plan_builder import PlanBuilder, fixed, obj, port, subtree, write_library
 
 HERE = Path(__file__).resolve().parent
 LIBRARY = HERE.parent / "library" / "kitting"
 _NAMESPACE = uuid.UUID("5d1c7a0e-2b4f-4c8e-9a3d-7e6f5a4b3c2d")
-DATE = "2026-11-24T00:00:00Z"
 
 DOWN = (1.0, 0.0, 0.0, 0.0)  # the tool pointing straight down
 OBSERVE_JOINTS = (1.2, -1.9, 2.0, -1.6, -1.57, 0.0)  # out of the shoulder camera's view
@@ -84,66 +79,22 @@ def place_waypoint(plate: str) -> Waypoint:
     )
 
 
-class _Maker:
-    """Nodes with ids that stay the same from one run of the generator to the next."""
+class _Maker(PlanBuilder):
+    """The kitting generator's nodes (ids in its own namespace), and a straight vertical move."""
 
     def __init__(self, scope: str) -> None:
-        self.scope = scope
-        self.count = 0
-
-    def id(self) -> str:
-        self.count += 1
-        return uuid.uuid5(_NAMESPACE, f"{self.scope}/{self.count}").hex
-
-    def node(self, kind: NodeKind, name: str, *children: NodeSpec, **config: Any) -> NodeSpec:
-        params = {k: setting(kind, k, v) for k, v in config.items()}
-        return NodeSpec(kind, name, self.id(), params=params, children=list(children))
-
-    def op(self, op: str, name: str, **params: Binding | str) -> NodeSpec:
-        bound = {k: Binding.reference(v) if isinstance(v, str) else v for k, v in params.items()}
-        return NodeSpec(NodeKind.OPERATION, name, self.id(), op=op, params=bound)
-
-    def move(
-        self, name: str, target: Waypoint | str, reference: str = "", linear: bool = False
-    ) -> NodeSpec:
-        params: dict[str, Binding | str] = {
-            "target": target if isinstance(target, str) else _fixed(target, ParamType.WAYPOINT)
-        }
-        if reference:
-            params["reference"] = reference
-        if linear:
-            params["mode"] = _fixed("linear", ParamType.TEXT)
-        return self.op("motion.move_to", name, **params)
+        super().__init__(_NAMESPACE, scope)
 
     def vertical(self, name: str, dz: str | float) -> NodeSpec:
         return self.op(
             "motion.move_relative",
             name,
-            dz=dz if isinstance(dz, str) else _fixed(dz, ParamType.NUMBER),
+            dz=dz if isinstance(dz, str) else fixed(dz, ParamType.NUMBER),
         )
-
-    def instance(self, subtree: SubtreeSpec, name: str, **params: Binding | str) -> NodeSpec:
-        bound = {k: Binding.reference(v) if isinstance(v, str) else v for k, v in params.items()}
-        return NodeSpec(NodeKind.SUBTREE, name, self.id(), params=bound, subtree=subtree.ref)
-
-
-def _fixed(value: Any, ptype: ParamType) -> Binding:
-    return Binding.fixed(value, ptype)
-
-
-def _obj(name: str) -> Binding:
-    return _fixed(ObjectModel(name), ParamType.OBJECT)
-
-
-def _port(name: str, ptype: ParamType, doc: str, default: Any = None) -> SubtreePort:
-    return SubtreePort(name, ptype, doc, default)
 
 
 def _subtree(key: str, name: str, description: str, tree: NodeSpec, **ports: Any) -> SubtreeSpec:
-    return SubtreeSpec(
-        f"kitting.{key}", name, tree, 1, DATE, description,
-        inputs=ports.get("inputs", []), outputs=ports.get("outputs", []),
-    )  # fmt: skip
+    return subtree(f"kitting.{key}", name, description, tree, **ports)
 
 
 def handoff() -> SubtreeSpec:
@@ -152,7 +103,7 @@ def handoff() -> SubtreeSpec:
         NodeKind.SEQUENCE, "Handoff",
         m.move("step out of view", observe()),
         m.op("collaboration.wait_for_handoff", "wait for the bin", object="OBJECT", region="AREA",
-             timeout=_fixed(300.0, ParamType.DURATION), settle=_fixed(0.5, ParamType.DURATION),
+             timeout=fixed(300.0, ParamType.DURATION), settle=fixed(0.5, ParamType.DURATION),
              pose="POSE"),
     )  # fmt: skip
     return _subtree(
@@ -160,9 +111,9 @@ def handoff() -> SubtreeSpec:
         "Waits for the worker to put an object (the kit bin) down in an area, seen by its "
         "markers in the shoulder camera, and tells where it is.",
         tree,
-        inputs=[_port("OBJECT", ParamType.OBJECT, "what the worker hands in", ObjectModel("kit_bin")),
-                _port("AREA", ParamType.REGION, "where the worker puts it")],
-        outputs=[_port("POSE", ParamType.POSE, "where it was put")],
+        inputs=[port("OBJECT", ParamType.OBJECT, "what the worker hands in", ObjectModel("kit_bin")),
+                port("AREA", ParamType.REGION, "where the worker puts it")],
+        outputs=[port("POSE", ParamType.POSE, "where it was put")],
     )  # fmt: skip
 
 
@@ -201,12 +152,12 @@ def transfer() -> SubtreeSpec:
     tree = m.node(
         NodeKind.SEQUENCE, "Transfer",
         m.move("step out of view", observe()),
-        m.op("perception.detect_objects", "look", camera=_fixed("shoulder", ParamType.TEXT)),
+        m.op("perception.detect_objects", "look", camera=fixed("shoulder", ParamType.TEXT)),
         m.op("perception.object_found", "OBJECT on the table", object="OBJECT"),
         m.op("perception.object_pose", "pose of OBJECT", object="OBJECT", pose="PART_POSE"),
         m.node(NodeKind.INVERTER, "not in the bin yet",
                m.op("predicates.touching", "OBJECT in the bin", object_a="OBJECT",
-                    object_b=_obj("kit_bin"))),
+                    object_b=obj("kit_bin"))),
         m.op("motion.go_home", "clear of the table"),  # from the camera pose, over the bin
         m.move("above OBJECT", "PICK", "PART_POSE"),
         m.vertical("down to OBJECT", -HOVER),
@@ -224,10 +175,10 @@ def transfer() -> SubtreeSpec:
         "it down with a waypoint taught relative to the bin. Fails at once when the part is not "
         "on the table (not seen, or already in the bin).",
         tree,
-        inputs=[_port("OBJECT", ParamType.OBJECT, "the part to move"),
-                _port("PICK", ParamType.WAYPOINT, "the tool 10 cm above the part, relative to it"),
-                _port("PLACE", ParamType.WAYPOINT, "the tool above where the part goes, relative to the bin"),
-                _port("BIN", ParamType.POSE, "where the bin is")],
+        inputs=[port("OBJECT", ParamType.OBJECT, "the part to move"),
+                port("PICK", ParamType.WAYPOINT, "the tool 10 cm above the part, relative to it"),
+                port("PLACE", ParamType.WAYPOINT, "the tool above where the part goes, relative to the bin"),
+                port("BIN", ParamType.POSE, "where the bin is")],
     )  # fmt: skip
 
 
@@ -251,9 +202,9 @@ def return_bin() -> SubtreeSpec:
         "return", "Return",
         "Takes the bin by its wall with the gripper and puts it down at a new place.",
         tree,
-        inputs=[_port("BIN", ParamType.POSE, "where the bin is"),
-                _port("GRASP", ParamType.WAYPOINT, "the gripper 10 cm above the wall, relative to the bin"),
-                _port("DEST", ParamType.WAYPOINT, "the gripper 10 cm above where it lets go (world)")],
+        inputs=[port("BIN", ParamType.POSE, "where the bin is"),
+                port("GRASP", ParamType.WAYPOINT, "the gripper 10 cm above the wall, relative to the bin"),
+                port("DEST", ParamType.WAYPOINT, "the gripper 10 cm above where it lets go (world)")],
     )  # fmt: skip
 
 
@@ -280,9 +231,9 @@ def kitting() -> PlanSpec:
 
     def transfer_of(plate: str, label: str) -> NodeSpec:
         return m.instance(
-            subs["transfer"], f"Transfer {label}", OBJECT=_obj(plate),
-            PICK=_fixed(pick_waypoint(plate), ParamType.WAYPOINT),
-            PLACE=_fixed(place_waypoint(plate), ParamType.WAYPOINT), BIN="BIN_POSE",
+            subs["transfer"], f"Transfer {label}", OBJECT=obj(plate),
+            PICK=fixed(pick_waypoint(plate), ParamType.WAYPOINT),
+            PLACE=fixed(place_waypoint(plate), ParamType.WAYPOINT), BIN="BIN_POSE",
         )  # fmt: skip
 
     plates = m.node(
@@ -295,14 +246,14 @@ def kitting() -> PlanSpec:
     )  # fmt: skip
     tree = m.node(
         NodeKind.SEQUENCE, "Kitting",
-        m.instance(subs["handoff"], "Handoff", AREA=_fixed(HANDOFF_AREA, ParamType.REGION),
+        m.instance(subs["handoff"], "Handoff", AREA=fixed(HANDOFF_AREA, ParamType.REGION),
                    POSE="BIN_POSE"),
         m.instance(subs["unholster"], "Unholster"),
         plates,
         m.instance(subs["holster"], "Holster"),
         m.instance(subs["return"], "Return", BIN="BIN_POSE",
-                   GRASP=_fixed(wall_grasp(), ParamType.WAYPOINT),
-                   DEST=_fixed(return_place(), ParamType.WAYPOINT)),
+                   GRASP=fixed(wall_grasp(), ParamType.WAYPOINT),
+                   DEST=fixed(return_place(), ParamType.WAYPOINT)),
     )  # fmt: skip
     return PlanSpec(
         tree, "Kitting (Figure 7, simulated cell)",
@@ -318,11 +269,7 @@ def kitting() -> PlanSpec:
 
 
 def main() -> None:
-    LIBRARY.mkdir(parents=True, exist_ok=True)
-    for subtree in library():
-        path = LIBRARY / f"{subtree.name}.subtree.json"
-        write_atomic(path, dump_subtree(subtree).encode("utf-8"))
-        print(f"wrote {path.relative_to(HERE.parent)}")
+    write_library(LIBRARY, library(), HERE.parent)
     plan = HERE / "kitting.costar.json"
     save_plan(kitting(), plan)
     print(f"wrote {plan.name}")

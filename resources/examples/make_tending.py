@@ -31,12 +31,9 @@ from __future__ import annotations
 import math
 import uuid
 from pathlib import Path
-from typing import Any
 
 from engine.files import save_plan
-from engine.kinds import setting
-from engine.library import dump_subtree, load_subtree
-from engine.plan_writer import write_atomic
+from engine.library import load_subtree
 from engine.spec import (
     Binding,
     NodeKind,
@@ -47,11 +44,11 @@ from engine.spec import (
     SubtreeSpec,
 )
 from engine.types import JointConfig, ObjectModel, ParamType, Pose, Region, Waypoint, WaypointFrame
+from resources.examples.plan_builder import PlanBuilder, fixed, port, subtree, write_library
 
 HERE = Path(__file__).resolve().parent
 LIBRARY = HERE.parent / "library"
 _NAMESPACE = uuid.UUID("8f3e6a2c-1d4b-4e7a-9c5f-2b8d7e6a5c41")
-DATE = "2026-11-24T00:00:00Z"
 
 OBSERVE_JOINTS = (1.2, -1.9, 2.0, -1.6, -1.57, 0.0)  # out of the shoulder camera's view
 # The tool down, turned as the bender drops its parts (the weld bead along world x, the
@@ -72,8 +69,8 @@ OVER_RACK_Z, RACK_DROP_Z = 0.32, 0.235  # TCP, rack frame: the fingertips 2 cm o
 SCRAP_XY, SCRAP_Z = (0.42, 0.5), 0.2  # over the scrap bin (taught, world): 8 cm over its rim
 REGRASP_TRIES = 1  # more tries scatter the pieces of a broken weld
 ARM_TIMEOUT = 40.0  # s: longer than the bender's longest interval (20 s + 35 %) and a cycle
-PIECE_TIME = 15.0
-TAKE_TIME = 15.0  # s: simulated seconds for a pick (its moves take about 5)  # s: simulated seconds for one piece (a jammed finger gives up)
+PIECE_TIME = 15.0  # s: simulated seconds for one piece (a jammed finger gives up)
+TAKE_TIME = 15.0  # s: simulated seconds for a pick (its moves take about 5)
 
 
 def observe() -> Waypoint:
@@ -103,40 +100,11 @@ def waypoints() -> list[Waypoint]:
     return found
 
 
-class _Maker:
-    """Nodes with ids that stay the same from one run of the generator to the next."""
+class _Maker(PlanBuilder):
+    """The tending generator's nodes (ids in its own namespace), and a timed take."""
 
     def __init__(self, scope: str) -> None:
-        self.scope = scope
-        self.count = 0
-
-    def id(self) -> str:
-        self.count += 1
-        return uuid.uuid5(_NAMESPACE, f"{self.scope}/{self.count}").hex
-
-    def node(self, kind: NodeKind, name: str, *children: NodeSpec, **config: Any) -> NodeSpec:
-        params = {k: setting(kind, k, v) for k, v in config.items()}
-        return NodeSpec(kind, name, self.id(), params=params, children=list(children))
-
-    def op(self, op: str, name: str, **params: Binding | str) -> NodeSpec:
-        bound = {k: Binding.reference(v) if isinstance(v, str) else v for k, v in params.items()}
-        return NodeSpec(NodeKind.OPERATION, name, self.id(), op=op, params=bound)
-
-    def move(
-        self, name: str, target: Waypoint | str, reference: str = "", linear: bool = False
-    ) -> NodeSpec:
-        params: dict[str, Binding | str] = {
-            "target": target if isinstance(target, str) else _fixed(target, ParamType.WAYPOINT)
-        }
-        if reference:
-            params["reference"] = reference
-        if linear:
-            params["mode"] = _fixed("linear", ParamType.TEXT)
-        return self.op("motion.move_to", name, **params)
-
-    def instance(self, subtree: SubtreeSpec, name: str, **params: Binding | str) -> NodeSpec:
-        bound = {k: Binding.reference(v) if isinstance(v, str) else v for k, v in params.items()}
-        return NodeSpec(NodeKind.SUBTREE, name, self.id(), params=bound, subtree=subtree.ref)
+        super().__init__(_NAMESPACE, scope)
 
     def take(self, name: str, above: str, at: str) -> NodeSpec:
         """Down from ``above`` to ``at``, close, feel it held, lift, feel it still held; in
@@ -155,34 +123,19 @@ class _Maker:
         )  # fmt: skip
 
 
-def _fixed(value: Any, ptype: ParamType) -> Binding:
-    return Binding.fixed(value, ptype)
-
-
 def _wp(waypoint: Waypoint) -> Binding:
-    return _fixed(waypoint, ParamType.WAYPOINT)
-
-
-def _port(name: str, ptype: ParamType, doc: str, default: Any = None) -> SubtreePort:
-    return SubtreePort(name, ptype, doc, default)
-
-
-def _subtree(key: str, name: str, description: str, tree: NodeSpec, **ports: Any) -> SubtreeSpec:
-    return SubtreeSpec(
-        key, name, tree, 1, DATE, description,
-        inputs=ports.get("inputs", []), outputs=ports.get("outputs", []),
-    )  # fmt: skip
+    return fixed(waypoint, ParamType.WAYPOINT)
 
 
 def _exit_ports() -> list[SubtreePort]:
-    return [_port("ABOVE", ParamType.WAYPOINT, "the tool over the exit, clear of the parts"),
-            _port("AT", ParamType.WAYPOINT, "the tool where it closes on a part at the exit")]  # fmt: skip
+    return [port("ABOVE", ParamType.WAYPOINT, "the tool over the exit, clear of the parts"),
+            port("AT", ParamType.WAYPOINT, "the tool where it closes on a part at the exit")]  # fmt: skip
 
 
 def pick_at_exit() -> SubtreeSpec:
     m = _Maker("pick_at_exit")
     tree = m.take("PickAtExit", "ABOVE", "AT")
-    return _subtree(
+    return subtree(
         "tending.pick_at_exit", "PickAtExit",
         "Takes a part where a machine dropped it, with taught waypoints: over it, straight "
         "down, close, feel it held, lift, feel it still held (fails when it is not).",
@@ -199,14 +152,14 @@ def place_on_rack() -> SubtreeSpec:
         m.op("gripper.open", "let go into the tote"),
         m.move("up from the rack", "OVER", "RACK", linear=True),
     )  # fmt: skip
-    return _subtree(
+    return subtree(
         "tending.place_on_rack", "PlaceOnRack",
         "Drops what the gripper holds into the rack's tote, with waypoints taught relative to "
         "the rack.",
         tree,
-        inputs=[_port("RACK", ParamType.POSE, "where the rack is"),
-                _port("OVER", ParamType.WAYPOINT, "the tool over the tote, relative to the rack"),
-                _port("INTO", ParamType.WAYPOINT, "where the tool lets go, relative to the rack")],
+        inputs=[port("RACK", ParamType.POSE, "where the rack is"),
+                port("OVER", ParamType.WAYPOINT, "the tool over the tote, relative to the rack"),
+                port("INTO", ParamType.WAYPOINT, "where the tool lets go, relative to the rack")],
     )  # fmt: skip
 
 
@@ -219,7 +172,7 @@ def regrasp() -> SubtreeSpec:
                m.take("take it", "ABOVE", "AT")),
         count=REGRASP_TRIES,
     )  # fmt: skip
-    return _subtree(
+    return subtree(
         "recovery.regrasp", "Regrasp",
         f"After a grasp that closed on nothing or a part that slipped out: let go and take the "
         f"part again where it lies at the exit, feeling it held before and after lifting "
@@ -243,7 +196,7 @@ def discard_to_scrap() -> SubtreeSpec:
         # No "held?" check: the gripper's sensor reads the thin, light pieces as nothing
         # held, yet the fingers lift them. A time limit: a finger that jams on a piece
         # lying askew must not hold the robot up.
-        down = _fixed(GRASP_Z - ABOVE_Z, ParamType.NUMBER)
+        down = fixed(GRASP_Z - ABOVE_Z, ParamType.NUMBER)
         return m.node(
             NodeKind.FORCE_SUCCESS, f"{key.lower()}, if it lies there",
             m.node(NodeKind.TIMEOUT, f"{key.lower()}, {PIECE_TIME:g} s at most",
@@ -253,7 +206,7 @@ def discard_to_scrap() -> SubtreeSpec:
                           m.op("motion.move_relative", "down to it", dz=down),
                           m.op("gripper.close", "close on it"),
                           m.op("motion.move_relative", "lift it",
-                               dz=_fixed(-down.value, ParamType.NUMBER)),
+                               dz=fixed(-down.value, ParamType.NUMBER)),
                           m.move("over the scrap bin", "SCRAP"),
                           m.op("gripper.open", "drop it into the bin")),
                    seconds=PIECE_TIME),
@@ -267,16 +220,16 @@ def discard_to_scrap() -> SubtreeSpec:
         *(piece(f"PIECE_{i}") for i in range(1, 5)),
         m.move("step out of view", observe()),
     )  # fmt: skip
-    return _subtree(
+    return subtree(
         "recovery.discard_to_scrap", "DiscardToScrap",
         "A bad part: whatever the gripper still holds goes into the scrap bin, then the "
         "pieces of a broken weld are taken where they fall at the exit (taught spots, one after "
         "the other; where nothing lies the fingers close on nothing) and dropped into the "
         "scrap bin.",
         tree,
-        inputs=[_port("ABOVE", ParamType.WAYPOINT, "the tool over the exit, clear of the parts"),
-                _port("SCRAP", ParamType.WAYPOINT, "the tool over the scrap bin (taught)"),
-                *(_port(f"PIECE_{i}", ParamType.WAYPOINT,
+        inputs=[port("ABOVE", ParamType.WAYPOINT, "the tool over the exit, clear of the parts"),
+                port("SCRAP", ParamType.WAYPOINT, "the tool over the scrap bin (taught)"),
+                *(port(f"PIECE_{i}", ParamType.WAYPOINT,
                         "the tool over where a piece of a broken part lies (it goes straight "
                         f"down {ABOVE_Z - GRASP_Z:.3f} m to take it)") for i in range(1, 5))],
     )  # fmt: skip
@@ -287,17 +240,17 @@ def reregister_rack() -> SubtreeSpec:
     tree = m.node(
         NodeKind.SEQUENCE, "ReRegisterRack",
         m.move("step out of view", observe()),
-        m.op("markers.detect_markers", "look at the rack", camera=_fixed("shoulder", ParamType.TEXT)),
+        m.op("markers.detect_markers", "look at the rack", camera=fixed("shoulder", ParamType.TEXT)),
         m.op("markers.object_pose", "pose of the rack", object="RACK", pose="RACK_POSE"),
     )  # fmt: skip
-    return _subtree(
+    return subtree(
         "recovery.reregister_rack", "ReRegisterRack",
         "Finds the rack again by its marker (the arm out of the shoulder camera's view) and "
         "gives its pose now: waypoints taught relative to the rack follow it when it was "
         "moved. Fails (not_found) when its marker is not seen.",
         tree,
-        inputs=[_port("RACK", ParamType.OBJECT, "the rack", ObjectModel("tending_rack"))],
-        outputs=[_port("RACK_POSE", ParamType.POSE, "where the rack is now")],
+        inputs=[port("RACK", ParamType.OBJECT, "the rack", ObjectModel("tending_rack"))],
+        outputs=[port("RACK_POSE", ParamType.POSE, "where the rack is now")],
     )  # fmt: skip
 
 
@@ -321,8 +274,8 @@ PLACE_ERRORS = "protective_stop"  # the rack moved into the way: a collision
 def _part_cycle(m: _Maker, subs: dict[str, SubtreeSpec], wps: dict[str, Waypoint]) -> NodeSpec:
     """One part: wait for the welding arm, pick (with recovery), find the rack (a worker may
     have moved it; the arm steps out of the camera's view anyway), place (with recovery)."""
-    region = _fixed(ARM_REGION, ParamType.REGION)
-    period = _fixed(0.25, ParamType.DURATION)  # four looks a second see the arm come and go
+    region = fixed(ARM_REGION, ParamType.REGION)
+    period = fixed(0.25, ParamType.DURATION)  # four looks a second see the arm come and go
     exit_wps = {"ABOVE": _wp(wps["over exit"]), "AT": _wp(wps["at exit"])}
     scrap = m.instance(
         subs["DiscardToScrap"], "DiscardToScrap", ABOVE=_wp(wps["over exit"]),
@@ -338,7 +291,7 @@ def _part_cycle(m: _Maker, subs: dict[str, SubtreeSpec], wps: dict[str, Waypoint
                       m.node(NodeKind.PARALLEL, "scrap it until the next part comes",
                              scrap,
                              m.op("occupancy.wait_until_occupied", "the welding arm comes",
-                                  region=region, timeout=_fixed(600.0, ParamType.DURATION),
+                                  region=region, timeout=fixed(600.0, ParamType.DURATION),
                                   period=period),
                              success="any"))),
         errors=PICK_ERRORS, error="PICK_ERROR",
@@ -362,7 +315,7 @@ def _part_cycle(m: _Maker, subs: dict[str, SubtreeSpec], wps: dict[str, Waypoint
         NodeKind.CATCH, "wait for the welding arm, else feel at the exit",
         m.node(NodeKind.SEQUENCE, "the welding arm swings down and back up",
                m.op("occupancy.wait_until_occupied", "wait for the welding arm", region=region,
-                    timeout=_fixed(ARM_TIMEOUT, ParamType.DURATION), period=period),
+                    timeout=fixed(ARM_TIMEOUT, ParamType.DURATION), period=period),
                m.op("occupancy.wait_until_empty", "wait until the arm is back up",
                     region=region, period=period)),
         # A swing the camera missed (a busy computer) leaves a part at the exit that the
@@ -441,11 +394,7 @@ def tending() -> PlanSpec:
 
 def main() -> None:
     for folder, subtrees in library().items():
-        (LIBRARY / folder).mkdir(parents=True, exist_ok=True)
-        for subtree in subtrees:
-            path = LIBRARY / folder / f"{subtree.name}.subtree.json"
-            write_atomic(path, dump_subtree(subtree).encode("utf-8"))
-            print(f"wrote {path.relative_to(HERE.parent)}")
+        write_library(LIBRARY / folder, subtrees, HERE.parent)
     plan = HERE / "tending.costar.json"
     save_plan(tending(), plan)
     print(f"wrote {plan.name}")
