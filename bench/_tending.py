@@ -77,6 +77,7 @@ def run_trial(job: TendingJob) -> dict[str, Any]:
             trial = TendingTrial(session, PLANS[job.plan], operator, lead=LEAD)
             counters = trial.run(parts=job.parts, wall_timeout=300.0 * job.parts)
             out: dict[str, Any] = counters.as_dict() | {"stops": trial.stops}
+            out["lost_parts"] = trial.lost()  # what became of each, and what failed then
             if trial.ended():  # the plan ended before the trial did: what failed last
                 out["plan_ended"] = trial.ended()
                 out["last_failures"] = trial.failures[-5:]

@@ -21,6 +21,7 @@ The counters, as in Table I (two trials of 50 parts: 82 caught, 2 bad welds, 5 b
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from typing import Any
@@ -30,7 +31,7 @@ from capabilities.sim.bender import RELEASED, SLIPPED, WELD_BROKE, WireBender
 from capabilities.sim.scene import SceneState
 from engine.types import Pose
 
-__all__ = ["TrialCounters", "container_of", "loose_things", "score_trial"]
+__all__ = ["TrialCounters", "container_of", "lost_parts", "loose_things", "score_trial"]
 
 RACK = "rack"  # the scene object whose tote counts as caught; other totes are scrap bins
 OVER_RIM = 0.03  # m over a tote's rim still counts as in it (a pile); higher: held over it
@@ -180,3 +181,45 @@ def score_trial(
         operator_interventions=interventions,
         sim_seconds=sim_seconds,
     )
+
+
+def _where(client: int, scene: SceneState, at: Pose, exit_at: Pose | None) -> str:
+    """In words: in a tote, at the bender's exit (within 15 cm) or elsewhere, with height."""
+    place = container_of(client, scene, at)
+    if place:
+        return "in the rack's tote" if place == "caught" else "in the scrap bin"
+    x, y, z = at.position
+    if exit_at is not None and math.dist(at.position[:2], exit_at.position[:2]) < 0.15:
+        return f"at the exit (z {z:.3f})"
+    return f"at ({x:.2f}, {y:.2f}, {z:.3f})"
+
+
+def lost_parts(
+    client: int, bender: WireBender, scene: SceneState, removed: set[int]
+) -> list[dict[str, Any]]:
+    """What became of each lost part, in words (physics thread; for the bench's report):
+    its release time, its fault, and where it (or each of its pieces) is now."""
+    events = bender.events()
+    pieces = _pieces_by_part(bender, scene)
+    faults = {e.part: e.kind for e in events if e.kind in (WELD_BROKE, SLIPPED)}
+    out = []
+    for event in events:
+        if event.kind != RELEASED:
+            continue
+        kept = pieces.get(event.part)
+        live = None if kept is None else [b for b in kept if b not in removed]
+        if _fate(client, scene, event.part, live):
+            continue
+        if kept is not None:
+            where = [
+                "taken away" if b in removed else _where(client, scene, _body_pose(client, b),
+                                                          event.pose)
+                for b in kept
+            ]  # fmt: skip
+        elif event.part in scene.objects:
+            where = [_where(client, scene, scene.truth_pose(client, event.part), event.pose)]
+        else:
+            where = ["taken away"]
+        out.append({"part": event.part, "released": round(event.time, 1),
+                    "fault": faults.get(event.part, ""), "where": where})  # fmt: skip
+    return out

@@ -35,7 +35,7 @@ from capabilities.bullet import pybullet as p
 from capabilities.faults import hold_check
 from capabilities.sim.errors import SimError
 from capabilities.sim.session import SimCellSession
-from capabilities.sim.tending_score import TrialCounters, loose_things, score_trial
+from capabilities.sim.tending_score import TrialCounters, loose_things, lost_parts, score_trial
 from engine.build import build_tree
 from engine.events import Event, RunHeld, StatusChanged
 from engine.executor import Executor
@@ -284,3 +284,20 @@ class TendingTrial:
             return score_trial(client, bender, session.scene, self._removed, calls, elapsed)
 
         return session.sim.call(count)
+
+    def lost(self) -> list[dict[str, object]]:
+        """Each lost part's fault and whereabouts, with the failures around it (ground truth,
+        for the bench's report): the failures from 5 s before its release to 40 s after."""
+        session, bender = self.session, self.session.bender
+        assert bender is not None
+        report = session.sim.call(
+            lambda client: lost_parts(client, bender, session.scene, self._removed)
+        )
+        start = bender.start_time or 0.0
+        for part in report:
+            at = float(part["released"])
+            part["released"] = round(at - start, 1)
+            part["failures"] = [
+                f"{t - start:.1f} s {what}" for t, what in self.failures if at - 5 <= t <= at + 40
+            ]
+        return report

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
+from functools import partial
 
 import numpy as np
 import pytest
@@ -15,7 +16,7 @@ import pytest
 from capabilities.base import CapabilityRegistry, NullCell
 from capabilities.markers import capability
 from capabilities.markers.geometry import pose_errors
-from capabilities.sim.session import SimCellSession
+from capabilities.sim.session import SimCameraDevice, SimCellSession
 from engine.build import build_tree
 from engine.error_types import ErrorType
 from engine.executor import run_to_end
@@ -85,7 +86,7 @@ def test_marker_poses_from_320x240_images_within_5mm_and_2deg() -> None:
                 seen[marker_id] = found[0]
         assert len(seen) >= 3, sorted(seen)  # the table's calibration markers at least
         for marker_id, pose in seen.items():
-            truth = cell.sim.call(lambda c, m=marker_id: cell.scene.truth_marker_pose(c, m))
+            truth = cell.sim.call(partial(cell.scene.truth_marker_pose, marker_id=marker_id))
             position_error, angle = pose_errors(pose, truth)
             assert position_error < 0.005 and math.degrees(angle) < 2.0, (
                 marker_id,
@@ -106,6 +107,7 @@ def _displaced(nominal: Pose, shift_m: float, tilt_deg: float) -> Pose:
 def test_calibration_recovers_a_displaced_camera_within_5mm() -> None:
     with SimCellSession(seed=1, shoulder_size=(320, 240)) as cell:
         camera = cell.cameras["shoulder"]
+        assert isinstance(camera, SimCameraDevice)  # a rendered camera: it can be displaced
         true_pose = _displaced(camera.extrinsics(), 0.03, 3.0)
         camera.displace_for_test(true_pose)
         before, _ = pose_errors(camera.extrinsics(), true_pose)

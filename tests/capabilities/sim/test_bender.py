@@ -25,7 +25,7 @@ from capabilities.sim.bender_spec import FaultModel, parse_bender, plan_parts
 from capabilities.sim.objects import SceneError
 from capabilities.sim.scene import default_scene_path
 from capabilities.sim.scene_spec import SceneFileError
-from capabilities.sim.session import SimCellSession
+from capabilities.sim.session import SimCameraDevice, SimCellSession
 from capabilities.sim.testing import down_at, run
 from engine.types import Pose, Region
 from tests.capabilities.occupancy.helpers import run_op
@@ -291,6 +291,7 @@ def test_the_shoulder_camera_is_calibrated_on_the_benders_markers(tmp_path: Path
         layout = session.scene_layout()["fixed_markers"]
         assert set(layout) == {30, 31}  # the rack moves between runs: its markers are not
         camera = session.cameras["shoulder"]
+        assert isinstance(camera, SimCameraDevice)  # a rendered camera: it can be displaced
         nominal = camera.extrinsics()
         turn = Pose((0.0, 0.0, 0.0), (0.0, math.sin(0.02), 0.0, math.cos(0.02)))  # 2.3 deg
         true_pose = Pose(tuple(np.add(nominal.position, (0.02, -0.015, 0.01))),
