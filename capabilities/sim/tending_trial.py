@@ -113,7 +113,12 @@ class TendingTrial:
         if has_errors(problems):
             errors = "; ".join(str(x) for x in problems if x.severity == "error")
             raise TrialError(f"{plan}: the plan is not valid: {errors}")
+        # (label, operation) by node id: the plan's own and its subtrees' (an instance's
+        # nodes run as "<instance id>/<node id>"; see node()).
         self._nodes = {node.id: (node.label, node.op or "") for _, node in spec.walk()}
+        for sub in spec.subtrees:
+            for _, node in sub.tree.walk():
+                self._nodes.setdefault(node.id, (f"{sub.name}/{node.label}", node.op or ""))
         tree = build_tree(spec, registry, clock=session.clock)
         self._cell_hold = hold_check(session)
         self.executor = Executor(tree, rate_hz, [self._heard], hold=self._before_tick)
@@ -145,12 +150,16 @@ class TendingTrial:
 
     # ------------------------------------------------------------------ the plan's events
 
+    def node(self, node_id: str) -> tuple[str, str]:
+        """(label, operation) of a running node ("SUBTREE/label" inside an instance)."""
+        return self._nodes.get(node_id.rsplit("/", 1)[-1], ("", ""))
+
     def _heard(self, event: Event) -> None:
         if isinstance(event, RunHeld) and event.reason:
             self._call(f"held: {event.reason}", press=False)
         if not isinstance(event, StatusChanged):
             return
-        label, op = self._nodes.get(event.node_id, ("", ""))
+        label, op = self.node(event.node_id)
         if event.new is Status.FAILURE and op and op not in OPERATOR_OPS:
             self._last_failure = f"{label}: {event.message}"
             self.failures.append((round(self.session.clock(), 1), self._last_failure))

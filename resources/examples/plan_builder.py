@@ -44,9 +44,15 @@ class PlanBuilder:
         return NodeSpec(NodeKind.OPERATION, name, self.id(), op=op, params=_bound(params))
 
     def move(
-        self, name: str, target: Waypoint | str, reference: str = "", linear: bool = False
+        self,
+        name: str,
+        target: Waypoint | str,
+        reference: str = "",
+        linear: bool = False,
+        speed: float = 1.0,
     ) -> NodeSpec:
-        """``motion.move_to`` a waypoint (or the one a blackboard entry names)."""
+        """``motion.move_to`` a waypoint (or the one a blackboard entry names); ``speed``
+        scales the nominal speed and acceleration alike (default: left at the port's 1)."""
         params: dict[str, Binding | str] = {
             "target": target if isinstance(target, str) else fixed(target, ParamType.WAYPOINT)
         }
@@ -54,6 +60,9 @@ class PlanBuilder:
             params["reference"] = reference
         if linear:
             params["mode"] = fixed("linear", ParamType.TEXT)
+        if speed != 1.0:
+            params |= {"speed": fixed(speed, ParamType.NUMBER),
+                       "accel": fixed(speed, ParamType.NUMBER)}  # fmt: skip
         return self.op("motion.move_to", name, **params)
 
     def instance(self, subtree: SubtreeSpec, name: str, **params: Binding | str) -> NodeSpec:

@@ -122,7 +122,7 @@ STEPS: list[Step] = [
     (None, "until the next part", "parallel", "parallel", [("success", "value", "any")]),
     (None, "discard", "DiscardToScrap", "subtree",
      [("ABOVE", "value", "over exit"), ("SCRAP", "value", "over scrap"),
-      *((f"PIECE_{i}", "value", f"over piece {i}") for i in range(1, 5))]),
+      *((f"PIECE_{i}", "value", f"over piece {i}") for i in range(1, 4))]),
     (None, "arm comes", "occupied", "occupancy.wait_until_occupied",
      [*ARM_WAIT, ("timeout", "value", 600.0)]),
     ("one part", "where is the rack", "ReRegisterRack", "subtree", FIND),

@@ -58,7 +58,7 @@ class _Watched(TendingTrial):
     def _heard(self, event: Event) -> None:
         super()._heard(event)
         if isinstance(event, StatusChanged) and event.new is Status.RUNNING:
-            self.ran.add(self._nodes.get(event.node_id, ("", ""))[0])
+            self.ran.add(self.node(event.node_id)[0])
 
 
 def _trial(session: SimCellSession) -> tuple[TrialCounters, _Watched]:
