@@ -12,6 +12,8 @@ import math
 from collections.abc import Callable
 from pathlib import Path
 
+import pytest
+
 from capabilities.sim.bender import read_bender
 from capabilities.sim.bender_spec import FaultModel, plan_parts
 from capabilities.sim.objects import set_object_frame_pose
@@ -34,14 +36,17 @@ def _where(session: SimCellSession, part: str) -> str:
     return session.sim.call(lambda c: container_of(c, scene, scene.truth_pose(c, part)))
 
 
-def _seed_with(faults: list[tuple[bool, bool]], rates: FaultModel, scene: Path) -> int:
-    """A seed whose parts have these (bad weld, bad grasp) faults."""
+def _seed_with(
+    faults: list[tuple[bool, bool]], rates: FaultModel, scene: Path, shape: str = ""
+) -> int:
+    """A seed whose parts have these (bad weld, bad grasp) faults (the first part this shape)."""
     spec = read_bender(scene)
     assert spec is not None
     for seed in range(500):
-        if [(p.bad_weld, p.bad_grasp) for p in plan_parts(spec, seed, rates)] == faults:
+        parts = plan_parts(spec, seed, rates)
+        if [(p.bad_weld, p.bad_grasp) for p in parts] == faults and shape in parts[0].shape:
             return seed
-    raise AssertionError(f"no seed gives faults {faults}")
+    raise AssertionError(f"no seed gives faults {faults} with a {shape} first")
 
 
 def _session(scene: Path, seed: int, rates: FaultModel) -> SimCellSession:
@@ -84,13 +89,15 @@ def test_a_slipped_grasp_is_regrasped(tmp_path: Path) -> None:
         assert counters.caught == 2 and trial.calls == []
 
 
-def test_a_broken_weld_is_discarded_without_the_operator(tmp_path: Path) -> None:
+@pytest.mark.parametrize("shape", ["wireform_u", "wireform_step"])
+def test_a_broken_weld_is_discarded_without_the_operator(tmp_path: Path, shape: str) -> None:
     """Part 1's weld comes apart when lifted: Regrasp gives up and DiscardToScrap takes over
-    (the pieces into the scrap bin) until the next part comes, which is caught. The run
-    goes on: the operator is never called and no protective stop holds it."""
+    (both pieces into the scrap bin, wherever each shape's lie) until the next part comes,
+    which is caught. The run goes on: the operator is never called and no protective stop
+    holds it."""
     scene = tending_scene(tmp_path, parts=2, interval=24.0)
     rates = FaultModel(bad_weld=0.5, bad_grasp=0.0, interval_spread=0.0)
-    seed = _seed_with([(True, False), (False, False)], rates, scene)
+    seed = _seed_with([(True, False), (False, False)], rates, scene, shape)
     with _session(scene, seed, rates) as session:
         counters, trial = _trial(session)
         bender = session.bender
