@@ -23,6 +23,7 @@ from engine.hold import Hold, HoldCheck
 __all__ = [
     "CONNECTION_LOST",
     "EMERGENCY_STOP",
+    "LOOKING",
     "PROTECTIVE_STOP",
     "CellStatus",
     "fault_error",
@@ -49,8 +50,14 @@ def fault_error(message: str) -> ErrorType:
     return ErrorType.FAILED
 
 
+# Capabilities that only look (the cameras): a stop of the arm leaves their operations
+# running, so a watch for the next part goes on while the arm stands and recovers.
+LOOKING = frozenset({"occupancy", "markers", "perception"})
+
+
 def hold_check(cell: Any) -> HoldCheck | None:
-    """The executor's hold check of a cell with ``hold_reason()`` (None for one without)."""
+    """The executor's hold check of a cell with ``hold_reason()`` (None for one without);
+    its stops spare the operations of the capabilities that only look."""
     reason_of: Callable[[], str] | None = getattr(cell, "hold_reason", None)
     if not callable(reason_of):
         return None
@@ -58,7 +65,7 @@ def hold_check(cell: Any) -> HoldCheck | None:
 
     def check() -> Hold | None:
         reason = ask()
-        return Hold(reason, fault_error(reason)) if reason else None
+        return Hold(reason, fault_error(reason), LOOKING) if reason else None
 
     return check
 

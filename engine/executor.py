@@ -33,7 +33,7 @@ from engine.events import (
     RunStarted,
     StatusChanged,
 )
-from engine.hold import Hold, HoldCheck, catchers, throw
+from engine.hold import Hold, HoldCheck, catchers, stopped_leaves, throw
 from engine.node import Node
 from engine.status import FAILURE, RUNNING, Status
 from engine.tree import BehaviorTree
@@ -308,7 +308,7 @@ class Executor:
         if any(hold.reason in message for message in self._failures):
             self._thrown = hold  # a node already failed with it: the plan has seen it
             return True
-        leaves = self.tree.running_leaves()
+        leaves = stopped_leaves(self.tree.running_leaves(), hold)
         if catchers(leaves, hold.error) is None:
             return False
         throw(leaves, hold)

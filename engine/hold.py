@@ -2,10 +2,12 @@
 
 A cell that can stop on its own gives the executor a hold check that answers a
 :class:`Hold` (why in words, and the error type a Catch node matches) or None. When a stop
-begins, the executor asks :func:`catchers`: if every running leaf sits in the body of a Catch
-that takes the stop's error type, the stop is *thrown*: those leaves fail with it
-(:func:`throw`) and each Catch's handler runs, as Rethink Intera throws a collision during a
-move to the tree. Otherwise the run is held until the cell is clear, as on a UR's pendant.
+begins, the executor asks :func:`catchers`: if every running leaf the stop concerns
+(:func:`stopped_leaves`: not those of the capabilities it spares, such as a camera's watch,
+which goes on seeing while the arm stands) sits in the body of a Catch that takes the stop's
+error type, the stop is *thrown*: those leaves fail with it (:func:`throw`) and each Catch's
+handler runs, as Rethink Intera throws a collision during a move to the tree. Otherwise the
+run is held until the cell is clear, as on a UR's pendant.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ from engine.catch import Catch
 from engine.error_types import ErrorType
 from engine.node import Node
 
-__all__ = ["Hold", "HoldCheck", "catchers", "throw"]
+__all__ = ["Hold", "HoldCheck", "catchers", "stopped_leaves", "throw"]
 
 
 @dataclass(frozen=True)
@@ -31,9 +33,18 @@ class Hold:
 
     reason: str
     error: ErrorType = ErrorType.FAILED
+    spares: frozenset[str] = frozenset()
+    """Capabilities whose running operations the stop leaves running (they only look)."""
 
 
 HoldCheck = Callable[[], Hold | None]
+
+
+def stopped_leaves(leaves: list[Node], hold: Hold) -> list[Node]:
+    """The running ``leaves`` the stop concerns: all but the operations of spared capabilities."""
+    if not hold.spares:
+        return leaves
+    return [leaf for leaf in leaves if getattr(leaf, "capability", "") not in hold.spares]
 
 
 def _catcher(leaf: Node, error: ErrorType) -> Catch | None:

@@ -55,6 +55,7 @@ class OperationLeaf(Node):
         ports: the manifest's input ports: fixed values are given to the operation as the
             port's type, and a reference's value is checked against the port's types when
             read (a value of another type fails the node, naming port, name and types).
+        capability: the capability the operation belongs to (a cell's stop may spare it).
     """
 
     kind = "operation"
@@ -71,8 +72,10 @@ class OperationLeaf(Node):
         outputs: Mapping[str, str] | None = None,
         *,
         ports: Sequence[PortSpec] = (),
+        capability: str = "",
     ) -> None:
         super().__init__(ctx, node_id, name)
+        self.capability = capability
         self.op_kind = op_kind
         self.kind = op_kind.value
         self.is_condition = op_kind is OperationKind.CONDITION

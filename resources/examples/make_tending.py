@@ -5,20 +5,22 @@ the operator on any failure while the bender goes on producing (Table I: 13 of 1
 that way). Ours does the same task composed from library subtrees, with recovery:
 
 - ``resources/library/tending``: PickAtExit (take a part at the exit with taught waypoints
-  and feel it held before and after lifting) and PlaceOnRack (drop it into the rack's tote,
-  taught relative to the rack).
+  and feel it held before and after lifting), PlaceOnRack (drop it into the rack's tote,
+  taught relative to the rack) and WaitForPart (the welding arm swings down and back up, by
+  occupancy; a swing not seen in time: feel for a part at the exit).
 - ``resources/library/recovery``: Regrasp (a grasp that closed on nothing or a part that
   slipped: let go, look again at the exit and grasp again, a bounded number of tries),
   DiscardToScrap (a bad part: what is still held goes to the scrap bin, and the pieces of a
   broken weld are taken from where they fall at the exit to the scrap bin) and
   ReRegisterRack (find the rack's marker again and give its pose, which the place
   waypoints are taught relative to).
-- ``resources/examples/tending.costar.json``: find the rack; then for every part, forever:
-  wait for the welding arm (occupancy), pick (a Catch sends a failed pick to Regrasp, and
-  when that gives up to DiscardToScrap), re-register the rack (ReRegisterRack: it is a mobile
-  rack, a worker may have moved it), place (a Catch sends a protective stop, the rack moved
-  into the way, to ClearStopAndBackOff and ReRegisterRack and places again) and step out of
-  view. ClearStopAndBackOff is shipped by ``make_clear_stop.py`` and read here from the
+- ``resources/examples/tending.costar.json``: find the rack, wait for the first part
+  (WaitForPart); then for every part, forever: pick (a Catch sends a failed pick to Regrasp,
+  and when that gives up to DiscardToScrap), re-register the rack (ReRegisterRack: it is a
+  mobile rack, a worker may have moved it), then place (a Catch sends a protective stop, the
+  rack moved into the way, to ClearStopAndBackOff and ReRegisterRack and places again) and
+  step out of view while WaitForPart watches for the next part (in a Parallel: the welding
+  arm may drop it before the place is done). ClearStopAndBackOff is shipped by ``make_clear_stop.py`` and read here from the
   library. Whatever else fails (a collision with the welding arm, ...) is caught around
   the part: the robot lets go, clears a protective stop, backs off and feels for a part
   left at the exit (a flat part the camera cannot see); it never waits for the operator.
@@ -71,6 +73,7 @@ OVER_RACK_Z, RACK_DROP_Z = 0.32, 0.235  # TCP, rack frame: the fingertips 2 cm o
 SCRAP_XY, SCRAP_Z = (0.42, 0.5), 0.2  # over the scrap bin (taught, world): 8 cm over its rim
 REGRASP_TRIES = 1  # more tries scatter the pieces of a broken weld
 ARM_TIMEOUT = 40.0  # s: longer than the bender's longest interval (20 s + 35 %) and a cycle
+_PERIOD = fixed(0.25, ParamType.DURATION)  # four looks a second see the welding arm come and go
 # The discard races the next part (the welding arm comes down over the exit): its moves run
 # at twice the nominal speed and acceleration (2.1 rad/s; a UR5's joints allow 3.15).
 DISCARD_SPEED = 2.0
@@ -145,6 +148,33 @@ def pick_at_exit() -> SubtreeSpec:
         "Takes a part where a machine dropped it, with taught waypoints: over it, straight "
         "down, close, feel it held, lift, feel it still held (fails when it is not).",
         tree, inputs=_exit_ports(),
+    )  # fmt: skip
+
+
+def wait_for_part() -> SubtreeSpec:
+    m = _Maker("wait_for_part")
+    tree = m.node(
+        NodeKind.CATCH, "WaitForPart",
+        m.node(NodeKind.SEQUENCE, "the arm swings down and back up",
+               m.op("occupancy.wait_until_occupied", "the arm comes down", region="REGION",
+                    timeout=fixed(ARM_TIMEOUT, ParamType.DURATION), period=_PERIOD),
+               m.op("occupancy.wait_until_empty", "the arm is back up", region="REGION",
+                    period=_PERIOD)),
+        # A swing the camera missed (a busy computer) leaves a part at the exit that the
+        # camera cannot see (flat on the table): after the longest interval, feel for it.
+        m.instance(pick_at_exit(), "feel for a part that came unseen", ABOVE="ABOVE", AT="AT"),
+        errors="timeout",
+    )  # fmt: skip
+    return subtree(
+        "tending.wait_for_part", "WaitForPart",
+        "Waits until a machine that drops its parts at an exit has dropped one: its arm swings "
+        f"into REGION and back out (the camera's occupancy, four looks a second). When no "
+        f"swing is seen in {ARM_TIMEOUT:g} s (longer than the longest interval), feels for a "
+        "part at the exit with PickAtExit, so the part may then be held; fails when there is "
+        "none.",
+        tree,
+        inputs=[port("REGION", ParamType.REGION, "where the machine's arm swings down"),
+                *_exit_ports()],
     )  # fmt: skip
 
 
@@ -278,7 +308,7 @@ def clear_stop() -> SubtreeSpec:
 def library() -> dict[str, list[SubtreeSpec]]:
     """The shipped subtrees this generator writes, by library folder."""
     return {
-        "tending": [pick_at_exit(), place_on_rack()],
+        "tending": [pick_at_exit(), place_on_rack(), wait_for_part()],
         "recovery": [regrasp(), discard_to_scrap(), reregister_rack()],
     }
 
@@ -287,11 +317,17 @@ PICK_ERRORS = "failed, grasp_failed, object_lost, timeout"
 PLACE_ERRORS = "protective_stop"  # the rack moved into the way: a collision
 
 
+def _wait_for_part(m: _Maker, subs: dict[str, SubtreeSpec], wps: dict[str, Waypoint],
+                   name: str) -> NodeSpec:  # fmt: skip
+    return m.instance(subs["WaitForPart"], name, REGION=fixed(ARM_REGION, ParamType.REGION),
+                      ABOVE=_wp(wps["over exit"]), AT=_wp(wps["at exit"]))  # fmt: skip
+
+
 def _part_cycle(m: _Maker, subs: dict[str, SubtreeSpec], wps: dict[str, Waypoint]) -> NodeSpec:
-    """One part: wait for the welding arm, pick (with recovery), find the rack (a worker may
-    have moved it; the arm steps out of the camera's view anyway), place (with recovery)."""
-    region = fixed(ARM_REGION, ParamType.REGION)
-    period = fixed(0.25, ParamType.DURATION)  # four looks a second see the arm come and go
+    """One part, once the welding arm has dropped it: pick (with recovery), find the rack (a
+    worker may have moved it; the arm steps out of the camera's view anyway), then place
+    (with recovery) while watching for the next part: the arm may drop it before the place
+    is done, and a part left at the exit unseen would be buried under the one after it."""
     exit_wps = {"ABOVE": _wp(wps["over exit"]), "AT": _wp(wps["at exit"])}
     scrap = m.instance(
         subs["DiscardToScrap"], "DiscardToScrap", ABOVE=_wp(wps["over exit"]),
@@ -307,8 +343,8 @@ def _part_cycle(m: _Maker, subs: dict[str, SubtreeSpec], wps: dict[str, Waypoint
                       m.node(NodeKind.PARALLEL, "scrap it until the next part comes",
                              scrap,
                              m.op("occupancy.wait_until_occupied", "the welding arm comes",
-                                  region=region, timeout=fixed(600.0, ParamType.DURATION),
-                                  period=period),
+                                  region=fixed(ARM_REGION, ParamType.REGION),
+                                  timeout=fixed(600.0, ParamType.DURATION), period=_PERIOD),
                              success="any"))),
         errors=PICK_ERRORS, error="PICK_ERROR",
     )  # fmt: skip
@@ -327,26 +363,17 @@ def _part_cycle(m: _Maker, subs: dict[str, SubtreeSpec], wps: dict[str, Waypoint
                m.instance(subs["PlaceOnRack"], "PlaceOnRack again", **rack)),
         errors=PLACE_ERRORS, error="PLACE_ERROR",
     )  # fmt: skip
-    watch = m.node(
-        NodeKind.CATCH, "wait for the welding arm, else feel at the exit",
-        m.node(NodeKind.SEQUENCE, "the welding arm swings down and back up",
-               m.op("occupancy.wait_until_occupied", "wait for the welding arm", region=region,
-                    timeout=fixed(ARM_TIMEOUT, ParamType.DURATION), period=period),
-               m.op("occupancy.wait_until_empty", "wait until the arm is back up",
-                    region=region, period=period)),
-        # A swing the camera missed (a busy computer) leaves a part at the exit that the
-        # camera cannot see (flat on the table): after the longest interval, feel for it.
-        m.instance(subs["PickAtExit"], "feel for a part that came unseen", **exit_wps),
-        errors="timeout",
-    )  # fmt: skip
+    # The watch starts once the arm is out of view with the part (ReRegisterRack): the part
+    # carried past the welding arm's region would look like the arm.
     return m.node(
         NodeKind.SEQUENCE, "one part",
-        watch,
         m.node(NodeKind.SELECTOR, "a part in the gripper",
                m.op("gripper.is_holding", "holding it already"), pick),
         m.instance(subs["ReRegisterRack"], "where is the rack now", RACK_POSE="RACK_POSE"),
-        place,
-        m.move("step out of view", observe()),
+        m.node(NodeKind.PARALLEL, "place it, watching for the next part",
+               m.node(NodeKind.SEQUENCE, "place it and step out of view",
+                      place, m.move("step out of view", observe())),
+               _wait_for_part(m, subs, wps, "the next part comes")),
     )  # fmt: skip
 
 
@@ -363,7 +390,8 @@ def tending() -> PlanSpec:
     }
     # Whatever else went wrong (a collision with the welding arm, ...): let go, clear a
     # protective stop if there is one (at once if not) and back off; a part may have come
-    # meanwhile and lie at the exit where the camera cannot see it: feel for it.
+    # meanwhile and lie at the exit where the camera cannot see it: feel for it. Then wait
+    # for the next part, as a part's cycle ends.
     go_on = m.node(
         NodeKind.SEQUENCE, "recover and go on",
         m.op("gripper.open", "let go"),
@@ -374,10 +402,15 @@ def tending() -> PlanSpec:
                       m.instance(subs["ReRegisterRack"], "where is the rack", RACK_POSE="RACK_POSE"),
                       m.instance(subs["PlaceOnRack"], "PlaceOnRack", **rack),
                       m.move("step out of view", observe()))),
+        _wait_for_part(m, subs, wps, "then the next part comes"),
     )  # fmt: skip
+    # Each part's cycle begins once its part has come (the first one's here) and ends when
+    # the next one has; after a collision while recovering, it begins at once (the arm
+    # came down on the robot at the exit: its part has come).
     tree = m.node(
         NodeKind.SEQUENCE, "tend the wire bender",
         m.instance(subs["ReRegisterRack"], "find the rack", RACK_POSE="RACK_POSE"),
+        _wait_for_part(m, subs, wps, "the first part comes"),
         m.node(NodeKind.ITERATOR, "every part",
                m.node(NodeKind.FORCE_SUCCESS, "never stop",
                       m.node(NodeKind.CATCH, "a collision while recovering",
@@ -393,8 +426,9 @@ def tending() -> PlanSpec:
         tree, "Wire-bender tending with recovery (section V-B, simulated cell)",
         "The paper's wire-bender task composed from the shipped library, with recovery instead "
         "of the operator: the rack is found by its marker; for each part the robot waits until "
-        "the bender's welding arm swings into an occupancy region and back out, picks the "
-        "wireform at the exit (PickAtExit) and drops it into the rack's tote (PlaceOnRack). A "
+        "the bender's welding arm swings into an occupancy region and back out (WaitForPart), "
+        "picks the wireform at the exit (PickAtExit) and drops it into the rack's tote "
+        "(PlaceOnRack) while it watches for the next part. A "
         "failed pick goes to Regrasp (a slipped grasp) and, when that gives up, to "
         "DiscardToScrap (a broken weld: its pieces go to the scrap bin); a collision while "
         "placing (the rack moved into the way) to ClearStopAndBackOff, ReRegisterRack and a "

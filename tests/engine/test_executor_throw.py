@@ -13,7 +13,9 @@ from engine.context import TreeContext
 from engine.error_types import ErrorType
 from engine.events import LogMessage, RunHeld
 from engine.executor import Executor
-from engine.hold import Hold, catchers
+from engine.hold import Hold, catchers, stopped_leaves
+from engine.leaves import OperationLeaf
+from engine.operations import OperationKind
 from engine.status import FAILURE, RUNNING, SUCCESS
 
 STOP = Hold("protective stop", ErrorType.PROTECTIVE_STOP)
@@ -90,6 +92,32 @@ def test_a_stop_is_held_when_one_running_leaf_has_no_catch() -> None:
     assert wait_until(lambda: executor.held == "protective stop")
     executor.stop()
     assert executor.wait(5.0) is not None
+
+
+def test_a_stop_spares_the_leaves_of_the_capabilities_that_only_look() -> None:
+    """A camera's watch beside a caught move (a Parallel): the stop is thrown into the move
+    only; the watch has no Catch of its own and goes on, and finishes the run."""
+    ctx = TreeContext()
+    catch, move, handler = caught_move(ctx, {ErrorType.PROTECTIVE_STOP})
+    watch = JobOperation()
+    seeing = OperationLeaf(ctx, "watch", "watch", OperationKind.ACTION, watch,
+                           capability="occupancy")  # fmt: skip
+    both = with_children(Parallel(ctx, "both"), [catch, seeing])
+    tree = rooted(ctx, both)
+    hold: list[Hold | None] = [None]
+    executor = Executor(tree, rate_hz=200.0, hold=lambda: hold[0])
+    executor.start()
+    assert move.started.wait(5.0) and watch.started.wait(5.0)
+    hold[0] = Hold("protective stop", ErrorType.PROTECTIVE_STOP, frozenset({"occupancy"}))
+    assert handler.started.wait(5.0)
+    assert executor.held == "" and tree.nodes["watch"].status is RUNNING
+    assert stopped_leaves([tree.nodes["move"], seeing], hold[0]) == [tree.nodes["move"]]
+    assert watch.jobs[0].cancels == 0  # its work goes on
+    hold[0] = None
+    handler.job.succeed()
+    watch.job.succeed()
+    result = executor.wait(5.0)
+    assert result is not None and result.status is SUCCESS
 
 
 def test_a_new_stop_while_the_handler_runs_holds_the_run() -> None:

@@ -162,20 +162,27 @@ def test_the_welding_arm_pushing_the_waiting_robot_is_thrown_into_the_catch(
     scene = tmp_path / "tending_two.json"
     scene.write_text(json.dumps(data), encoding="utf-8")
     no_faults = FaultModel(bad_weld=0.0, bad_grasp=0.0)
-    with SimCellSession(scene, seed=5, faults=no_faults) as session:  # the UR's 5 s delay
+    wait = NodeSpec(NodeKind.WAIT, "wait at the exit", "wait", params={
+        "seconds": Binding.fixed(60.0, ParamType.DURATION),
+    })  # fmt: skip
+    # Real time: the robot reaches the exit 2.6 s before the arm comes down, and the Wait must
+    # be running by then; as fast as possible, starting the run could take longer than that.
+    with SimCellSession(scene, seed=5, speed=1.0, faults=no_faults) as session:  # 5 s delay
         bender = session.bender
         assert bender is not None
         first, second = bender.release_times()
+        events: list[Event] = []
+        plan = caught(wait, "in the way")
+        registry = CapabilityRegistry(cell=session)
+        tree = build_tree(plan, registry, clock=session.clock)
+        executor = Executor(tree, 50.0, [events.append], plan.name, hold=hold_check(session))
         session.sim.wait_sim(first + 0.8 - session.clock())
         part = bender.produced()[0].part
         pose, grasp = session.truth_pose(part), session.scene.model(part).grasp()
         run(session.sim.robot.move_pose_joint_space(pose.compose(grasp.approach)))
         run(session.sim.robot.move_linear(pose.compose(grasp.pose)))  # at the exit
-        wait = NodeSpec(NodeKind.WAIT, "wait at the exit", "wait", params={
-            "seconds": Binding.fixed(60.0, ParamType.DURATION),
-        })  # fmt: skip
-        events: list[Event] = []
-        executor = start(session, caught(wait, "in the way"), events)
+        assert session.clock() < second - bender.spec.swing  # before the arm comes down
+        executor.start()
         result = executor.wait(120.0)
         assert result is not None and result.status is Status.SUCCESS, result
         assert session.clock() > second - bender.spec.swing  # the arm came down on it

@@ -157,7 +157,7 @@ def test_a_rack_moved_while_the_robot_picks_is_found_again(tmp_path: Path) -> No
         counters, trial = _trial(session)
         moved = session.truth_pose("rack")
         assert math.dist(before.position, moved.position) > 0.17  # out of the old tote
-        assert _where(session, "part_001") == "caught"
+        assert _where(session, "part_001") == "caught", (trial.failures, trial.lost())
         assert counters.caught == 1 and trial.calls == []
 
 
