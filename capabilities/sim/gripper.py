@@ -13,6 +13,8 @@ on a part lying askew trembles in its contacts but gets no further), and no comm
 
 from __future__ import annotations
 
+import contextlib
+
 from capabilities.bullet import pybullet
 from capabilities.sim.commands import CommandHandle
 from capabilities.sim.physics_thread import PhysicsThread
@@ -44,6 +46,7 @@ class GripperController:
         self.gap = 2 * OPEN_POSITION
         self.attached: int | None = None
         self._constraint: int | None = None
+        self._passing: int | None = None  # a body the fingers do not collide with (held)
         self._handle: CommandHandle | None = None
         self._elapsed = 0.0
         self._mark: tuple[float, float, float] = (0.0, OPEN_POSITION, OPEN_POSITION)
@@ -78,6 +81,7 @@ class GripperController:
         if self._constraint is not None:
             detach(self._client, self._constraint)
         self._constraint, self.attached = None, None
+        self._collide_again()
 
     def pre_step(self, _t: float) -> None:
         """Forget a hold that is gone; attach an object both closing fingers touch.
@@ -86,6 +90,7 @@ class GripperController:
         fingers then close on, but grasp anew only during a close command."""
         if self._constraint is not None and not self._hold_exists():
             self._constraint, self.attached = None, None
+            self._collide_again()
             if self.closed:
                 self._drive(0.0)  # nothing left between them: they close on, as a real one's
         if self.closed and self._handle is not None and self.attached is None:
@@ -125,9 +130,31 @@ class GripperController:
             # and in the end past it, so what they held depended on when the next command came.
             for finger, position in zip(self._fingers, self._positions(), strict=True):
                 self._drive(position, (finger,))
+            # And no longer collide with it: fixed to the gripper, it cannot give way, and the
+            # contacts of fingers sunk into it (12 -> 5 mm on an 8 mm wire) pushed them about
+            # until they crept past it and dropped it on the way (a broken weld's piece).
+            self._pass_through(self.attached)
         handle, self._handle = self._handle, None
         if handle is not None:
             handle.resolve(True, f"gap {self.gap * 1000:.1f} mm after {self._elapsed:.2f} s{note}")
+
+    def _pass_through(self, body: int) -> None:
+        self._set_collision(body, False)
+        self._passing = body
+
+    def _collide_again(self) -> None:
+        """The fingers collide with what they held again (once it is let go or gone)."""
+        body, self._passing = self._passing, None
+        if body is not None:
+            # It may be gone from the world (a broken weld's part, taken out of the cell).
+            with contextlib.suppress(pybullet.error):
+                self._set_collision(body, True)
+
+    def _set_collision(self, body: int, collide: bool) -> None:
+        for finger in self._fingers:
+            pybullet.setCollisionFilterPair(
+                self._robot, body, finger, -1, int(collide), physicsClientId=self._client
+            )
 
     def _positions(self) -> tuple[float, float]:
         states = pybullet.getJointStates(self._robot, self._fingers, physicsClientId=self._client)
