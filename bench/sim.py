@@ -10,6 +10,11 @@ Figures (all with ``speed=None``, as fast as the machine goes):
 - ``start_s``: wall time to build the cell;
 - ``camera_fps_320x240`` / ``camera_fps_640x480``: shoulder camera frames per wall second
   (render + depth conversion), in a client of their own;
+- ``python_work_ms_*``: wall ms of a perception-like Python workload (many small numpy
+  calls, each dropping the GIL for a moment) with the world standing still (``alone``),
+  beside the world stepping as fast as it can inside ``SimCell.sharing`` as a session's
+  worker pool runs perception (``shared``), and beside it without (``unshared``); the
+  ratios are each against ``alone`` in the same run;
 - ``cup_to_bin_rtf``: real-time factor of a headless run of the paper's Figure 3 plan
   (resources/examples/cup_to_bin.costar.json) through the engine on the simulated cell.
 
@@ -88,6 +93,34 @@ def measure_cameras(cell: SimCell) -> dict[str, Any]:
     }
 
 
+def _python_work_ms() -> float:
+    """Wall ms of a workload shaped like perception: thousands of small numpy calls."""
+    import numpy as np
+
+    points = np.random.default_rng(0).random((2000, 3))
+    started = time.perf_counter()
+    for _ in range(3000):
+        points = points @ np.eye(3) + 1e-9
+        float(np.linalg.norm(points[:10]))
+    return (time.perf_counter() - started) * 1000
+
+
+def measure_python_beside_the_world(cell: SimCell) -> dict[str, Any]:
+    """A perception-like workload with the world still, and beside it shared or not."""
+    with cell.standing_still():
+        alone = _python_work_ms()
+    with cell.sharing():
+        shared = _python_work_ms()
+    unshared = _python_work_ms()
+    return {
+        "python_work_ms_alone": round(alone, 1),
+        "python_work_ms_shared": round(shared, 1),
+        "python_work_ms_unshared": round(unshared, 1),
+        "python_work_shared_ratio": round(shared / alone, 2),
+        "python_work_unshared_ratio": round(unshared / alone, 2),
+    }
+
+
 def measure_cup_to_bin(seed: int = 0) -> dict[str, Any]:
     """Real-time factor of the cup-to-bin plan run by the engine on a fresh simulated cell."""
 
@@ -115,7 +148,13 @@ def measure_cup_to_bin(seed: int = 0) -> dict[str, Any]:
 
 def measurements() -> list[Measurement]:
     """The measurements run, in order, on one cell. Extend this list to add figures."""
-    return [measure_idle_steps, measure_moving_steps, measure_pick_place, measure_cameras]
+    return [
+        measure_idle_steps,
+        measure_moving_steps,
+        measure_pick_place,
+        measure_cameras,
+        measure_python_beside_the_world,
+    ]
 
 
 def main(argv: list[str] | None = None) -> int:

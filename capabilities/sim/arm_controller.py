@@ -29,13 +29,14 @@ from capabilities.sim.trajectory import (
 )
 from capabilities.sim.transforms import rotation_angle
 
-__all__ = ["ArmController"]
+__all__ = ["ArmController", "MOVING_SPEED"]
 
 Trajectory = JointTrajectory | CartesianTrajectory
 _FORCES = (330.0, 330.0, 150.0, 56.0, 56.0, 56.0)  # 2x the UR5's rated joint torques (N m)
 _POSITION_GAIN = 0.6
 _VELOCITY_GAIN = 1.0
 _SETTLED_RAD = 5e-5
+MOVING_SPEED = 1e-3  # rad/s: slower joints count as standing still (a move ends only then)
 _SETTLE_TIMEOUT = 0.5  # s after the trajectory ends
 _MAX_STOP_TIME = 0.15  # s: a stop always completes well within 0.2 s
 _TOL_M = 1e-3
@@ -275,7 +276,8 @@ class ArmController:
     def _settle(self, motion: _Motion) -> None:
         motion.settle += self._dt
         error = float(np.max(np.abs(np.asarray(self.q_actual) - self.q_cmd)))
-        if error < _SETTLED_RAD:
+        # Ended as a UR's moves end: on the target and standing still.
+        if error < _SETTLED_RAD and max(abs(v) for v in self.qd_actual) < MOVING_SPEED:
             self._finish_motion(True, "reached")
         elif motion.settle >= _SETTLE_TIMEOUT:
             self._finish_motion(*self._arrival_check())

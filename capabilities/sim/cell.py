@@ -48,9 +48,18 @@ class SimCell:
         robot, gripper, suction: the devices.
         ground_truth: exact world state, for tests and scores only.
         robot_body_id, table_top_z, world: for the scene and camera helpers.
+
+    Args:
+        config: the cell's configuration (default: the shipped simulated cell).
+        speed: real-time factor; None steps as fast as it can.
+        driven: step only while a command runs or a thread waits for simulated time
+            (``PhysicsThread.waited_on``): what happens no longer depends on how long the
+            thread that drives the cell takes between two commands (tests).
     """
 
-    def __init__(self, config: CellConfig | None = None, speed: float | None = None) -> None:
+    def __init__(
+        self, config: CellConfig | None = None, speed: float | None = None, driven: bool = False
+    ) -> None:
         if config is None:
             config = (
                 CellConfig.load(DEFAULT_CONFIG_PATH)
@@ -60,6 +69,8 @@ class SimCell:
         self.config = config
         self.kinematics = UR5Kinematics(config.robot_base)
         self._physics = PhysicsThread(self._build, speed, TIME_STEP)
+        if driven:
+            self._physics.add_gate(self._physics.waited_on)
         self._tcp_matrices = {k: pose_to_matrix(v) for k, v in config.tcp_offsets.items()}
         self._world: World | None = None
         self._arm: ArmController | None = None
@@ -140,6 +151,11 @@ class SimCell:
     def standing_still(self) -> AbstractContextManager[None]:
         """A block in which simulated time stands still (see ``PhysicsThread``)."""
         return self._physics.standing_still()
+
+    def sharing(self) -> AbstractContextManager[None]:
+        """A block in which another thread computes: the world shares the GIL with it every
+        step (see ``PhysicsThread.sharing``)."""
+        return self._physics.sharing()
 
     @contextmanager
     def perceiving(self, latency: float) -> Iterator[None]:

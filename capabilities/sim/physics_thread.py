@@ -4,13 +4,16 @@ Every other thread talks to pybullet through ``call`` (run a function here and g
 result) or ``post`` (fire and forget). Step hooks registered by the cell's controllers run
 before each ``stepSimulation`` (control) and after it (sensing). Simulated time advances by
 ``time_step`` per step; with a speed factor the loop is paced against the wall clock,
-without one it runs as fast as it can. Inside :meth:`PhysicsThread.standing_still` (lockstep:
+without one it runs as fast as it can, handing the GIL to other threads every
+``_YIELD_S`` of stepping, or every step inside :meth:`PhysicsThread.sharing` (another thread
+computes in Python: perception). Inside :meth:`PhysicsThread.standing_still` (lockstep:
 perception computing on another thread) the world is not stepped and simulated time stands
 still, as it already does while a call (a camera render) is served.
 """
 
 from __future__ import annotations
 
+import contextlib
 import heapq
 import itertools
 import logging
@@ -23,6 +26,7 @@ from contextlib import contextmanager
 from typing import Any, TypeVar
 
 from capabilities.bullet import pybullet
+from capabilities.sim.commands import CommandHandle
 from capabilities.sim.errors import SimError
 
 __all__ = ["PhysicsThread", "StepHook"]
@@ -30,6 +34,10 @@ __all__ = ["PhysicsThread", "StepHook"]
 T = TypeVar("T")
 StepHook = Callable[[float], None]
 _log = logging.getLogger(__name__)
+# Wall seconds of stepping between two hand-overs of the GIL when no thread said it computes.
+# pybullet steps without releasing the GIL and a hand-over (time.sleep(0)) costs a system
+# call (~55 us on a VM), so it is not done every step unless another thread asks for it.
+_YIELD_S = 0.001
 
 
 class PhysicsThread:
@@ -66,6 +74,8 @@ class PhysicsThread:
         self._timer_lock = threading.Lock()
         self._holds = 0  # blocks in standing_still: while above 0 the world is not stepped
         self._hold_lock = threading.Lock()
+        self._sharers = 0  # blocks in sharing: while above 0 the GIL is handed over every step
+        self._in_flight = 0  # commands posted and not finished (see waited_on)
         self._gates: list[Callable[[], bool]] = []  # all must say True for a step
         self._ready = threading.Event()
         self._stopping = threading.Event()
@@ -156,17 +166,53 @@ class PhysicsThread:
         with self._hold_lock:
             self._holds += 1
         try:
+            # A step already under way when the hold began would still advance the clock
+            # inside the block: a call served after it means the loop has seen the hold.
+            if self.running:
+                with contextlib.suppress(SimError):
+                    self.call(lambda _client: None)
             yield
         finally:
             with self._hold_lock:
                 self._holds -= 1
             self.nudge()  # wake a loop waiting on calls
 
+    @contextmanager
+    def sharing(self) -> Iterator[None]:
+        """Another thread computes in Python inside this block (perception): the loop hands
+        it the GIL after every step meanwhile. Without it, a thread that dropped the GIL for a
+        moment (a numpy call) waited for the interpreter's switch interval (5 ms) to get it
+        back: a look that takes 1 s alone took 25 s beside a cell stepping as fast as it can."""
+        with self._hold_lock:
+            self._sharers += 1
+        try:
+            yield
+        finally:
+            with self._hold_lock:
+                self._sharers -= 1
+
     def add_gate(self, may_step: Callable[[], bool]) -> None:
         """Step the world only while ``may_step()`` (any thread's state; keep it cheap) says
         True: lockstep with another loop, e.g. an engine that must not fall behind. Whoever
         changes what the gate reads calls :meth:`nudge`."""
         self._gates.append(may_step)
+
+    def track(self, handle: CommandHandle) -> None:
+        """Count ``handle`` as a command in flight until it finishes (see :meth:`waited_on`)."""
+        with self._hold_lock:
+            self._in_flight += 1
+
+        def finished(_handle: CommandHandle) -> None:
+            with self._hold_lock:
+                self._in_flight -= 1
+
+        handle.add_done_callback(finished)
+
+    def waited_on(self) -> bool:
+        """True while a command is in flight or a thread waits for simulated time: as a gate,
+        the world steps only then (a driven cell: each command starts at the step after the
+        one the last ended in, however long its sender took to send it)."""
+        return self._in_flight > 0 or bool(self._timers)
 
     def nudge(self) -> None:
         """Wake a loop that stands still, to look at its gates again (any thread)."""
@@ -196,6 +242,7 @@ class PhysicsThread:
     def _loop(self) -> None:
         wall_start = time.perf_counter()
         sim_start = self._time
+        yielded = wall_start
         while not self._stopping.is_set():
             self._drain()
             if self._holds or not all(gate() for gate in self._gates):
@@ -210,8 +257,11 @@ class PhysicsThread:
                 ahead = (self._time - sim_start) / self.speed - wall
                 if ahead > 0.002:
                     self._idle(ahead)
-            elif self.steps % 64 == 0:
-                time.sleep(0)  # let other Python threads have the GIL now and then
+            else:
+                now = time.perf_counter()
+                if self._sharers or now - yielded > _YIELD_S:
+                    time.sleep(0)  # let other Python threads have the GIL
+                    yielded = now
 
     def _stand_still(self) -> None:
         """Serve calls without stepping while a block holds time (wall time not simulated)."""

@@ -13,7 +13,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from capabilities.sim.arm_controller import ArmController
+from capabilities.sim.arm_controller import MOVING_SPEED, ArmController
 from capabilities.sim.commands import CommandHandle
 from capabilities.sim.errors import SimError
 from capabilities.sim.kinematics import UR5Kinematics
@@ -23,8 +23,6 @@ from capabilities.sim.transforms import pose_text_mm, pose_to_matrix
 from engine.types import Pose
 
 __all__ = ["SimRobot", "post_command"]
-
-_MOVING_SPEED = 1e-3  # rad/s: slower joints count as standing still
 
 
 class SimRobot:
@@ -84,7 +82,7 @@ class SimRobot:
 
     def is_moving(self) -> bool:
         """True while a move runs or any joint still turns."""
-        return self._ctl.busy or max(abs(v) for v in self._ctl.qd_actual) > _MOVING_SPEED
+        return self._ctl.busy or max(abs(v) for v in self._ctl.qd_actual) > MOVING_SPEED
 
     def home_joints(self) -> tuple[float, ...]:
         """The configured home joints."""
@@ -239,6 +237,7 @@ def post_command(
         except Exception as exc:
             handle.resolve(False, f"{handle.name} failed: {exc}")
 
+    physics.track(handle)
     future = physics.post(run)
     if future.done() and future.exception() is not None:
         handle.resolve(False, f"{handle.name} failed: {future.exception()}")

@@ -170,7 +170,9 @@ class SimCellSession:
         self.sim = SimCell(config, speed)
         self.world_model = WorldModel()
         latency = lockstep
-        around = None if latency is None else (lambda: self.sim.perceiving(latency))
+        # Perception computes while the world stands still (lockstep) or shares the GIL
+        # with it every step (else it crawls beside a cell that steps as fast as it can).
+        around = self.sim.sharing if latency is None else (lambda: self.sim.perceiving(latency))
         self.workers = WorkerPool(2, "costar-sim-worker", around)
         self.operator = OperatorConsole()
         self.worker: SimWorker | None = None  # the simulated person, if the scene has one

@@ -11,6 +11,7 @@ from collections.abc import Iterator
 import pytest
 
 from capabilities.jobs import WorkerPool
+from capabilities.sim.commands import CommandHandle
 from capabilities.sim.errors import SimError
 from capabilities.sim.physics_thread import PhysicsThread
 from capabilities.sim.session import SimCellSession
@@ -86,12 +87,13 @@ def test_the_physics_thread_cannot_hold_itself(physics: PhysicsThread) -> None:
 
 def test_a_closed_gate_stops_the_world_until_it_opens_and_nudges(physics: PhysicsThread) -> None:
     """A follower (the engine) that falls behind holds the world; its tick opens it again."""
-    engine_at = [physics.time()]
-    physics.add_gate(lambda: physics.time() - engine_at[0] <= 0.05)
+    with physics.standing_still():  # the world must not run ahead before the gate is there
+        engine_at = [physics.time()]
+        physics.add_gate(lambda: physics.time() - engine_at[0] <= 0.05)
     assert physics.wait_sim(0.04, timeout=10.0)
     time.sleep(0.2)
     stopped = physics.time()
-    assert stopped - engine_at[0] <= 0.05 + physics.time_step
+    assert stopped - engine_at[0] <= 0.05 + physics.time_step + 1e-9  # one step past, at most
     time.sleep(0.1)
     assert physics.time() == stopped  # the engine did not tick: the world waits
     engine_at[0] = stopped
@@ -118,3 +120,38 @@ def test_a_lockstep_session_charges_each_perception_job_its_simulated_time() -> 
         assert job.poll() is SUCCESS
         assert seen[0] == seen[1]
         assert session.clock() >= seen[0] + 0.5
+
+
+def test_a_driven_world_steps_only_while_a_command_runs_or_someone_waits(
+    physics: PhysicsThread,
+) -> None:
+    """The gate of a driven cell: nothing happens between two commands of a slow sender."""
+    physics.add_gate(physics.waited_on)
+    physics.nudge()
+    time.sleep(0.1)  # whatever ran before the gate: from here on the world waits
+    held = physics.time()
+    time.sleep(0.2)
+    assert physics.time() == held
+    handle = CommandHandle("three steps")
+    physics.track(handle)
+    ended_at: list[float] = []
+
+    def count(now: float) -> None:
+        if not handle.done() and now >= held + 3 * physics.time_step - 1e-9:
+            ended_at.append(now)
+            handle.resolve(True)
+
+    physics.add_hooks(post=count)
+    physics.nudge()
+    assert handle.wait(10.0)
+    time.sleep(0.2)
+    assert physics.time() == ended_at[0]  # not one step past the step the command ended in
+    assert physics.wait_sim(0.1, timeout=10.0)  # a waiter drives it too
+    time.sleep(0.1)
+    assert abs(physics.time() - (ended_at[0] + 0.1)) <= physics.time_step + 1e-9
+
+
+def test_a_shared_block_lets_the_world_go_on(physics: PhysicsThread) -> None:
+    """Unlike standing still, sharing the GIL does not stop simulated time."""
+    with physics.sharing():
+        assert physics.wait_sim(0.05, timeout=10.0)
