@@ -4,7 +4,7 @@ A cell that can stop on its own gives the executor a hold check that answers a
 :class:`Hold` (why in words, and the error type a Catch node matches) or None. When a stop
 begins, the executor asks :func:`catchers`: if every running leaf the stop concerns
 (:func:`stopped_leaves`: not those of the capabilities it spares, such as a camera's watch,
-which goes on seeing while the arm stands) sits in the body of a Catch that takes the stop's
+which goes on seeing while the arm stands, unless only they run) sits in the body of a Catch that takes the stop's
 error type, the stop is *thrown*: those leaves fail with it (:func:`throw`) and each Catch's
 handler runs, as Rethink Intera throws a collision during a move to the tree. Otherwise the
 run is held until the cell is clear, as on a UR's pendant.
@@ -41,10 +41,14 @@ HoldCheck = Callable[[], Hold | None]
 
 
 def stopped_leaves(leaves: list[Node], hold: Hold) -> list[Node]:
-    """The running ``leaves`` the stop concerns: all but the operations of spared capabilities."""
+    """The running ``leaves`` the stop concerns: all but the operations of spared capabilities,
+    unless nothing else runs. A robot stopped while the plan only watches was hit where it
+    stood (a machine's arm came down on it): the watch is what the plan is doing then, so a
+    Catch around it must hear of the stop, or the run stays held with the robot in the way."""
     if not hold.spares:
         return leaves
-    return [leaf for leaf in leaves if getattr(leaf, "capability", "") not in hold.spares]
+    concerned = [leaf for leaf in leaves if getattr(leaf, "capability", "") not in hold.spares]
+    return concerned or leaves
 
 
 def _catcher(leaf: Node, error: ErrorType) -> Catch | None:

@@ -400,8 +400,9 @@ def tending() -> PlanSpec:
     }
     # Whatever else went wrong (a collision with the welding arm, ...): let go, clear a
     # protective stop if there is one (at once if not) and back off; a part may have come
-    # meanwhile and lie at the exit where the camera cannot see it: feel for it. Then wait
-    # for the next part, as a part's cycle ends.
+    # meanwhile and lie at the exit where the camera cannot see it: feel for it. Then, out of
+    # the welding arm's way whether there was one or not (a robot left over the exit waited
+    # there for the arm to come down on it), wait for the next part, as a part's cycle ends.
     go_on = m.node(
         NodeKind.SEQUENCE, "recover and go on",
         m.op("gripper.open", "let go"),
@@ -410,8 +411,8 @@ def tending() -> PlanSpec:
                m.node(NodeKind.SEQUENCE, "take it to the rack",
                       m.instance(subs["PickAtExit"], "feel for a part at the exit", **exit_wps),
                       m.instance(subs["ReRegisterRack"], "where is the rack", RACK_POSE="RACK_POSE"),
-                      m.instance(subs["PlaceOnRack"], "PlaceOnRack", **rack),
-                      m.move("step out of view", observe()))),
+                      m.instance(subs["PlaceOnRack"], "PlaceOnRack", **rack))),
+        m.move("step out of view", observe()),
         _wait_for_part(m, subs, wps, "then the next part comes"),
     )  # fmt: skip
     # Each part's cycle begins once its part has come (the first one's here) and ends when

@@ -172,3 +172,29 @@ def test_a_node_that_failed_with_the_stop_first_is_not_held_while_its_handler_ru
     handler.job.succeed()
     result = executor.wait(5.0)
     assert result is not None and result.status is SUCCESS
+
+
+def test_a_stop_while_the_plan_only_watches_is_thrown_into_the_watch() -> None:
+    """Nothing but a camera's watch runs when the robot is hit where it stands (a machine's
+    arm came down on it): the Catch around the watch gets the stop and its handler moves the
+    robot away, instead of a run held with the robot in the way."""
+    ctx = TreeContext()
+    watch, handler = JobOperation(), JobOperation()
+    seeing = OperationLeaf(ctx, "watch", "watch", OperationKind.ACTION, watch,
+                           capability="occupancy")  # fmt: skip
+    catch = Catch(ctx, "catch", "catch", {ErrorType.PROTECTIVE_STOP}, "WHY")
+    with_children(catch, [seeing, leaf(ctx, handler, "back off")])
+    tree = rooted(ctx, catch)
+    hold: list[Hold | None] = [None]
+    executor = Executor(tree, rate_hz=200.0, hold=lambda: hold[0])
+    executor.start()
+    assert watch.started.wait(5.0)
+    stop = Hold("protective stop", ErrorType.PROTECTIVE_STOP, frozenset({"occupancy"}))
+    assert stopped_leaves([seeing], stop) == [seeing]
+    hold[0] = stop
+    assert handler.started.wait(5.0)
+    assert executor.held == "" and tree.nodes["watch"].status is FAILURE
+    hold[0] = None
+    handler.job.succeed()
+    result = executor.wait(5.0)
+    assert result is not None and result.status is SUCCESS
