@@ -31,7 +31,7 @@ from capabilities.camera_sources import open_source
 from capabilities.cell_robot import TCP_OF_TOOL
 from capabilities.collaboration.console import OperatorConsole
 from capabilities.collaboration.inputs import DigitalInputButton
-from capabilities.faults import CellStatus
+from capabilities.faults import CONNECTION_LOST, CellStatus
 from capabilities.jobs import WorkerPool
 from capabilities.object_library import ObjectLibrary
 from capabilities.sim.config import CellConfig
@@ -163,7 +163,7 @@ class URCellSession:
         until the arm runs again: between the unlock of a protective stop and the control
         script's upload it still reads "protective stop" (not a new fault of its own).
         """
-        reason = fault_reason(self.connection.state)
+        reason = self.connection.fault()
         if reason == NO_SCRIPT and self._recovery.clearing:
             return self._recovery.clearing
         return reason
@@ -185,16 +185,16 @@ class URCellSession:
 
     def status(self) -> CellStatus:
         """The robot's state for the toolbar (a snapshot; never blocks)."""
-        state = self.connection.state
-        if not state.connected:
-            return CellStatus(False, "DISCONNECTED", "-", "-", fault_reason(state))
+        state, fault = self.connection.state, self.connection.fault()
+        if not state.connected or fault.startswith(CONNECTION_LOST):
+            return CellStatus(False, "DISCONNECTED", "-", "-", fault)
         return CellStatus(
             True,
             RobotMode(state.robot_mode).name,
             SafetyMode(state.safety_mode).name,
             "PLAYING" if state.program_running else "STOPPED",
-            fault_reason(state),
-            RESTART_SCRIPT if fault_reason(state) == NO_SCRIPT else "",
+            fault,
+            RESTART_SCRIPT if fault == NO_SCRIPT else "",
         )
 
     # ---------------------------------------------------------------- lifetime

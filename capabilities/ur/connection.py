@@ -27,6 +27,9 @@ _log = logging.getLogger(__name__)
 T = TypeVar("T")
 _EMERGENCY = (SafetyMode.ROBOT_EMERGENCY_STOP, SafetyMode.SYSTEM_EMERGENCY_STOP)
 _MOVING_SPEED = 1e-3  # rad/s
+# s without a fresh state before the controller's silence is a lost connection: the I/O thread
+# can sit inside a ur_rtde call (a move's send) for good when the controller dies under it.
+SILENCE_S = 3.0
 NO_SCRIPT = "the control script is not running on the controller"
 
 
@@ -173,6 +176,17 @@ class URConnection:
         """(I/O thread only) Poll ``monitor(self)`` every cycle until it returns True."""
         self._monitors.append(monitor)
 
+    def fault(self) -> str:
+        """Why the robot cannot move now ("" when it can): :func:`fault_reason` of the last
+        state, or a lost connection when that state, with no fault in it, is older than
+        ``SILENCE_S`` (the I/O thread has not heard from the controller since). Any thread."""
+        state = self.state
+        reason = fault_reason(state)
+        silent = time.monotonic() - state.stamp
+        if reason or silent <= SILENCE_S:
+            return reason
+        return f"{CONNECTION_LOST} (no word from the controller for {silent:.0f} s)"
+
     def call(self, fn: Callable[[], T], timeout: float = 10.0) -> T:
         """Run ``fn()`` on the I/O thread and wait for it (never from the engine thread)."""
         return self.submit(fn).result(timeout)
@@ -229,6 +243,7 @@ class URConnection:
             deadline = time.monotonic() + 5.0
             while not self.control.isProgramRunning() and time.monotonic() < deadline:
                 time.sleep(0.01)
+                self.refresh()
         if any(self._tcp):
             self.control.setTcp(self._tcp)
         if self._payload is not None and self._payload[0] > 0:

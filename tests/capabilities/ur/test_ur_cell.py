@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import io
 import json
+import threading
 from pathlib import Path
 
 import dashboard_client
@@ -20,6 +21,7 @@ from capabilities.cells import CellError, open_cell
 from capabilities.cli import main
 from capabilities.faults import hold_check
 from capabilities.sim.config import DEFAULT_CONFIG_PATH, CellConfig, CellConfigError
+from capabilities.ur.connection import SILENCE_S
 from engine.build import build_tree
 from engine.events import Event, RunHeld, StatusChanged
 from engine.executor import Executor
@@ -312,6 +314,33 @@ def test_a_dropped_connection_holds_the_run_and_it_goes_on_once_reconnected(
     reasons = [e.reason for e in events if isinstance(e, RunHeld)]
     assert reasons[-1] == "" and any(r.startswith("connection lost") for r in reasons)
     assert emulator.state()["q"] == pytest.approx(list(_joints(-0.6)), abs=0.01)
+
+
+@pytest.mark.sim
+def test_a_controller_not_heard_from_holds_the_run_until_it_answers_again(
+    tmp_path: Path, start_emulator
+) -> None:
+    """The I/O thread stuck in a ur_rtde call (as in a move's send when the controller dies
+    under it): its last state says all is well, but it is old: the run holds, and goes on
+    once the thread reads the controller again."""
+    cell_file = tmp_path / "emulated.cell.json"
+    start_emulator("5.12", write_cell=cell_file)
+    plan, _ = _plan(tmp_path, (0.3,), speed=0.5)
+    events: list[Event] = []
+    with open_cell(str(cell_file)) as cell:
+        release = threading.Event()
+        stuck = cell.connection.submit(lambda: release.wait(SILENCE_S + 20))
+        executor = _run(cell, plan, events)
+        assert wait_for(lambda: executor.held.startswith("connection lost"), SILENCE_S + 10), (
+            executor.held
+        )
+        assert "no word from the controller" in cell.status().problem
+        assert not cell.status().connected
+        release.set()
+        stuck.result(5)
+        result = executor.wait(60)
+        assert result is not None and result.status is SUCCESS, (result, executor.held)
+    assert [e.reason for e in events if isinstance(e, RunHeld)][-1] == ""
 
 
 @pytest.mark.sim
