@@ -84,6 +84,16 @@ def test_catches_route_the_pick_and_the_place_to_their_recovery() -> None:
     assert str(place.params["errors"].value) == "protective_stop"
     outer = catches["part, whatever happens"]
     assert str(outer.params["errors"].value) == "any"
-    assert "ClearStopAndBackOff" in _instances(outer.children[1])
+    go_on = outer.children[1]
+    assert [c.name for c in go_on.children[:3]] == [
+        "ClearStopAndBackOff", "what is held, into the scrap bin", "let go"
+    ]  # a piece on its way to the scrap bin goes there before the gripper opens
+    # A part felt at the exit is let go for the next cycle's pick (and its recovery), not
+    # taken to the rack here, where a broken weld had no recovery.
+    either = go_on.children[3]
+    assert either.kind is NodeKind.SELECTOR and "PickAtExit" not in _instances(go_on)
+    assert [n.op for _, n in either.children[0].walk()][-2:] == [
+        "gripper.is_holding", "gripper.open"
+    ]  # fmt: skip
     operator_ops = [n for _, n in plan.walk() if (n.op or "").startswith("collaboration.")]
     assert operator_ops == []  # never waits for the operator
