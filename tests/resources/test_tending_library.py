@@ -86,7 +86,9 @@ def test_catches_route_the_pick_and_the_place_to_their_recovery() -> None:
     assert str(outer.params["errors"].value) == "any"
     go_on = outer.children[1]
     assert [c.name for c in go_on.children[:3]] == [
-        "ClearStopAndBackOff", "what is held, into the scrap bin", "let go"
+        "ClearStopAndBackOff",
+        "what is held, into the scrap bin",
+        "let go",
     ]  # a piece on its way to the scrap bin goes there before the gripper opens
     # A part felt at the exit is let go for the next cycle's pick (and its recovery), not
     # taken to the rack here, where a broken weld had no recovery.

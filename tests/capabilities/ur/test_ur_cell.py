@@ -16,7 +16,7 @@ import dashboard_client
 import jsonschema
 import pytest
 
-from capabilities.base import CapabilityRegistry
+from capabilities.base import CapabilityRegistry, Cell
 from capabilities.cells import CellError, open_cell
 from capabilities.cli import main
 from capabilities.faults import hold_check
@@ -156,9 +156,9 @@ def _ids(plan: PlanSpec) -> list[str]:
     return [child.id for child in plan.tree.children]
 
 
-def _run(cell: object, plan: PlanSpec, events: list[Event]) -> Executor:
+def _run(cell: Cell, plan: PlanSpec, events: list[Event]) -> Executor:
     registry = CapabilityRegistry(cell=cell)
-    tree = build_tree(plan, registry, clock=cell.clock)  # type: ignore[attr-defined]
+    tree = build_tree(plan, registry, clock=cell.clock)
     executor = Executor(
         tree,
         20.0,
