@@ -230,13 +230,15 @@ class URConnection:
         if not fault_reason(URState(**{**self.state.__dict__, "program_running": True})):
             self.start_control()
 
-    def start_control(self) -> None:
-        """(I/O thread) Connect the control interface, or upload its script again."""
+    def start_control(self, reupload: bool = False) -> None:
+        """(I/O thread) Connect the control interface, or upload its script again: when it
+        does not run, or with ``reupload`` (a stop ended it, though the controller may not
+        have said so yet)."""
         import rtde_control
 
         if self.control is None:
             self.control = _control_interface(rtde_control, self.host)
-        elif not self.control.isProgramRunning():
+        elif reupload or not self.control.isProgramRunning():
             if not self.control.isConnected():
                 self.control.reconnect()
             self.control.reuploadScript()
@@ -290,7 +292,9 @@ class URConnection:
             self.dashboard.unlockProtectiveStop()
         except Exception as exc:
             raise URError(f"unlocking the protective stop failed: {exc}") from exc
-        self.start_control()
+        # A protective stop ends the control script; the frame that says so may still be on
+        # its way (a loaded machine), and a script thought running was never uploaded again.
+        self.start_control(reupload=True)
 
     def refresh(self) -> None:
         """(I/O thread only) Read the controller's state into :attr:`state` now."""
