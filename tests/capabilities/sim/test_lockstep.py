@@ -126,9 +126,8 @@ def test_a_driven_world_steps_only_while_a_command_runs_or_someone_waits(
     physics: PhysicsThread,
 ) -> None:
     """The gate of a driven cell: nothing happens between two commands of a slow sender."""
-    physics.add_gate(physics.waited_on)
-    physics.nudge()
-    time.sleep(0.1)  # whatever ran before the gate: from here on the world waits
+    with physics.standing_still():  # the loop has seen the gate before the world goes on
+        physics.add_gate(physics.waited_on)
     held = physics.time()
     time.sleep(0.2)
     assert physics.time() == held
