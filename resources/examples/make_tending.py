@@ -264,31 +264,35 @@ def discard_to_scrap() -> SubtreeSpec:
             seconds=PIECE_TIME,
         )  # fmt: skip
 
-    # A broken part has two pieces: the left one lies at PIECE_1 (either shape's); the
-    # right one at PIECE_2 (a U's) or else at PIECE_3 (a step's); each is tried twice when
-    # nothing was held. Once both are in the bin
-    # the robot leaves: every second near the exit is one the welding arm may come down.
+    # A broken part has two pieces: the right one lies at PIECE_2 (a U's) or else at
+    # PIECE_3 (a step's), the left one at PIECE_1 (either shape's); each is tried twice when
+    # nothing was held. The right one first: it lies under the welding arm's swing (taught
+    # by swinging it over the robot at each spot: it clears PIECE_1 by 7 cm and none of the
+    # others), so the robot is done there early, while the next part cannot come yet (taken
+    # last, the arm came down on the robot there: 2 of the 3 parts lost in 2 x 50, seeds
+    # 9100-9101). Once both are in the bin the robot leaves: a part dropped at the exit
+    # lands on the left piece's spot.
     tree = m.node(
         NodeKind.SEQUENCE, "DiscardToScrap",
         held,
         m.op("gripper.open", "let go"),
         m.move("up from the exit", "ABOVE", speed=DISCARD_SPEED),
-        m.node(NodeKind.FORCE_SUCCESS, "the left piece, if it lies there",
-               m.node(NodeKind.RETRY, "twice if need be", piece("PIECE_1"), count=PIECE_TRIES)),
         m.node(NodeKind.FORCE_SUCCESS, "the right piece, if it lies there",
                m.node(NodeKind.RETRY, "both spots twice if need be",
                       m.node(NodeKind.SELECTOR, "where a U's lies, else a step's",
                              piece("PIECE_2"), piece("PIECE_3")),
                       count=PIECE_TRIES)),
+        m.node(NodeKind.FORCE_SUCCESS, "the left piece, if it lies there",
+               m.node(NodeKind.RETRY, "twice if need be", piece("PIECE_1"), count=PIECE_TRIES)),
         m.move("step out of view", observe(), speed=DISCARD_SPEED),
     )  # fmt: skip
     return subtree(
         "recovery.discard_to_scrap", "DiscardToScrap",
         "A bad part: whatever the gripper still holds goes into the scrap bin, then the "
         "pieces of a broken weld are taken where they fall at the exit and dropped into the "
-        "scrap bin: the left piece at PIECE_1, the right one at PIECE_2, or at PIECE_3 when "
-        "nothing was held at PIECE_2, each tried twice when nothing was held (taught "
-        "spots; the moves at twice the nominal speed, "
+        "scrap bin: first the right piece, at PIECE_2, or at PIECE_3 when nothing was held at "
+        "PIECE_2 (the spots under the machine's arm), then the left one at PIECE_1, each "
+        "tried twice when nothing was held (taught spots; the moves at twice the nominal speed, "
         "the next part is coming, but for carrying a piece to the bin).",
         tree,
         inputs=[port("ABOVE", ParamType.WAYPOINT, "the tool over the exit, clear of the parts"),
@@ -358,12 +362,19 @@ def _part_cycle(m: _Maker, subs: dict[str, SubtreeSpec], wps: dict[str, Waypoint
         m.node(NodeKind.SELECTOR, "regrasp, else scrap it",
                m.instance(subs["Regrasp"], "Regrasp", **exit_wps),
                m.node(NodeKind.FORCE_FAILURE, "scrapped: nothing to place",
-                      m.node(NodeKind.PARALLEL, "scrap it until the next part comes",
-                             scrap,
-                             m.op("occupancy.wait_until_occupied", "the welding arm comes",
-                                  region=fixed(ARM_REGION, ParamType.REGION),
-                                  timeout=fixed(600.0, ParamType.DURATION), period=_PERIOD),
-                             success="any"))),
+                      m.node(NodeKind.SEQUENCE, "scrap it",
+                             m.node(NodeKind.PARALLEL, "scrap it until the next part comes",
+                                    scrap,
+                                    m.op("occupancy.wait_until_occupied",
+                                         "the welding arm comes",
+                                         region=fixed(ARM_REGION, ParamType.REGION),
+                                         timeout=fixed(600.0, ParamType.DURATION),
+                                         period=_PERIOD),
+                                    success="any"),
+                             # A piece on its way to the bin when the next part came: on
+                             # into the bin (carried on through the back-off that follows,
+                             # it fell off: 1 of the 3 parts lost in 2 x 50).
+                             m.held_into_scrap(wps["over scrap"])))),
         errors=PICK_ERRORS, error="PICK_ERROR",
     )  # fmt: skip
     rack: dict[str, Binding | str] = {

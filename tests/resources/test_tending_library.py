@@ -99,3 +99,30 @@ def test_catches_route_the_pick_and_the_place_to_their_recovery() -> None:
     ]  # fmt: skip
     operator_ops = [n for _, n in plan.walk() if (n.op or "").startswith("collaboration.")]
     assert operator_ops == []  # never waits for the operator
+
+
+def _waypoints_moved_to(node: NodeSpec) -> list[str]:
+    """Where the moves under ``node`` go, in order: a waypoint's name, or the port it is
+    bound to (inside a subtree)."""
+    found = []
+    for _, n in node.walk():
+        target = n.params.get("target") if n.op == "motion.move_to" else None
+        if target is not None:
+            found.append(target.ref or getattr(target.value, "name", ""))
+    return found
+
+
+def test_a_broken_weld_s_pieces_under_the_welding_arm_go_first() -> None:
+    """DiscardToScrap takes the right piece (PIECE_2, else PIECE_3: under the welding arm's
+    swing) before the left one (PIECE_1, clear of it), so the robot is done under the arm
+    early; a scrap cut short by the next part carries a held piece on into the bin."""
+    library = Library(Path("/nonexistent"), shipped=(SHIPPED_LIBRARY,)).scan()
+    discard = next(e.subtree for e in library.entries if e.subtree.name == "DiscardToScrap")
+    spots = [w for w in _waypoints_moved_to(discard.tree) if w.startswith("PIECE_")]
+    assert spots == ["PIECE_2", "PIECE_3", "PIECE_1"]
+    plan = load_plan(TENDING)
+    assert plan.tree is not None
+    pick = {c.name: c for c in _catches(plan.tree)}["pick, with recovery"]
+    scrap_it = pick.children[1].children[1].children[0]
+    assert [c.kind for c in scrap_it.children] == [NodeKind.PARALLEL, NodeKind.FORCE_SUCCESS]
+    assert _waypoints_moved_to(scrap_it.children[1]) == ["over scrap"]
