@@ -266,12 +266,12 @@ def discard_to_scrap() -> SubtreeSpec:
 
     # A broken part has two pieces: the right one lies at PIECE_2 (a U's) or else at
     # PIECE_3 (a step's), the left one at PIECE_1 (either shape's); each is tried twice when
-    # nothing was held. The right one first: it lies under the welding arm's swing (taught
-    # by swinging it over the robot at each spot: it clears PIECE_1 by 7 cm and none of the
-    # others), so the robot is done there early, while the next part cannot come yet (taken
-    # last, the arm came down on the robot there: 2 of the 3 parts lost in 2 x 50, seeds
-    # 9100-9101). Once both are in the bin the robot leaves: a part dropped at the exit
-    # lands on the left piece's spot.
+    # nothing was held. The right one first: it lies deeper under the welding arm's swing
+    # (seen by swinging the arm over the robot at each spot: half-way down the arm already
+    # meets the robot at PIECE_2 and PIECE_3 and still clears it by 6 cm at PIECE_1, which
+    # it reaches only at the end of its swing), so the robot is done there early, before
+    # the next part can come (taken last, the arm came down on the robot there: 2 of the 3
+    # parts lost in 2 x 50, seeds 9100-9101). Once both are in the bin the robot leaves.
     tree = m.node(
         NodeKind.SEQUENCE, "DiscardToScrap",
         held,

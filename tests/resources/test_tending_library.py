@@ -113,9 +113,9 @@ def _waypoints_moved_to(node: NodeSpec) -> list[str]:
 
 
 def test_a_broken_weld_s_pieces_under_the_welding_arm_go_first() -> None:
-    """DiscardToScrap takes the right piece (PIECE_2, else PIECE_3: under the welding arm's
-    swing) before the left one (PIECE_1, clear of it), so the robot is done under the arm
-    early; a scrap cut short by the next part carries a held piece on into the bin."""
+    """DiscardToScrap takes the right piece (PIECE_2, else PIECE_3: deep under the welding
+    arm's swing) before the left one (PIECE_1, at its edge), so the robot is done under the
+    arm early; a scrap cut short by the next part carries a held piece on into the bin."""
     library = Library(Path("/nonexistent"), shipped=(SHIPPED_LIBRARY,)).scan()
     discard = next(e.subtree for e in library.entries if e.subtree.name == "DiscardToScrap")
     spots = [w for w in _waypoints_moved_to(discard.tree) if w.startswith("PIECE_")]
