@@ -50,7 +50,14 @@ def record(qtbot: Any, window: MainWindow, name: str, frame: str, reference: str
 
 
 def click_and_wait(qtbot: Any, window: MainWindow, button: Any) -> None:
-    with qtbot.waitSignal(window.views.teacher.finished, timeout=30_000) as blocker:
+    """Click a jog button and wait until its jog ended. Only a jog's end counts: the end of
+    what ran before (freedrive off) may still be on its way from the worker on a loaded
+    machine, and taken for the jog's, the test went on while the jog had not moved yet."""
+    with qtbot.waitSignal(
+        window.views.teacher.finished,
+        timeout=30_000,
+        check_params_cb=lambda what, _problem: what.startswith("jog"),
+    ) as blocker:
         qtbot.mouseClick(button, LEFT)
     assert blocker.args[1] == "", blocker.args
 
