@@ -11,9 +11,10 @@ that way). Ours does the same task composed from library subtrees, with recovery
 - ``resources/library/recovery``: Regrasp (a grasp that closed on nothing or a part that
   slipped: let go, look again at the exit and grasp again, a bounded number of tries),
   DiscardToScrap (a bad part: what is still held goes to the scrap bin, and the pieces of a
-  broken weld are taken from where they fall at the exit to the scrap bin) and
-  ReRegisterRack (find the rack's marker again and give its pose, which the place
-  waypoints are taught relative to).
+  broken weld are taken from where they fall at the exit to the scrap bin), ReRegisterRack
+  (find the rack's marker again and give its pose, which the place waypoints are taught
+  relative to) and PartThenLeftPiece (after a scrap the next part cut short: that part to
+  the rack, then the piece it lay on into the scrap bin).
 - ``resources/examples/tending.costar.json``: find the rack, wait for the first part
   (WaitForPart); then for every part, forever: pick (a Catch sends a failed pick to Regrasp,
   and when that gives up to DiscardToScrap), re-register the rack (ReRegisterRack: it is a
@@ -24,7 +25,8 @@ that way). Ours does the same task composed from library subtrees, with recovery
   library. Whatever else fails (a collision with the welding arm, ...) is caught around
   the part: the robot clears a protective stop and backs off, puts what it still holds into
   the scrap bin, lets go and feels for a part left at the exit (a flat part the camera
-  cannot see), which the next cycle then picks; it never waits for the operator.
+  cannot see): when one lies there, PartThenLeftPiece takes it to the rack and then the
+  left piece of a scrap it cut short; it never waits for the operator.
 
 Usage: python resources/examples/make_tending.py
 """
@@ -139,6 +141,33 @@ class _Maker(PlanBuilder):
                 self.op("gripper.close", "close on it"),
                 self.op("gripper.is_holding", "in the gripper")]  # fmt: skip
 
+    def piece(self, over: Waypoint | str, scrap: Waypoint | str) -> NodeSpec:
+        """A piece of a broken weld from where it lies (the tool ``over`` it) into the
+        scrap bin, in ``PIECE_TIME`` (a piece must not hold the robot up)."""
+        # Lifted whether or not the fingers hold anything (the next spot is reached from
+        # above), then into the scrap bin only when held: an empty spot costs a close and
+        # two short moves.
+        down, fast = GRASP_Z - ABOVE_Z, fixed(DISCARD_SPEED, ParamType.NUMBER)
+        key = over if isinstance(over, str) else over.name.replace("over ", "").replace(" ", "_")
+
+        def vertical(name: str, dz: float) -> NodeSpec:
+            return self.op("motion.move_relative", name, dz=fixed(dz, ParamType.NUMBER),
+                           speed=fast, accel=fast)  # fmt: skip
+
+        return self.node(
+            NodeKind.TIMEOUT, f"{key.lower()}, {PIECE_TIME:g} s at most",
+            self.node(NodeKind.SEQUENCE, f"{key.lower()} into the scrap bin",
+                      self.op("gripper.open", "open"),
+                      self.move("over it", over, speed=DISCARD_SPEED),
+                      vertical("down to it", down),
+                      self.op("gripper.close", "close on it"),
+                      vertical("lift it", -down),
+                      self.op("gripper.is_holding", "a piece held"),
+                      self.move("over the scrap bin", scrap),
+                      self.op("gripper.open", "drop it into the bin")),
+            seconds=PIECE_TIME,
+        )  # fmt: skip
+
     def held_into_scrap(self, scrap: Waypoint | str) -> NodeSpec:
         """Whatever the gripper holds goes into the scrap bin (nothing to do if nothing)."""
         return self.node(
@@ -240,30 +269,6 @@ def discard_to_scrap() -> SubtreeSpec:
     m = _Maker("discard_to_scrap")
     held = m.held_into_scrap("SCRAP")
 
-    def piece(key: str) -> NodeSpec:
-        # Lifted whether or not the fingers hold anything (the next spot is reached from
-        # above), then into the scrap bin only when held: an empty spot costs a close and
-        # two short moves. A time limit: a piece must not hold the robot up.
-        down, fast = GRASP_Z - ABOVE_Z, fixed(DISCARD_SPEED, ParamType.NUMBER)
-
-        def vertical(name: str, dz: float) -> NodeSpec:
-            return m.op("motion.move_relative", name, dz=fixed(dz, ParamType.NUMBER),
-                        speed=fast, accel=fast)  # fmt: skip
-
-        return m.node(
-            NodeKind.TIMEOUT, f"{key.lower()}, {PIECE_TIME:g} s at most",
-            m.node(NodeKind.SEQUENCE, f"{key.lower()} into the scrap bin",
-                   m.op("gripper.open", "open"),
-                   m.move("over it", key, speed=DISCARD_SPEED),
-                   vertical("down to it", down),
-                   m.op("gripper.close", "close on it"),
-                   vertical("lift it", -down),
-                   m.op("gripper.is_holding", "a piece held"),
-                   m.move("over the scrap bin", "SCRAP"),
-                   m.op("gripper.open", "drop it into the bin")),
-            seconds=PIECE_TIME,
-        )  # fmt: skip
-
     # A broken part has two pieces: the right one lies at PIECE_2 (a U's) or else at
     # PIECE_3 (a step's), the left one at PIECE_1 (either shape's); each is tried twice when
     # nothing was held. The right one first: it lies deeper under the welding arm's swing
@@ -280,10 +285,10 @@ def discard_to_scrap() -> SubtreeSpec:
         m.node(NodeKind.FORCE_SUCCESS, "the right piece, if it lies there",
                m.node(NodeKind.RETRY, "both spots twice if need be",
                       m.node(NodeKind.SELECTOR, "where a U's lies, else a step's",
-                             piece("PIECE_2"), piece("PIECE_3")),
+                             m.piece("PIECE_2", "SCRAP"), m.piece("PIECE_3", "SCRAP")),
                       count=PIECE_TRIES)),
         m.node(NodeKind.FORCE_SUCCESS, "the left piece, if it lies there",
-               m.node(NodeKind.RETRY, "twice if need be", piece("PIECE_1"), count=PIECE_TRIES)),
+               m.node(NodeKind.RETRY, "twice if need be", m.piece("PIECE_1", "SCRAP"), count=PIECE_TRIES)),
         m.move("step out of view", observe(), speed=DISCARD_SPEED),
     )  # fmt: skip
     return subtree(
@@ -322,6 +327,61 @@ def reregister_rack() -> SubtreeSpec:
     )  # fmt: skip
 
 
+def part_then_left_piece() -> SubtreeSpec:
+    m = _Maker("part_then_left_piece")
+    # A discard the next part cut short leaves the left piece where that part lands (a bar of
+    # either shape lies on its spot): the part goes to the rack first, the piece after. If
+    # the arm comes again meanwhile, its part lies at the exit: the caller's cycle picks it.
+    tree = m.node(
+        NodeKind.SEQUENCE, "PartThenLeftPiece",
+        m.node(NodeKind.TIMEOUT, "a part at the exit",
+               m.node(NodeKind.SEQUENCE, "feel for it, take it",
+                      *m.feel("ABOVE", "AT"),
+                      m.move("lift it", "ABOVE", linear=True),
+                      m.op("gripper.is_holding", "still held")),
+               seconds=TAKE_TIME),
+        m.instance(reregister_rack(), "where is the rack", RACK_POSE="RACK_POSE"),
+        m.instance(place_on_rack(), "PlaceOnRack", RACK="RACK_POSE", OVER="OVER", INTO="INTO"),
+        m.node(NodeKind.SELECTOR, "the left piece, else the next part came",
+               m.node(NodeKind.SEQUENCE, "the left piece, then the next part",
+                      m.node(NodeKind.PARALLEL, "the left piece, unless the next part comes",
+                             m.node(NodeKind.FORCE_SUCCESS, "if it lies there",
+                                    m.node(NodeKind.RETRY, "twice if need be",
+                                           m.piece("PIECE", "SCRAP"), count=PIECE_TRIES)),
+                             m.node(NodeKind.FORCE_FAILURE, "the next part came",
+                                    _arm_comes(m, "REGION")),
+                             success="any"),
+                      m.move("step out of view", observe()),
+                      m.instance(wait_for_part(), "then the next part comes", REGION="REGION",
+                                 ABOVE="ABOVE", AT="AT")),
+               m.node(NodeKind.SEQUENCE, "the next part came: the caller picks it",
+                      m.held_into_scrap("SCRAP"),
+                      m.op("gripper.open", "let go"),
+                      m.op("motion.move_relative", "up, clear of it",
+                           dz=fixed(ABOVE_Z - GRASP_Z, ParamType.NUMBER)),
+                      m.move("step out of view", observe()),
+                      m.op("occupancy.wait_until_empty", "the arm is back up", region="REGION",
+                           period=_PERIOD))),
+    )  # fmt: skip
+    return subtree(
+        "recovery.part_then_left_piece", "PartThenLeftPiece",
+        "After a scrap the next part cut short: takes that part at the exit (fails when there "
+        "is none, or it is not held after the lift) to the rack (found again by its marker), "
+        "then the piece left at PIECE into the scrap bin (tried twice), then waits for the "
+        "next part (WaitForPart). When the machine's arm comes into REGION before the piece "
+        "is held, its part lies at the exit: the robot leaves the piece, steps out of view "
+        "and waits until the arm is back up.",
+        tree,
+        inputs=[*_exit_ports(),
+                port("OVER", ParamType.WAYPOINT, "the tool over the tote, relative to the rack"),
+                port("INTO", ParamType.WAYPOINT, "where the tool lets go, relative to the rack"),
+                port("PIECE", ParamType.WAYPOINT, "the tool over where the left piece lies"),
+                port("SCRAP", ParamType.WAYPOINT, "the tool over the scrap bin (taught)"),
+                port("REGION", ParamType.REGION, "where the machine's arm swings down")],
+        outputs=[port("RACK_POSE", ParamType.POSE, "where the rack is now")],
+    )  # fmt: skip
+
+
 def clear_stop() -> SubtreeSpec:
     """ClearStopAndBackOff as shipped (written by make_clear_stop.py)."""
     return load_subtree(LIBRARY / "recovery" / "ClearStopAndBackOff.subtree.json")
@@ -331,7 +391,7 @@ def library() -> dict[str, list[SubtreeSpec]]:
     """The shipped subtrees this generator writes, by library folder."""
     return {
         "tending": [pick_at_exit(), place_on_rack(), wait_for_part()],
-        "recovery": [regrasp(), discard_to_scrap(), reregister_rack()],
+        "recovery": [regrasp(), discard_to_scrap(), reregister_rack(), part_then_left_piece()],
     }
 
 
@@ -343,6 +403,11 @@ def _wait_for_part(m: _Maker, subs: dict[str, SubtreeSpec], wps: dict[str, Waypo
                    name: str) -> NodeSpec:  # fmt: skip
     return m.instance(subs["WaitForPart"], name, REGION=fixed(ARM_REGION, ParamType.REGION),
                       ABOVE=_wp(wps["over exit"]), AT=_wp(wps["at exit"]))  # fmt: skip
+
+
+def _arm_comes(m: _Maker, region: Binding | str) -> NodeSpec:
+    return m.op("occupancy.wait_until_occupied", "the welding arm comes", region=region,
+                timeout=fixed(600.0, ParamType.DURATION), period=_PERIOD)  # fmt: skip
 
 
 def _part_cycle(m: _Maker, subs: dict[str, SubtreeSpec], wps: dict[str, Waypoint]) -> NodeSpec:
@@ -365,11 +430,7 @@ def _part_cycle(m: _Maker, subs: dict[str, SubtreeSpec], wps: dict[str, Waypoint
                       m.node(NodeKind.SEQUENCE, "scrap it",
                              m.node(NodeKind.PARALLEL, "scrap it until the next part comes",
                                     scrap,
-                                    m.op("occupancy.wait_until_occupied",
-                                         "the welding arm comes",
-                                         region=fixed(ARM_REGION, ParamType.REGION),
-                                         timeout=fixed(600.0, ParamType.DURATION),
-                                         period=_PERIOD),
+                                    _arm_comes(m, fixed(ARM_REGION, ParamType.REGION)),
                                     success="any"),
                              # A piece on its way to the bin when the next part came: on
                              # into the bin (carried on through the back-off that follows,
@@ -416,22 +477,23 @@ def tending() -> PlanSpec:
     # is still held (a piece on its way to the scrap bin) goes into the scrap bin before the
     # gripper opens (opened where it stood, a carried piece fell beside the bin: 3 of the 4
     # parts lost in 2 x 50, seeds 9100-9101). A part may have come meanwhile and lie at the
-    # exit where the camera cannot see it: feel for it, and when it is there let the next
-    # cycle pick it, with the pick's recovery (taken here without, a part whose weld broke
-    # too left its pieces at the exit: the fourth). Else, out of the welding arm's way (a
-    # robot left over the exit waited there for the arm to come down on it), wait for the
-    # next part, as a part's cycle ends.
+    # exit where the camera cannot see it, on the left piece of a scrap it cut short: feel
+    # for it, and when it is there take it to the rack, then the piece into the scrap bin
+    # (PartThenLeftPiece; left for the next cycle, the piece stayed there for good: the 3
+    # parts lost in 2 x 50, seeds 9100-9101, after the discard's order changed). Else, out
+    # of the welding arm's way (a robot left over the exit waited there for the arm to come
+    # down on it), wait for the next part, as a part's cycle ends.
     go_on = m.node(
         NodeKind.SEQUENCE, "recover and go on",
         m.instance(subs["ClearStopAndBackOff"], "ClearStopAndBackOff", SAFE=_wp(observe())),
         m.held_into_scrap(wps["over scrap"]),
         m.op("gripper.open", "let go"),
         m.node(NodeKind.SELECTOR, "a part at the exit already, else the next one",
-               m.node(NodeKind.TIMEOUT, "a part left at the exit",
-                      m.node(NodeKind.SEQUENCE, "feel for it",
-                             *m.feel(wps["over exit"], wps["at exit"]),
-                             m.op("gripper.open", "let go of it: the next cycle picks it")),
-                      seconds=TAKE_TIME),
+               m.instance(subs["PartThenLeftPiece"], "PartThenLeftPiece",
+                          ABOVE=_wp(wps["over exit"]), AT=_wp(wps["at exit"]),
+                          OVER=_wp(wps["over rack"]), INTO=_wp(wps["into rack"]),
+                          PIECE=_wp(wps["over piece 1"]), SCRAP=_wp(wps["over scrap"]),
+                          REGION=fixed(ARM_REGION, ParamType.REGION), RACK_POSE="RACK_POSE"),
                m.node(NodeKind.SEQUENCE, "none: the next one",
                       m.move("step out of view", observe()),
                       _wait_for_part(m, subs, wps, "then the next part comes"))),
@@ -467,7 +529,8 @@ def tending() -> PlanSpec:
         "second place; before each place the rack is found again (it may have been moved). "
         "Anything else (a collision with the welding arm, ...) is caught around the part: the "
         "robot clears a protective stop, backs off, puts what it still holds into the scrap "
-        "bin, lets go and feels for a part left at the exit (the next cycle picks it); it "
+        "bin, lets go and feels for a part left at the exit (PartThenLeftPiece takes it to "
+        "the rack, then the left piece of a scrap it cut short into the scrap bin); it "
         "never waits for the operator. Runs until stopped, on the simulated scene tending. "
         "Run it with: costar run example:tending.",
         RunPolicy.ONCE, waypoints=waypoints(), objects=["tending_rack"], reset_cell=True,
