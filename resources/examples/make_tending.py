@@ -188,6 +188,12 @@ def _exit_ports() -> list[SubtreePort]:
             port("AT", ParamType.WAYPOINT, "the tool where it closes on a part at the exit")]  # fmt: skip
 
 
+def _piece_ports() -> list[SubtreePort]:
+    return [port(f"PIECE_{i}", ParamType.WAYPOINT,
+                 "the tool over where a piece of a broken part lies (it goes straight down "
+                 f"{ABOVE_Z - GRASP_Z:.3f} m to take it)") for i in range(1, len(PIECES) + 1)]  # fmt: skip
+
+
 def pick_at_exit() -> SubtreeSpec:
     m = _Maker("pick_at_exit")
     tree = m.take("PickAtExit", "ABOVE", "AT")
@@ -302,9 +308,7 @@ def discard_to_scrap() -> SubtreeSpec:
         tree,
         inputs=[port("ABOVE", ParamType.WAYPOINT, "the tool over the exit, clear of the parts"),
                 port("SCRAP", ParamType.WAYPOINT, "the tool over the scrap bin (taught)"),
-                *(port(f"PIECE_{i}", ParamType.WAYPOINT,
-                        "the tool over where a piece of a broken part lies (it goes straight "
-                        f"down {ABOVE_Z - GRASP_Z:.3f} m to take it)") for i in range(1, len(PIECES) + 1))],
+                *_piece_ports()],
     )  # fmt: skip
 
 
@@ -327,55 +331,97 @@ def reregister_rack() -> SubtreeSpec:
     )  # fmt: skip
 
 
-def part_then_left_piece() -> SubtreeSpec:
-    m = _Maker("part_then_left_piece")
-    # A discard the next part cut short leaves the left piece where that part lands (a bar of
-    # either shape lies on its spot): the part goes to the rack first, the piece after. If
-    # the arm comes again meanwhile, its part lies at the exit: the caller's cycle picks it.
-    tree = m.node(
-        NodeKind.SEQUENCE, "PartThenLeftPiece",
-        m.node(NodeKind.TIMEOUT, "a part at the exit",
-               m.node(NodeKind.SEQUENCE, "feel for it, take it",
-                      *m.feel("ABOVE", "AT"),
-                      m.move("lift it", "ABOVE", linear=True),
-                      m.op("gripper.is_holding", "still held")),
-               seconds=TAKE_TIME),
+def _feel_at_exit(m: _Maker, name: str) -> NodeSpec:
+    """Over the exit, down, close, feel a part held, in ``TAKE_TIME``."""
+    return m.node(NodeKind.TIMEOUT, name,
+                  m.node(NodeKind.SEQUENCE, "feel for it", *m.feel("ABOVE", "AT")),
+                  seconds=TAKE_TIME)  # fmt: skip
+
+
+def _unless_the_arm_comes(m: _Maker, name: str, work: NodeSpec) -> NodeSpec:
+    """``work`` (whatever it finds), then out of view until the next part comes
+    (WaitForPart); fails as soon as the machine's arm comes into REGION before it is done."""
+    return m.node(
+        NodeKind.SEQUENCE, f"{name}, then the next part",
+        m.node(NodeKind.PARALLEL, f"{name}, unless the next part comes",
+               m.node(NodeKind.FORCE_SUCCESS, "whatever it finds", work),
+               m.node(NodeKind.FORCE_FAILURE, "the next part came", _arm_comes(m, "REGION")),
+               success="any"),
+        m.move("step out of view", observe()),
+        m.instance(wait_for_part(), "then the next part comes", REGION="REGION", ABOVE="ABOVE",
+                   AT="AT"),
+    )  # fmt: skip
+
+
+def _clear_of_the_arm(m: _Maker) -> list[NodeSpec]:
+    """The machine's arm came: what is held into the scrap bin, let go, up clear, out of
+    view until the arm is back up (its part lies at the exit)."""
+    return [m.held_into_scrap("SCRAP"),
+            m.op("gripper.open", "let go"),
+            m.op("motion.move_relative", "up, clear of it",
+                 dz=fixed(ABOVE_Z - GRASP_Z, ParamType.NUMBER)),
+            m.move("step out of view", observe()),
+            m.op("occupancy.wait_until_empty", "the arm is back up", region="REGION",
+                 period=_PERIOD)]  # fmt: skip
+
+
+def _to_the_rack_then_the_left_piece(m: _Maker) -> list[NodeSpec]:
+    """The part felt at the exit: lift it, feel it still held, to the rack (found again by
+    its marker), then the left piece into the scrap bin unless the next part comes first
+    (that part then lies at the exit: the caller's cycle picks it)."""
+    piece = m.node(NodeKind.RETRY, "twice if need be", m.piece("PIECE_1", "SCRAP"),
+                   count=PIECE_TRIES)  # fmt: skip
+    return [
+        m.move("lift it", "ABOVE", linear=True),
+        m.op("gripper.is_holding", "still held"),
         m.instance(reregister_rack(), "where is the rack", RACK_POSE="RACK_POSE"),
         m.instance(place_on_rack(), "PlaceOnRack", RACK="RACK_POSE", OVER="OVER", INTO="INTO"),
         m.node(NodeKind.SELECTOR, "the left piece, else the next part came",
-               m.node(NodeKind.SEQUENCE, "the left piece, then the next part",
-                      m.node(NodeKind.PARALLEL, "the left piece, unless the next part comes",
-                             m.node(NodeKind.FORCE_SUCCESS, "if it lies there",
-                                    m.node(NodeKind.RETRY, "twice if need be",
-                                           m.piece("PIECE", "SCRAP"), count=PIECE_TRIES)),
-                             m.node(NodeKind.FORCE_FAILURE, "the next part came",
-                                    _arm_comes(m, "REGION")),
-                             success="any"),
-                      m.move("step out of view", observe()),
-                      m.instance(wait_for_part(), "then the next part comes", REGION="REGION",
-                                 ABOVE="ABOVE", AT="AT")),
+               _unless_the_arm_comes(m, "the left piece", piece),
                m.node(NodeKind.SEQUENCE, "the next part came: the caller picks it",
-                      m.held_into_scrap("SCRAP"),
-                      m.op("gripper.open", "let go"),
-                      m.op("motion.move_relative", "up, clear of it",
-                           dz=fixed(ABOVE_Z - GRASP_Z, ParamType.NUMBER)),
-                      m.move("step out of view", observe()),
-                      m.op("occupancy.wait_until_empty", "the arm is back up", region="REGION",
-                           period=_PERIOD))),
+                      *_clear_of_the_arm(m))),
+    ]  # fmt: skip
+
+
+def part_then_left_piece() -> SubtreeSpec:
+    m = _Maker("part_then_left_piece")
+    # A discard the next part cut short leaves the left piece where that part lands (a bar of
+    # either shape lies on its spot): the part goes to the rack first, the piece after. A
+    # part that breaks on the lift (a bad weld) goes to the scrap bin, piece by piece (left
+    # at the exit, its pieces lay there for good: 1 of the 2 parts lost in 2 x 50, seeds
+    # 9100-9101); when the next part cuts that short, it lies on them: it goes to the rack,
+    # then the left piece. Whenever the arm comes again, its part lies at the exit: the
+    # caller's cycle picks it.
+    discard = m.instance(discard_to_scrap(), "DiscardToScrap", ABOVE="ABOVE", SCRAP="SCRAP",
+                         **{f"PIECE_{i}": f"PIECE_{i}" for i in range(1, len(PIECES) + 1)})  # fmt: skip
+    tree = m.node(
+        NodeKind.SEQUENCE, "PartThenLeftPiece",
+        _feel_at_exit(m, "a part at the exit"),
+        m.node(NodeKind.SELECTOR, "to the rack, else it broke on the lift",
+               m.node(NodeKind.SEQUENCE, "to the rack, then the left piece",
+                      *_to_the_rack_then_the_left_piece(m)),
+               m.node(NodeKind.SELECTOR, "its pieces into the scrap bin, else the next part came",
+                      _unless_the_arm_comes(m, "its pieces into the scrap bin", discard),
+                      m.node(NodeKind.SEQUENCE, "the next part came: it, then the left piece",
+                             *_clear_of_the_arm(m),
+                             _feel_at_exit(m, "the next part at the exit"),
+                             *_to_the_rack_then_the_left_piece(m)))),
     )  # fmt: skip
     return subtree(
         "recovery.part_then_left_piece", "PartThenLeftPiece",
         "After a scrap the next part cut short: takes that part at the exit (fails when there "
-        "is none, or it is not held after the lift) to the rack (found again by its marker), "
-        "then the piece left at PIECE into the scrap bin (tried twice), then waits for the "
-        "next part (WaitForPart). When the machine's arm comes into REGION before the piece "
-        "is held, its part lies at the exit: the robot leaves the piece, steps out of view "
-        "and waits until the arm is back up.",
+        "is none) to the rack (found again by its marker), then the piece left at PIECE_1 "
+        "into the scrap bin (tried twice), then waits for the next part (WaitForPart). A part "
+        "not held after the lift (a bad weld broke) goes to the scrap bin with DiscardToScrap "
+        "instead, and so does one that cannot be placed. When the machine's arm comes into "
+        "REGION before the piece (or the pieces) is held, its part lies at the exit: the robot "
+        "leaves the piece, steps out of view and waits until the arm is back up; after the "
+        "pieces of a broken part, it takes that part to the rack and then the left piece.",
         tree,
         inputs=[*_exit_ports(),
                 port("OVER", ParamType.WAYPOINT, "the tool over the tote, relative to the rack"),
                 port("INTO", ParamType.WAYPOINT, "where the tool lets go, relative to the rack"),
-                port("PIECE", ParamType.WAYPOINT, "the tool over where the left piece lies"),
+                *_piece_ports(),
                 port("SCRAP", ParamType.WAYPOINT, "the tool over the scrap bin (taught)"),
                 port("REGION", ParamType.REGION, "where the machine's arm swings down")],
         outputs=[port("RACK_POSE", ParamType.POSE, "where the rack is now")],
@@ -492,7 +538,8 @@ def tending() -> PlanSpec:
                m.instance(subs["PartThenLeftPiece"], "PartThenLeftPiece",
                           ABOVE=_wp(wps["over exit"]), AT=_wp(wps["at exit"]),
                           OVER=_wp(wps["over rack"]), INTO=_wp(wps["into rack"]),
-                          PIECE=_wp(wps["over piece 1"]), SCRAP=_wp(wps["over scrap"]),
+                          SCRAP=_wp(wps["over scrap"]),
+                          **{f"PIECE_{i}": _wp(wps[f"over piece {i}"]) for i in range(1, len(PIECES) + 1)},
                           REGION=fixed(ARM_REGION, ParamType.REGION), RACK_POSE="RACK_POSE"),
                m.node(NodeKind.SEQUENCE, "none: the next one",
                       m.move("step out of view", observe()),

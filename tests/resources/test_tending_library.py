@@ -130,13 +130,30 @@ def test_a_broken_weld_s_pieces_under_the_welding_arm_go_first() -> None:
 
 def test_a_part_found_after_a_scrap_goes_to_the_rack_before_the_left_piece() -> None:
     """PartThenLeftPiece: the part that lies on the left piece's spot goes to the rack
-    first, then the piece into the scrap bin, unless the next part comes first."""
+    first, then the piece into the scrap bin, unless the next part comes first; a part that
+    breaks on the lift goes to the scrap bin (DiscardToScrap), and when the next part cuts
+    that short, the next part goes to the rack, then the left piece."""
     library = Library(Path("/nonexistent"), shipped=(SHIPPED_LIBRARY,)).scan()
     after = next(e.subtree for e in library.entries if e.subtree.name == "PartThenLeftPiece")
-    moves = _waypoints_moved_to(after.tree)
-    assert moves.index("AT") < moves.index("PIECE") < moves.index("SCRAP")
-    assert _instances(after.tree) == [
+    feel, either = after.tree.children
+    assert _waypoints_moved_to(feel) == ["ABOVE", "AT"]
+    to_rack, broke = either.children
+    moves = _waypoints_moved_to(to_rack)
+    assert moves.index("ABOVE") < moves.index("PIECE_1") < moves.index("SCRAP")
+    assert _instances(to_rack) == ["where is the rack", "PlaceOnRack", "then the next part comes"]
+    assert [c.op for c in to_rack.children[:2]] == ["motion.move_to", "gripper.is_holding"]
+    scrap_it, cut_short = broke.children
+    assert _instances(scrap_it) == ["DiscardToScrap", "then the next part comes"]
+    # Cut short: clear of the arm until it is back up, then its part, as above.
+    assert _instances(cut_short) == [
         "where is the rack", "PlaceOnRack", "then the next part comes"
     ]  # fmt: skip
-    watches = [n.op for _, n in after.tree.walk() if (n.op or "").startswith("occupancy.")]
-    assert watches == ["occupancy.wait_until_occupied", "occupancy.wait_until_empty"]
+    ops = [c.op or c.kind.value for c in cut_short.children]
+    assert (
+        ops.index("occupancy.wait_until_empty")
+        < ops.index("timeout")
+        < ops.index("gripper.is_holding")
+    )
+    for work in (to_rack, scrap_it):
+        watches = [n.op for _, n in work.walk() if (n.op or "").startswith("occupancy.")]
+        assert watches[0] == "occupancy.wait_until_occupied"  # the next part ends the work
