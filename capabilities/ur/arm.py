@@ -18,7 +18,13 @@ from typing import TYPE_CHECKING, Any
 from capabilities.faults import PROTECTIVE_STOP
 from capabilities.sim.commands import CommandHandle
 from capabilities.sim.kinematics import UR5Kinematics
-from capabilities.ur.connection import NO_SCRIPT, URConnection, URState, fault_reason
+from capabilities.ur.connection import (
+    HALT_DECEL,
+    NO_SCRIPT,
+    URConnection,
+    URState,
+    fault_reason,
+)
 from capabilities.ur.errors import URError
 from capabilities.ur.frames import URFrames
 from capabilities.ur.modes import PolyScopeVersion, RobotMode
@@ -133,7 +139,7 @@ class URArm:
             return CommandHandle.failed("move_pose_joint_space", "unreachable pose")
         return self.move_joints(q, speed, accel)
 
-    def stop(self, decel: float = 4.0) -> CommandHandle:
+    def stop(self, decel: float = HALT_DECEL) -> CommandHandle:
         handle = CommandHandle("stop")
 
         def run() -> None:
@@ -186,8 +192,9 @@ class URArm:
     ) -> CommandHandle:
         handle = CommandHandle(name, lambda h: None)  # cancel is seen by the monitor
         conn = self._conn
+        deadline = time.monotonic() + _START_TIMEOUT
 
-        def start() -> None:
+        def send_now() -> None:
             problem = fault_reason(conn.state)
             if problem:
                 handle.resolve(False, f"{name}: {problem}")
@@ -200,6 +207,23 @@ class URArm:
                 )
                 return
             _Monitor(handle, before, stop_name, arrived).attach(conn)
+
+        def send_when_idle(c: URConnection) -> bool:
+            """A halted move's asynchronous stop may still decelerate the arm: its end would
+            end this move too (and look like it), so this one waits for it (bounded)."""
+            if handle.done():
+                return True
+            if handle.cancel_requested:
+                handle.resolve(False, f"{name} halted")
+                return True
+            if c.state.async_running and time.monotonic() < deadline:
+                return False
+            send_now()
+            return True
+
+        def start() -> None:
+            if not send_when_idle(conn):
+                conn.add_monitor(send_when_idle)
 
         self._submit(handle, start)
         return handle
@@ -293,7 +317,7 @@ class _Monitor:
         self.script_gone_at = None
         if handle.cancel_requested:
             try:
-                getattr(conn.control, self.stop_name)(2.0, True)
+                getattr(conn.control, self.stop_name)(HALT_DECEL, True)
             finally:
                 handle.resolve(False, f"{handle.name} halted")
             return True

@@ -56,6 +56,13 @@ TEACH_BUTTON = "teach"  # the console button the pendant's teach button presses 
 _RETRY_SCRIPT = 1.0  # s between uploads of the control script while it is not running
 _RETRY_CONNECT = 2.0  # s between reconnection attempts
 _LET_UR_RTDE_TRY = 5.0  # s of a lost connection before ours (see _Recovery)
+# s after this program resumed from a stall longer than the watchdog's period in which a
+# script seen stopped is the watchdog's doing (it is seen at the first refresh after it).
+_STALL_WINDOW = 0.25
+WATCHDOG_STOP = (
+    "the arm stopped: this program did not answer the controller in time (its watchdog); "
+    "the control script is started again"
+)
 RESTART_SCRIPT = "Restart control script"  # the status bar's clear of a stopped script
 
 
@@ -242,6 +249,11 @@ class _Recovery:
             self.clearing = problem
         elif not problem:
             self.clearing = ""
+        elif not self.clearing and now - conn.stalled_at < _STALL_WINDOW:
+            # The script's watchdog stopped it (and the arm) while this process was stalled;
+            # it answers again, so it is not dead: start the script again, as after a stop.
+            self.clearing = WATCHDOG_STOP
+            _log.warning("UR: %s", WATCHDOG_STOP)
         if now < self._next_try:
             return False
         try:

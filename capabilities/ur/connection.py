@@ -4,10 +4,17 @@ Every ur_rtde call runs on the thread this class starts; callers queue work with
 :meth:`URConnection.submit` (a Future) or :meth:`URConnection.watch` (a monitor polled every
 cycle) and read :attr:`URConnection.state`, a snapshot the thread refreshes each cycle. The
 engine's and the GUI's threads never wait on the robot.
+
+Stop means stop. A UR goes on with its last move when the program that sent it dies, so:
+closing the connection (also at interpreter exit) first decelerates the arm to a halt and
+ends the control script, on the I/O thread, before anything is disconnected; and the control
+script's RTDE watchdog (``setWatchdog``), kicked by the I/O thread every few cycles, stops
+the program, and with it the arm, when this process is killed or frozen.
 """
 
 from __future__ import annotations
 
+import atexit
 import logging
 import queue
 import threading
@@ -21,7 +28,7 @@ from capabilities.faults import CONNECTION_LOST, EMERGENCY_STOP, PROTECTIVE_STOP
 from capabilities.ur.errors import URConnectionLost, URError
 from capabilities.ur.modes import PolyScopeVersion, RobotMode, SafetyMode, parse_version
 
-__all__ = ["NO_SCRIPT", "URConnection", "URState", "fault_reason"]
+__all__ = ["HALT_DECEL", "NO_SCRIPT", "URConnection", "WATCHDOG_HZ", "URState", "fault_reason"]
 
 _log = logging.getLogger(__name__)
 T = TypeVar("T")
@@ -31,6 +38,12 @@ _MOVING_SPEED = 1e-3  # rad/s
 # can sit inside a ur_rtde call (a move's send) for good when the controller dies under it.
 SILENCE_S = 3.0
 NO_SCRIPT = "the control script is not running on the controller"
+# The control script stops the program (and the arm) when no RTDE input arrives for
+# 1/WATCHDOG_HZ s: kill -9 or a frozen process halts the arm within 0.2 s plus the stop.
+WATCHDOG_HZ = 5.0
+_KICK_PERIOD = 0.02  # s between kicks: ten per watchdog period
+HALT_DECEL = 4.0  # rad/s^2: the controlled stop when the connection closes (as Stop's)
+_HALT_TIMEOUT = 2.0  # s for the arm to stand before the script is ended regardless
 
 
 @dataclass(frozen=True)
@@ -113,6 +126,13 @@ class URConnection:
         self._monitors: list[Monitor] = []
         self._closing = threading.Event()
         self._thread = threading.Thread(target=self._run, name="costar-ur-io", daemon=True)
+        self._watchdog = False  # set on the running control script
+        self._last_kick = 0.0
+        self._halted = False  # close() halted the arm: no more work runs
+        # When the I/O thread last resumed after a stall longer than the watchdog's period
+        # (another thread held the GIL: an import, a long C call): the script may have
+        # stopped on it, which is ours to restart (see capabilities.ur.cell._Recovery).
+        self.stalled_at = -1e9
         # ur_rtde objects: touched on the I/O thread only.
         self.dashboard: Any = None
         self.receive: Any = None
@@ -127,6 +147,7 @@ class URConnection:
             URConnectionLost: the controller does not answer.
         """
         self._thread.start()
+        atexit.register(self.close)  # an exit that skips close() still halts the arm
         future = self.submit(self._connect)
         try:
             future.result(timeout)
@@ -140,11 +161,18 @@ class URConnection:
             ) from exc
 
     def close(self) -> None:
-        """Disconnect and stop the I/O thread. Idempotent."""
+        """Halt the arm, end the control script, disconnect and stop the I/O thread.
+
+        The halt runs on the I/O thread after the work already queued (a move sent just
+        before is stopped too) and before anything is disconnected. Idempotent; also run at
+        interpreter exit.
+        """
         if self._closing.is_set():
             return
         self._closing.set()
+        atexit.unregister(self.close)
         if self._thread.is_alive():
+            self._tasks.put(self.halt)
             self._tasks.put(None)
             self._thread.join(timeout=10.0)
 
@@ -159,6 +187,9 @@ class URConnection:
 
         def run() -> None:
             if not future.set_running_or_notify_cancel():
+                return
+            if self._halted:
+                future.set_exception(URConnectionLost("the UR connection is closed"))
                 return
             try:
                 future.set_result(fn())
@@ -200,14 +231,16 @@ class URConnection:
             try:
                 task = self._tasks.get(timeout=timeout)
             except queue.Empty:
-                task = None if self._closing.is_set() else _POLL
-            if task is None and self._closing.is_set():
+                task = _POLL
+            if task is None:  # close() queues it after the halt: nothing runs in between
                 break
-            if task is not None and task is not _POLL:
+            if task is not _POLL:
                 task()
+                self.kick()
                 continue
             next_poll = time.monotonic() + self._period
             self.refresh()
+            self.kick()
             for monitor in list(self._monitors):
                 try:
                     finished = monitor(self)
@@ -217,6 +250,51 @@ class URConnection:
                 if finished:
                     self._monitors.remove(monitor)
         self._disconnect()
+
+    def kick(self, force: bool = False) -> None:
+        """(I/O thread) Kick the control script's watchdog (at most every ``_KICK_PERIOD``
+        s unless ``force``); a long wait on the I/O thread calls it to keep the arm going."""
+        control, now = self.control, time.monotonic()
+        if not self._watchdog or control is None or (
+            not force and now - self._last_kick < _KICK_PERIOD
+        ):
+            return
+        if now - self._last_kick > 1.0 / WATCHDOG_HZ:
+            self.stalled_at = now
+            _log.info("the UR I/O thread stalled for %.2f s", now - self._last_kick)
+        self._last_kick = now
+        try:
+            # A script that is not running would make ur_rtde print and wait: kick only one
+            # that runs (ending it ends its watchdog too).
+            if control.isConnected() and control.isProgramRunning():
+                control.kickWatchdog()
+        except Exception:  # a dead controller: the recovery monitor says so
+            _log.debug("kicking the watchdog failed", exc_info=True)
+
+    def halt(self) -> None:
+        """(I/O thread) Stop the arm with a controlled deceleration, wait (bounded) until it
+        stands, then end the control script. Later work queued on the thread is refused.
+        Never raises: a controller that is gone stops the arm by itself (the watchdog)."""
+        self._halted = True
+        self._monitors.clear()
+        control = self.control
+        if control is None:
+            return
+        try:
+            if not (control.isConnected() and control.isProgramRunning()):
+                return
+            control.stopJ(HALT_DECEL, True)  # asynchronous: the watchdog is kicked meanwhile
+            deadline = time.monotonic() + _HALT_TIMEOUT
+            while time.monotonic() < deadline:
+                time.sleep(self._period)
+                self.refresh()
+                self.kick(force=True)
+                if not self.state.moving:
+                    break
+            self._watchdog = False
+            control.stopScript()
+        except Exception:
+            _log.warning("halting the arm failed: the controller's watchdog stops it", exc_info=True)
 
     def _connect(self) -> None:
         import dashboard_client
@@ -255,6 +333,11 @@ class URConnection:
         while not self.state.program_running and time.monotonic() < deadline:
             time.sleep(0.005)
             self.refresh()
+        # Every new run of the script needs its own watchdog (a program stop removes it).
+        self._watchdog = bool(self.control.isProgramRunning()) and bool(
+            self.control.setWatchdog(WATCHDOG_HZ)
+        )
+        self._last_kick = time.monotonic()
 
     def reconnect(self) -> None:
         """(I/O thread) Drop the interfaces and connect afresh (the socket is really gone).
@@ -333,6 +416,7 @@ class URConnection:
         )
 
     def _disconnect(self) -> None:
+        self._watchdog = False
         for name in ("control", "receive", "dashboard"):
             obj = getattr(self, name)
             setattr(self, name, None)

@@ -89,6 +89,7 @@ class RobotiqGripper:
                     if time.monotonic() > deadline:
                         raise URError("the Robotiq gripper did not activate within 5 s")
                     time.sleep(0.05)
+                    self._conn.kick()  # a wait on the I/O thread: keep the arm's watchdog fed
             self._closed = self._get("PRE") >= 128
         except OSError as exc:
             raise URError(f"no Robotiq URCap at {self._conn.host}:{self._port}: {exc}") from exc

@@ -9,6 +9,8 @@ methods here; every method may be called from any thread.
 from __future__ import annotations
 
 import logging
+import select
+import socket
 import threading
 import time
 from collections.abc import Sequence
@@ -64,6 +66,8 @@ class EmulatedController:
         self.unlock_delay = unlock_delay
         self._lock = threading.RLock()
         self._inputs: dict[str, Any] = {}
+        self._input_stamps: dict[str, float] = {}  # when each input was last written
+        self._input_sockets: set[socket.socket] = set()  # the RTDE clients' connections
         self._out_int = [0] * 48
         self._out_double = [0.0] * 48
         self.robot_mode = RobotMode.RUNNING
@@ -181,9 +185,34 @@ class EmulatedController:
 
     def write_inputs(self, values: dict[str, Any]) -> None:
         """Apply an RTDE input package (registers, digital outputs, speed slider)."""
+        now = time.monotonic()
         with self._lock:
             self._inputs.update(values)
+            self._input_stamps.update(dict.fromkeys(values, now))
             self._apply_masks(values)
+
+    def input_silence(self, name: str, since: float) -> float:
+        """Seconds since input ``name`` was last written (or since ``since``, if later)."""
+        with self._lock:
+            return time.monotonic() - max(self._input_stamps.get(name, since), since)
+
+    def add_input_socket(self, conn: socket.socket, present: bool = True) -> None:
+        """An RTDE client's connection starts (or, ``present`` False, ends)."""
+        with self._lock:
+            if present:
+                self._input_sockets.add(conn)
+            else:
+                self._input_sockets.discard(conn)
+
+    def inputs_pending(self) -> bool:
+        """True while an RTDE client has sent bytes the emulator has not read yet: then a
+        silence is the emulator's own delay (a loaded machine), not the client's."""
+        with self._lock:
+            conns = [c for c in self._input_sockets if c.fileno() >= 0]
+        try:
+            return bool(conns) and bool(select.select(conns, [], [], 0)[0])
+        except (OSError, ValueError):  # closed meanwhile
+            return False
 
     def _apply_masks(self, values: dict[str, Any]) -> None:
         for prefix, shift in (("standard", 0), ("configurable", 8), ("tool", 16)):
@@ -260,6 +289,9 @@ class EmulatedController:
             self._program.end()
             self._program = None
             self.text(reason)
+            # A program stop decelerates the arm to a halt, as a UR does (a move left to
+            # the controller would otherwise go on to its target).
+            self.cell.robot.stop(4.0)
 
     # ---------------------------------------------------------------- arm
 

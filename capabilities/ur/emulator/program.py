@@ -10,6 +10,7 @@ command, 2 when done with it, and the asynchronous progress word in ``output_int
 from __future__ import annotations
 
 import logging
+import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
@@ -47,6 +48,8 @@ class ControlProgram:
         self._stop: CommandHandle | None = None  # an asynchronous stop under way
         self._op_id = 0
         self._writes = 0
+        self._watchdog: float | None = None  # s without an update of the command register
+        self._watchdog_since = 0.0
         self._handlers: dict[int, Callable[[], None]] = {
             MOVEJ: lambda: self._move_joints(self._floats(0, 6)),
             MOVEJ_IK: self._move_joints_ik,
@@ -67,8 +70,8 @@ class ControlProgram:
             GET_TCP_OFFSET: lambda: self._write_floats(0, ctl.tcp_rotvec()),
             IS_STEADY: lambda: self._write_int(1, int(not ctl.arm_moving())),
             SET_PAYLOAD: lambda: None,
-            SET_WATCHDOG: lambda: None,
-            WATCHDOG: lambda: None,
+            SET_WATCHDOG: self._set_watchdog,
+            WATCHDOG: lambda: None,  # ur_rtde's kick writes NO_CMD: this never arrives
             PROTECTIVE_STOP: lambda: ctl.protective_stop("triggered by the control script"),
         }
         self._progress(-1)
@@ -105,7 +108,9 @@ class ControlProgram:
     # ---------------------------------------------------------------- the main loop
 
     def step(self) -> bool:
-        """One controller cycle; False when the program ended (stop script)."""
+        """One controller cycle; False when the program ended (stop script, watchdog)."""
+        if self._watchdog_expired():
+            return False
         self._poll_motion()
         if self._sync is not None:
             return True
@@ -126,6 +131,24 @@ class ControlProgram:
         handler()
         if self._sync is None:
             self._write_int(0, DONE)
+        return True
+
+    def _set_watchdog(self) -> None:
+        """rtde_set_watchdog(register, frequency, "stop") on the command register."""
+        frequency = self._floats(0, 1)[0]
+        self._watchdog = 1.0 / frequency if frequency > 0 else None
+        self._watchdog_since = time.monotonic()
+
+    def _watchdog_expired(self) -> bool:
+        """True when the watched register was not written for a watchdog period: the
+        program stops, as rtde_set_watchdog's "stop" does (the arm halts with it)."""
+        if self._watchdog is None:
+            return False
+        register = f"input_int_register_{self._off}"
+        silence = self._ctl.input_silence(register, self._watchdog_since)
+        if silence <= self._watchdog or self._ctl.inputs_pending():
+            return False
+        self._ctl.text(f"RTDE watchdog: {register} not updated for {silence:.2f} s")
         return True
 
     def end(self) -> None:

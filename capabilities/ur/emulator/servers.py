@@ -275,7 +275,11 @@ class _RTDESession:
 def rtde_client(conn: socket.socket, ctl: EmulatedController, stop: threading.Event) -> None:
     """Serve one RTDE client until it disconnects."""
     session = _RTDESession(conn, ctl, stop)
-    while not stop.is_set():
-        size, kind = struct.unpack(">HB", _read_exact(conn, 3))
-        body = _read_exact(conn, size - 3) if size > 3 else b""
-        session.handle(kind, body)
+    ctl.add_input_socket(conn)  # the watchdog asks whether its bytes wait unread
+    try:
+        while not stop.is_set():
+            size, kind = struct.unpack(">HB", _read_exact(conn, 3))
+            body = _read_exact(conn, size - 3) if size > 3 else b""
+            session.handle(kind, body)
+    finally:
+        ctl.add_input_socket(conn, present=False)
