@@ -11,8 +11,9 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from capabilities.base import CapabilityRegistry
-from engine.btcpp import XmlExportError, XmlFileError, export_xml, load_xml
-from engine.files import PlanFileError, load_plan, save_plan
+from engine.btcpp import XmlExportError, XmlFileError, export_xml, read_xml
+from engine.btcpp.check import checked_plan_text
+from engine.files import PlanFileError, load_plan
 from engine.operations import OperationManifest
 from engine.plan_writer import write_atomic
 
@@ -41,10 +42,15 @@ def _cmd_export(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
 
 def _cmd_import(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    """Read the XML, check the plan as ``costar validate --cell none`` would (every operation
+    counted as available: there is no cell) and only then write it: a file import writes
+    always loads and validates."""
     ok, invalid = args.exit_codes
+    registry = CapabilityRegistry()
     try:
-        plan = load_xml(args.xml, operation_manifests())
-        save_plan(plan, args.out)
+        imported = read_xml(args.xml, operation_manifests(registry))
+        text = checked_plan_text(imported, registry)
+        write_atomic(Path(args.out), text.encode("utf-8"))
     except XmlFileError as exc:
         for problem in exc.problems:
             print(f"error: {problem.describe(exc.file)}", file=err)
@@ -52,7 +58,7 @@ def _cmd_import(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     except PlanFileError as exc:
         print(f"error: {exc}", file=err)
         return invalid
-    print(f"wrote {args.out}: plan {plan.name!r}", file=out)
+    print(f"wrote {args.out}: plan {imported.plan.name!r}", file=out)
     return ok
 
 

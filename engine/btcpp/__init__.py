@@ -53,7 +53,18 @@ A plan is written as::
 from __future__ import annotations
 
 from engine.btcpp.errors import XmlExportError, XmlFileError, XmlProblem
-from engine.btcpp.reader import import_xml, load_xml
+from engine.btcpp.imported import XmlImport, XmlLines
+from engine.btcpp.reader import import_xml, load_xml, read_xml
 from engine.btcpp.writer import export_xml
 
-__all__ = ["XmlExportError", "XmlFileError", "XmlProblem", "export_xml", "import_xml", "load_xml"]
+__all__ = [
+    "XmlExportError",
+    "XmlFileError",
+    "XmlImport",
+    "XmlLines",
+    "XmlProblem",
+    "export_xml",
+    "import_xml",
+    "load_xml",
+    "read_xml",
+]

@@ -26,14 +26,16 @@ class XmlExportError(EngineError):
 
 @dataclass(frozen=True)
 class XmlProblem:
-    """One thing wrong in an XML file: its line, what was expected and what was there."""
+    """One thing wrong in an XML file: its line (0: the file as a whole, not read), what was
+    expected and what was there."""
 
     line: int
     expected: str
     got: str
 
     def describe(self, file: str) -> str:
-        return f"{file}: line {self.line}: expected {self.expected}, got {self.got}"
+        where = f"line {self.line}: " if self.line > 0 else ""
+        return f"{file}: {where}expected {self.expected}, got {self.got}"
 
 
 class XmlFileError(EngineError):

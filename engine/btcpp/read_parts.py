@@ -5,9 +5,11 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from engine.btcpp.errors import XmlProblem
+from engine.btcpp.imported import XmlLines
 from engine.btcpp.names import decode_port
 from engine.btcpp.values import param_type_of_model, parse_value
 from engine.btcpp.xmltree import Element
@@ -35,11 +37,21 @@ class Model:
     ports: dict[str, tuple[str, ParamType, str | None, str]] = field(default_factory=dict)
 
 
-def read_models(element: Element | None) -> dict[str, Model]:
-    """The models of a ``<TreeNodesModel>`` by id (none when the file has none)."""
+def read_models(
+    element: Element | None, problem: Callable[[int, str, str], None] | None = None
+) -> dict[str, Model]:
+    """The models of a ``<TreeNodesModel>`` by id (none when the file has none).
+
+    Args:
+        element: the TreeNodesModel.
+        problem: told (line, expected, got) of a model whose ID an earlier one has.
+    """
     models: dict[str, Model] = {}
     for item in element.children if element is not None else []:
-        model = models.setdefault(item.attrs.get("ID", ""), Model(item.tag))
+        model_id = item.attrs.get("ID", "")
+        if model_id in models and problem is not None:
+            problem(item.line, "a model ID no other model has", repr(model_id))
+        model = models.setdefault(model_id, Model(item.tag))
         for port in item.children:
             doc = port.attrs.get("description") or port.text.strip()
             ptype = param_type_of_model(port.attrs.get("type"))
@@ -57,6 +69,7 @@ class ReaderBase:
     def __init__(self) -> None:
         self.problems: list[XmlProblem] = []
         self.models: dict[str, Model] = {}
+        self.lines = XmlLines()  # where the plan's parts are, for later problems
 
     def problem(self, line: int, expected: str, got: str) -> None:
         self.problems.append(XmlProblem(line, expected, got))
@@ -79,6 +92,7 @@ class ReaderBase:
         plan.scene = attrs.get("scene", "")
         for item in data.children:
             if item.tag == "Parameter":
+                self.lines.parameters[item.attrs.get("name", "")] = item.line
                 ptype = self._ptype(item, item.attrs.get("type", ""))
                 raw = item.attrs.get("value")
                 value = None if raw is None else self._value(item, ptype, raw, "value")

@@ -6,12 +6,13 @@ import os
 from collections.abc import Mapping
 
 from engine.btcpp.errors import XmlFileError, XmlProblem
+from engine.btcpp.imported import XmlImport
 from engine.btcpp.infer import infer_subtree_ports, instances_of
 from engine.btcpp.logic import LOGIC_BY_MODEL, LogicModel
 from engine.btcpp.names import decode_id, decode_port
 from engine.btcpp.read_parts import Model, ReaderBase, read_models
 from engine.btcpp.writer import UNUSED_OUTPUT
-from engine.btcpp.xmltree import Element, XmlSyntaxError, parse
+from engine.btcpp.xmltree import Element, XmlSyntaxError, XmlTooLarge, parse, parse_file
 from engine.kinds import setting as kind_setting
 from engine.operations import Direction, OperationManifest
 from engine.spec import (
@@ -27,7 +28,7 @@ from engine.spec import (
 )
 from engine.types import ParamType
 
-__all__ = ["import_xml", "load_xml"]
+__all__ = ["import_xml", "load_xml", "read_xml"]
 
 _EXPLICIT = ("Action", "Condition", "Control", "Decorator")
 # BehaviorTree.CPP's pre- and post-conditions: scripts we cannot run, so not dropped quietly.
@@ -52,20 +53,30 @@ class _Reader(ReaderBase):
         groups: dict[str, list[Element]] = {}
         for child in root.children:
             groups.setdefault(child.tag, []).append(child)
+        self.lines.root = root.line
         for extra in groups.get("TreeNodesModel", [])[1:]:
             self.problem(extra.line, "one <TreeNodesModel>", "a second one")
-        self.models = read_models(next(iter(groups.get("TreeNodesModel", [])), None))
+        self.models = read_models(next(iter(groups.get("TreeNodesModel", [])), None), self.problem)
+        for extra in groups.get("CostarPlan", [])[1:]:
+            self.problem(extra.line, "one <CostarPlan>", "a second one")
         data = next(iter(groups.get("CostarPlan", [])), None)
         self.foreign = data is None
         trees: dict[str, Element] = {}
         for index, tree in enumerate(groups.get("BehaviorTree", [])):
-            # BehaviorTree.CPP writes a loaded tree with one BehaviorTree per instance.
-            trees.setdefault(tree.attrs.get("ID", f"BehaviorTree_{index}"), tree)
+            tree_id = tree.attrs.get("ID", f"BehaviorTree_{index}")
+            if tree_id in trees and not self.foreign:
+                # BehaviorTree.CPP writes a loaded tree with one BehaviorTree per instance;
+                # we write each tree once, so in our files a second one is a mistake.
+                self.problem(
+                    tree.line, "a BehaviorTree ID no other BehaviorTree has", repr(tree_id)
+                )
+            trees.setdefault(tree_id, tree)
         main_id = self._main_id(root, data, trees)
         plan = PlanSpec(name=main_id or "")
         for tree_id, element in trees.items():
             if tree_id != main_id:
                 self.subtrees[tree_id] = sub = self._subtree(tree_id, element)
+                self._check_subtree_ref(sub, element)
                 if tree_id not in self.models:  # written by BehaviorTree.CPP or Groot2
                     instances = instances_of(tree_id, list(trees.values()))
                     sub.inputs, sub.outputs = infer_subtree_ports(
@@ -81,6 +92,16 @@ class _Reader(ReaderBase):
         if data is not None:
             self._plan_data(data, plan)
         return plan
+
+    def _check_subtree_ref(self, sub: SubtreeSpec, element: Element) -> None:
+        """A plan holds each subtree version once (its file reader refuses a second)."""
+        if any(other.ref == sub.ref for other in self.subtrees.values() if other is not sub):
+            self.problem(
+                element.line,
+                "each subtree version once (a _uid and _version no other BehaviorTree has)",
+                f"{sub.id!r} version {sub.version} a second time",
+            )
+        self.lines.subtrees.setdefault(sub.ref, element.line)
 
     def _port_info(self, element: Element, attr: str) -> tuple[Direction, ParamType] | None:
         """The direction and type of a port of an operation node, if it is known."""
@@ -136,6 +157,7 @@ class _Reader(ReaderBase):
         if node.id in self.ids:
             self.problem(element.line, "a _uid no other node has", repr(node.id))
         self.ids.add(node.id)
+        self.lines.nodes.setdefault(node.id, element.line)
         where = self._layout(element)
         if where is not None:
             layout[node.id] = where
@@ -272,6 +294,20 @@ def _setting_text(text: str) -> str | float:
         return text
 
 
+def _read(
+    root: Element, source_name: str, manifests: Mapping[str, OperationManifest] | None
+) -> XmlImport:
+    reader = _Reader(manifests)
+    plan = reader.plan(root)
+    if reader.problems:
+        raise XmlFileError(source_name, reader.problems)
+    return XmlImport(plan, reader.lines, source_name)
+
+
+def _syntax_error(file: str, exc: XmlSyntaxError) -> XmlFileError:
+    return XmlFileError(file, [XmlProblem(exc.line, "well-formed UTF-8 XML", str(exc))])
+
+
 def import_xml(
     text: str,
     source_name: str = "<string>",
@@ -293,33 +329,43 @@ def import_xml(
     try:
         root = parse(text)
     except XmlSyntaxError as exc:
+        raise _syntax_error(source_name, exc) from None
+    return _read(root, source_name, manifests).plan
+
+
+def read_xml(
+    path: str | os.PathLike[str], manifests: Mapping[str, OperationManifest] | None = None
+) -> XmlImport:
+    """Read a BehaviorTree.CPP XML file (see :func:`import_xml`), with the line of each part.
+
+    The file's size is checked before it is read (at most
+    :data:`engine.btcpp.xmltree.MAX_FILE_BYTES`), and it is read in chunks.
+
+    Raises:
+        XmlFileError: the file cannot be read, is too large, is not UTF-8, or has problems.
+    """
+    file = os.fspath(path)
+    try:
+        with open(file, "rb") as handle:
+            root = parse_file(handle)
+    except OSError as exc:
         raise XmlFileError(
-            source_name, [XmlProblem(exc.line, "well-formed XML", str(exc))]
+            file, [XmlProblem(0, "a readable file", exc.strerror or str(exc))]
         ) from None
-    reader = _Reader(manifests)
-    plan = reader.plan(root)
-    if reader.problems:
-        raise XmlFileError(source_name, reader.problems)
-    return plan
+    except XmlTooLarge as exc:
+        expected = f"a tree file of at most {exc.limit // 1_000_000} MB ({exc.limit} bytes)"
+        raise XmlFileError(file, [XmlProblem(0, expected, f"{exc.size} bytes")]) from None
+    except XmlSyntaxError as exc:
+        raise _syntax_error(file, exc) from None
+    return _read(root, file, manifests)
 
 
 def load_xml(
     path: str | os.PathLike[str], manifests: Mapping[str, OperationManifest] | None = None
 ) -> PlanSpec:
-    """Read a BehaviorTree.CPP XML file (see :func:`import_xml`).
+    """Read a BehaviorTree.CPP XML file (see :func:`import_xml` and :func:`read_xml`).
 
     Raises:
-        XmlFileError: the file cannot be read, is not UTF-8, or has problems.
+        XmlFileError: the file cannot be read, is too large, is not UTF-8, or has problems.
     """
-    file = os.fspath(path)
-    try:
-        with open(file, "rb") as handle:
-            data = handle.read()
-        text = data.decode("utf-8")
-    except OSError as exc:
-        raise XmlFileError(
-            file, [XmlProblem(0, "a readable file", exc.strerror or str(exc))]
-        ) from None
-    except UnicodeDecodeError as exc:
-        raise XmlFileError(file, [XmlProblem(0, "UTF-8 text", f"byte {exc.start}")]) from None
-    return import_xml(text, file, manifests)
+    return read_xml(path, manifests).plan
