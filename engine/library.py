@@ -18,7 +18,7 @@ A lock names its writer (PID, host, start time). A writer killed mid-save (kill 
 cut) leaves its lock and maybe a temporary file: the next save breaks a lock whose process is
 gone from this host, or that is unreadable or older than :data:`STALE_LOCK_SECONDS`, at once,
 and removes the temporary files of the file it now holds the lock of; :meth:`Library.scan`
-removes temporary files older than :data:`STALE_TEMP_SECONDS`. A live lock of another host is
+removes temporary files next to a stale lock, or older than :data:`STALE_TEMP_SECONDS`. A live lock of another host is
 waited for, at most :attr:`Library.lock_wait` seconds.
 
 Folders are relative to the library's root and stay inside it (:func:`check_folder`); a file
@@ -246,7 +246,7 @@ class Library:
         Temporary files a dead writer left in the writable folder are removed first. The lists
         are replaced whole, so a save on another thread sees the old or the new ones.
         """
-        _remove_old_temps(self.root)
+        _remove_dead_temps(self.root)
         entries: list[LibraryEntry] = []
         problems: list[str] = []
         for base, shipped in [(self.root, False), *((p, True) for p in self.shipped)]:
@@ -397,7 +397,7 @@ def _locked(target: Path, wait: float = LOCK_WAIT_SECONDS) -> Iterator[None]:
             fd = os.open(lock, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
             break
         except FileExistsError:
-            if _break_if_stale(lock):
+            if _break_if_stale(lock) and time.monotonic() <= deadline:
                 continue
             if time.monotonic() > deadline:
                 raise LibraryError(
@@ -466,8 +466,7 @@ def _break_if_stale(lock: Path) -> bool:
         return True
     except OSError:
         return False
-    owner = _read_owner(lock)
-    if not _is_stale(lock, owner, time.time() - before.st_mtime):
+    if not _is_stale(lock, _read_owner(lock), time.time() - before.st_mtime):
         return False
     try:
         now = os.stat(lock)
@@ -506,17 +505,18 @@ def _windows_process_alive(pid: int) -> bool:  # pragma: no cover - Windows only
     """os.kill(pid, 0) would end the process on Windows: ask OpenProcess instead."""
     import ctypes
 
-    kernel32 = ctypes.windll.kernel32  # type: ignore[attr-defined,unused-ignore]
+    kernel32 = ctypes.WinDLL("kernel32", use_last_error=True)  # type: ignore[attr-defined,unused-ignore]
+    kernel32.OpenProcess.restype = ctypes.c_void_p
     handle = kernel32.OpenProcess(0x1000, False, pid)  # PROCESS_QUERY_LIMITED_INFORMATION
     if not handle:
-        return bool(kernel32.GetLastError() == 5)  # access denied: it exists
+        return bool(ctypes.get_last_error() == 5)  # type: ignore[attr-defined,unused-ignore]
     try:
         code = ctypes.c_ulong()
-        if not kernel32.GetExitCodeProcess(handle, ctypes.byref(code)):
+        if not kernel32.GetExitCodeProcess(ctypes.c_void_p(handle), ctypes.byref(code)):
             return True
         return bool(code.value == 259)  # STILL_ACTIVE
     finally:
-        kernel32.CloseHandle(handle)
+        kernel32.CloseHandle(ctypes.c_void_p(handle))
 
 
 def _remove_temps_of(target: Path) -> None:
@@ -530,15 +530,26 @@ def _remove_temps_of(target: Path) -> None:
                     path.unlink()
 
 
-def _remove_old_temps(root: Path) -> None:
-    """Remove the library's temporary files older than any save takes."""
+def _remove_dead_temps(root: Path) -> None:
+    """Remove the library's temporary files whose writer is gone: its lock is stale (a killed
+    save leaves both), or the file is older than any save takes."""
     if not root.is_dir():
         return
     now = time.time()
     with contextlib.suppress(OSError):
         for path in root.rglob(".*.tmp"):
-            if not _TEMP.fullmatch(path.name):
+            match = _TEMP.fullmatch(path.name)
+            if not match:
                 continue
             with contextlib.suppress(OSError):
-                if now - path.stat().st_mtime > STALE_TEMP_SECONDS:
+                lock = path.with_name(f".{match['target']}.lock")
+                if now - path.stat().st_mtime > STALE_TEMP_SECONDS or _stale_lock_there(lock):
                     path.unlink()
+
+
+def _stale_lock_there(lock: Path) -> bool:
+    try:
+        age = time.time() - os.stat(lock).st_mtime
+    except OSError:
+        return False  # no lock: an old temporary file goes by its age only
+    return _is_stale(lock, _read_owner(lock), age)

@@ -141,7 +141,7 @@ def test_a_save_after_kill_9_of_a_saving_process_succeeds_at_once(tmp_path: Path
     assert owner["pid"] == writer.pid and owner["host"] and owner["started"] > 0
     assert len(list(root.glob(".Pick.subtree.json.*.tmp"))) == 1
     # a fresh lock: only its dead PID says it is stale (a short wait fails a regression fast)
-    library = Library(root, shipped=(), lock_wait=0.2).scan()
+    library = Library(root, shipped=(), lock_wait=0.2)  # not listed: the save cleans up
     saved = library.save(pick_subtree())
     assert saved.version == 1
     assert load_subtree(root / "Pick.subtree.json") == saved
@@ -195,6 +195,28 @@ def test_an_earlier_instructors_lock_holds_its_pid_only(tmp_path: Path) -> None:
         library.save(pick_subtree())
     os.utime(lock, (time.time() - 2 * STALE_LOCK_SECONDS,) * 2)
     assert library.save(pick_subtree()).version == 1
+
+
+def _dead_pid() -> int:
+    process = subprocess.Popen([sys.executable, "-c", "pass"])
+    process.wait(30)
+    return process.pid
+
+
+def test_a_dead_writers_temporary_file_is_removed_when_the_library_is_listed(
+    tmp_path: Path,
+) -> None:
+    owner = {"pid": _dead_pid(), "host": socket.gethostname(), "started": time.time()}
+    lock = _lock(tmp_path, "Pick.subtree.json", json.dumps(owner))
+    left = tmp_path / ".Pick.subtree.json.89abcdef.tmp"
+    left.write_text("{")
+    live = {"pid": os.getpid(), "host": socket.gethostname(), "started": time.time()}
+    _lock(tmp_path, "Other.subtree.json", json.dumps(live))
+    writing = tmp_path / ".Other.subtree.json.01234567.tmp"  # its writer is alive
+    writing.write_text("{")
+    library = Library(tmp_path, shipped=()).scan()
+    assert not left.exists() and writing.exists() and library.problems == []
+    assert library.save(pick_subtree()).version == 1 and not lock.exists()
 
 
 def test_old_temporary_files_are_removed_when_the_library_is_listed(tmp_path: Path) -> None:
