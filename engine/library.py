@@ -18,8 +18,8 @@ A lock names its writer (PID, host, start time). A writer killed mid-save (kill 
 cut) leaves its lock and maybe a temporary file: the next save breaks a lock whose process is
 gone from this host, or that is unreadable or older than :data:`STALE_LOCK_SECONDS`, at once,
 and removes the temporary files of the file it now holds the lock of; :meth:`Library.scan`
-removes temporary files next to a stale lock, or older than :data:`STALE_TEMP_SECONDS`. A live lock of another host is
-waited for, at most :attr:`Library.lock_wait` seconds.
+removes temporary files next to a stale lock, or older than :data:`STALE_TEMP_SECONDS`. A
+live lock of another host is waited for, at most :attr:`Library.lock_wait` seconds.
 
 Folders are relative to the library's root and stay inside it (:func:`check_folder`); a file
 name keeps the letters and digits of any script (:func:`file_name`).
@@ -441,7 +441,7 @@ def _owner_text(lock: Path) -> str:
     return f"process {owner['pid']} on {owner['host']}" if owner else "an unknown writer"
 
 
-def _is_stale(lock: Path, owner: dict[str, object] | None, age: float) -> bool:
+def _is_stale(owner: dict[str, object] | None, age: float) -> bool:
     """A lock nobody holds: its process is gone from this host, it names no owner (and is not
     being written), or it is older than any save takes."""
     if age > STALE_LOCK_SECONDS:
@@ -466,7 +466,7 @@ def _break_if_stale(lock: Path) -> bool:
         return True
     except OSError:
         return False
-    if not _is_stale(lock, _read_owner(lock), time.time() - before.st_mtime):
+    if not _is_stale(_read_owner(lock), time.time() - before.st_mtime):
         return False
     try:
         now = os.stat(lock)
@@ -552,4 +552,4 @@ def _stale_lock_there(lock: Path) -> bool:
         age = time.time() - os.stat(lock).st_mtime
     except OSError:
         return False  # no lock: an old temporary file goes by its age only
-    return _is_stale(lock, _read_owner(lock), age)
+    return _is_stale(_read_owner(lock), age)
