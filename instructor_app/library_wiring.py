@@ -5,11 +5,19 @@
 turns the panel's and menu's requests into document edits
 (:class:`instructor_app.document.subtree_edits.SubtreeEditor`, each an undo step) and library
 saves. Nothing here draws: the panel and the canvas show what the document holds.
+
+A library save runs on a worker thread (it may wait for another Instructor's lock, or for a
+slow network folder) and comes back through a queued signal; the GUI thread only builds the
+subtree before and puts the instance in after.
 """
 
 from __future__ import annotations
 
+import contextlib
+import copy
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -18,7 +26,7 @@ from PySide6.QtGui import QAction
 from PySide6.QtWidgets import QDialog, QFileDialog, QMenu, QWidget
 
 from engine.library import Library, LibraryEntry, LibraryError
-from engine.spec import NodeKind, SubtreeSpec
+from engine.spec import NodeKind, NodeSpec, SubtreeSpec
 from engine.subtree_ops import Usage, find_usages, ports_of
 from instructor_app.document.editing import PlanDocument
 from instructor_app.document.model import DocumentError
@@ -40,6 +48,15 @@ def library_palette_items(library: Library) -> list[PaletteItem]:
     ]  # fmt: skip
 
 
+@dataclass(frozen=True)
+class _PendingSave:
+    """A save on its way: the node it replaces, as it was when the save began."""
+
+    node_id: str
+    node: NodeSpec
+    choices: SubtreeChoices
+
+
 class LibraryController(QObject):
     """The library's panel, menu and edits in one window.
 
@@ -53,9 +70,13 @@ class LibraryController(QObject):
 
     Signals:
         message(str): something to show in the status bar.
+        save_finished(object): a save asked by :meth:`save_as_subtree` is over: the saved
+            SubtreeSpec, or None when it failed (the message says why).
     """
 
     message = Signal(str)
+    save_finished = Signal(object)
+    _saved = Signal(object, object)  # from the saving thread: (_PendingSave, spec or why not)
 
     def __init__(
         self,
@@ -74,6 +95,9 @@ class LibraryController(QObject):
         self.window = parent
         self.editor = SubtreeEditor(document)
         self.library = Library(root)
+        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="costar-library-save")
+        self._saving = False
+        self._saved.connect(self._on_saved)
         self.dialog_factory: Callable[..., SaveSubtreeDialog] = SaveSubtreeDialog
         self.folder_chooser: Callable[[], str] = lambda: QFileDialog.getExistingDirectory(
             parent, "Find usages in the plans of this folder"
@@ -121,21 +145,72 @@ class LibraryController(QObject):
     def _insert_under(self, subtree_id: str, parent_id: str | None) -> str:
         return self.editor.insert_instance(self.subtree(subtree_id), parent_id)
 
-    def save_as_subtree(self, node_id: str, choices: SubtreeChoices) -> SubtreeSpec | None:
-        """Save a node and those below it to the library; an instance takes their place."""
+    def save_as_subtree(self, node_id: str, choices: SubtreeChoices) -> bool:
+        """Save a node and those below it to the library, off the GUI thread; once saved, an
+        instance takes their place and ``save_finished`` says so. False (and a message) when
+        the save is refused at once (a bad port, a save already under way)."""
+        if self._saving:
+            self.message.emit("Cannot save the subtree: another save is under way; try again")
+            return False
         try:
             made = self.editor.save_as_subtree(
                 node_id, choices.name, self.registry(), choices.open_ports, choices.outputs,
                 choices.description,
             )  # fmt: skip
-            saved = self.library.save(made, choices.folder)
-        except (DocumentError, LibraryError) as exc:
+            pending = _PendingSave(node_id, copy.deepcopy(self.document.node(node_id)), choices)
+        except DocumentError as exc:
             self.message.emit(f"Cannot save the subtree: {exc}")
-            return None
-        self.editor.use_saved(node_id, saved, choices.open_ports)
+            return False
+        self._saving = True
+        self.actions["save_subtree"].setEnabled(False)
+        self.message.emit(f"Saving {made.name} to the library…")
+        self._pool.submit(self._save, made, pending)
+        return True
+
+    @property
+    def saving(self) -> bool:
+        """True while a library save runs."""
+        return self._saving
+
+    def _save(self, made: SubtreeSpec, pending: _PendingSave) -> None:
+        """On the worker thread: the library save only (no document, no widget)."""
+        try:
+            outcome: object = self.library.save(made, pending.choices.folder)
+        except LibraryError as exc:
+            outcome = f"Cannot save the subtree: {exc}"
+        except Exception as exc:  # an unexpected failure must still end the save in the GUI
+            outcome = f"Cannot save the subtree: {type(exc).__name__}: {exc}"
+        with contextlib.suppress(RuntimeError):  # the window is gone
+            self._saved.emit(pending, outcome)
+
+    def _on_saved(self, pending: object, outcome: object) -> None:
+        assert isinstance(pending, _PendingSave)
+        self._saving = False
+        self.actions["save_subtree"].setEnabled(True)
+        if not isinstance(outcome, SubtreeSpec):
+            self.message.emit(str(outcome))
+            self.save_finished.emit(None)
+            return
+        try:
+            unchanged = self.document.node(pending.node_id) == pending.node
+        except DocumentError:  # deleted, or another plan opened
+            unchanged = False
+        if unchanged:
+            self.editor.use_saved(pending.node_id, outcome, pending.choices.open_ports)
         self.reload()
-        self.message.emit(f"Saved {saved.name} (version {saved.version}) to the library")
-        return saved
+        if unchanged:
+            self.message.emit(f"Saved {outcome.name} (version {outcome.version}) to the library")
+        else:
+            self.message.emit(
+                f"Saved {outcome.name} (version {outcome.version}) to the library; the nodes "
+                "changed meanwhile, so they were left as they are"
+            )
+        self.save_finished.emit(outcome)
+
+    def shutdown(self) -> None:
+        """Let a save under way finish on its thread (its file is written whole or not at
+        all); nothing new starts."""
+        self._pool.shutdown(wait=False, cancel_futures=True)
 
     def detach(self, node_id: str) -> str | None:
         try:

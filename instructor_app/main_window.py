@@ -464,6 +464,7 @@ class MainWindow(QMainWindow):
         self.cell_views.stop()
         self.views.teacher.shutdown()
         self.views.objects.shutdown()
+        self.library.shutdown()
         self.autosaver.stop()
 
     def closeEvent(self, event: QCloseEvent) -> None:

@@ -2,17 +2,19 @@
 
 Save a selection as a subtree (the dialog's tables), the Library panel (folders, search,
 preview, insert, find usages), palette search-to-insert of a library subtree, an instance's
-binding form in the inspector, detach and update, each one undo step.
+binding form in the inspector, detach and update, each one undo step. A library save runs off
+the GUI thread: a lock held elsewhere does not stop the window.
 """
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
 from typing import Any
 
 import pytest
-from PySide6.QtCore import QPointF, Qt
+from PySide6.QtCore import QPointF, Qt, QTimer
 from PySide6.QtGui import QDropEvent
 from PySide6.QtWidgets import QDialog
 
@@ -71,7 +73,16 @@ def _node(window: MainWindow, name: str) -> NodeSpec:
 
 def _save_part_with_open_message(qtbot: Any, window: MainWindow) -> str:
     """Select "part", open Save as subtree, tick its message as the input MESSAGE and OUT as
-    an output, save; returns the instance's id."""
+    an output, save; returns the instance's id once the save is over."""
+    with qtbot.waitSignal(window.library.save_finished, timeout=20000) as finished:
+        _ask_to_save_part(window)
+    assert finished.args[0] is not None, "the save failed"
+    return _node(window, "part").id
+
+
+def _ask_to_save_part(window: MainWindow, folder: str = "tests") -> None:
+    """Select "part" and save it as a subtree (MESSAGE open, OUT an output) in ``folder``; the
+    save runs on."""
     shown: list[SaveSubtreeDialog] = []
 
     def dialog(*args: Any) -> SaveSubtreeDialog:
@@ -79,7 +90,7 @@ def _save_part_with_open_message(qtbot: Any, window: MainWindow) -> str:
         row = made.parameter_rows().index("say / message")
         made.set_open(row, "MESSAGE", "what to say")
         made.set_output(made.output_rows().index("OUT"), "the kept value")
-        made.folder_field.setText("tests")
+        made.folder_field.setText(folder)
         made.exec = lambda: QDialog.DialogCode.Accepted  # type: ignore[method-assign]
         shown.append(made)
         return made
@@ -88,7 +99,6 @@ def _save_part_with_open_message(qtbot: Any, window: MainWindow) -> str:
     select(window, _node(window, "part").id)
     window.library.actions["save_subtree"].trigger()
     assert shown, "the dialog was not shown"
-    return _node(window, "part").id
 
 
 def test_save_selection_as_subtree_runs_undoes_and_detaches(
@@ -230,3 +240,72 @@ def test_a_subtree_dragged_from_the_library_onto_a_node_becomes_its_child(
     added = window.document.plan.tree.children[-1]  # type: ignore[union-attr]
     assert added.kind is NodeKind.SUBTREE and added.name == "Unholster"
     assert [s.name for s in window.document.plan.subtrees] == ["Unholster"]
+
+
+def _messages(window: MainWindow) -> list[str]:
+    said: list[str] = []
+    window.library.message.connect(said.append)
+    return said
+
+
+def _hold_lock_elsewhere(folder: Path, name: str) -> Path:
+    """A live lock of another Instructor, on another host: a save waits for it."""
+    folder.mkdir(parents=True, exist_ok=True)
+    lock = folder / f".{name}.lock"
+    owner = {"pid": 1, "host": "another-host.invalid", "started": 0}
+    lock.write_text(json.dumps(owner), encoding="utf-8")
+    return lock
+
+
+def test_a_save_waiting_for_a_lock_does_not_block_the_window(
+    qtbot: Any, window: MainWindow, tmp_path: Path
+) -> None:
+    _open(window, tmp_path, _plan())
+    library = Path(os.environ[LIBRARY_ENV])
+    lock = _hold_lock_elsewhere(library / "tests", "part.subtree.json")
+    window.library.library.lock_wait = 120.0  # it waits as long as the test holds the lock
+    _ask_to_save_part(window)  # returns while the save waits for the lock
+    assert window.library.saving and lock.exists()
+    assert not window.library.actions["save_subtree"].isEnabled()
+    ticked: list[bool] = []
+    QTimer.singleShot(0, lambda: ticked.append(True))
+    qtbot.waitUntil(lambda: ticked == [True])  # the window's event loop runs meanwhile
+    assert window.library.saving and _node(window, "part").kind is NodeKind.SEQUENCE
+    with qtbot.waitSignal(window.library.save_finished, timeout=20000) as finished:
+        lock.unlink()  # the other Instructor is done
+    assert finished.args[0] is not None and finished.args[0].name == "part"
+    assert (library / "tests" / "part.subtree.json").exists()
+    assert _node(window, "part").kind is NodeKind.SUBTREE
+    assert window.library.actions["save_subtree"].isEnabled() and not window.library.saving
+
+
+def test_nodes_changed_while_saving_are_left_as_they_are(
+    qtbot: Any, window: MainWindow, tmp_path: Path
+) -> None:
+    _open(window, tmp_path, _plan())
+    lock = _hold_lock_elsewhere(Path(os.environ[LIBRARY_ENV]) / "tests", "part.subtree.json")
+    window.library.library.lock_wait = 120.0
+    said = _messages(window)
+    _ask_to_save_part(window)
+    set_value(qtbot, window, _node(window, "say").id, "message", "changed meanwhile")
+    with qtbot.waitSignal(window.library.save_finished, timeout=20000):
+        lock.unlink()
+    assert _node(window, "part").kind is NodeKind.SEQUENCE
+    assert _node(window, "say").params["message"] == _text("changed meanwhile")
+    assert "left as they are" in said[-1]
+
+
+@pytest.mark.parametrize("folder", ["/tmp/outside", "C:\\x", "a/../../b", "a\x00b"])
+def test_a_folder_outside_the_library_is_refused_in_the_window(
+    qtbot: Any, window: MainWindow, tmp_path: Path, folder: str
+) -> None:
+    _open(window, tmp_path, _plan())
+    said = _messages(window)
+    with qtbot.waitSignal(window.library.save_finished, timeout=20000) as finished:
+        _ask_to_save_part(window, folder)
+    assert finished.args[0] is None
+    assert (
+        "Cannot save the subtree" in said[-1] and "expected a folder inside the library" in said[-1]
+    )
+    assert _node(window, "part").kind is NodeKind.SEQUENCE
+    assert not list(Path(os.environ[LIBRARY_ENV]).rglob("*.subtree.json"))
