@@ -21,12 +21,6 @@ from capabilities.collaboration.console import (
     Prompt,
     PromptState,
 )
-from capabilities.collaboration.handoff import (
-    HandoffJob,
-    HandoffSettings,
-    in_region,
-    object_markers,
-)
 from capabilities.kit import CAMERAS, camera, manifest
 from capabilities.world_model import Detection, WorldModel
 from engine.error_types import ErrorType
@@ -175,6 +169,10 @@ class WaitForHandoff:
         self._env = env
 
     def start(self, call: OperationCall) -> Job:
+        # Imported here: the handoff's marker detection needs numpy and OpenCV, which the
+        # manifests (costar ops, validation, XML) do not.
+        from capabilities.collaboration.handoff import HandoffJob, HandoffSettings, object_markers
+
         what = "wait_for_handoff"
         device = camera(self._env, call.input("camera"))
         world: WorldModel = _interface(self._env, "world", what)
@@ -213,6 +211,8 @@ class ObjectInRegion:
         max_age = _seconds(call, "max_age")
         if max_age > 0 and call.clock() - detection.stamp > max_age:
             return Job.answer(False)
+        from capabilities.collaboration.handoff import in_region
+
         return Job.answer(in_region(detection.pose, call.input("region")))
 
 

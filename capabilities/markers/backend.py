@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any, Protocol
-
-import numpy as np
+from typing import TYPE_CHECKING, Any, Protocol
 
 from engine.types import Pose
+
+if TYPE_CHECKING:  # numpy only for the annotations: manifests load without it
+    import numpy as np
 
 __all__ = ["CameraDevice", "FrameLike", "MarkerLayout"]
 

@@ -9,19 +9,11 @@ then read the world model, so they answer at once.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from capabilities.base import Capability, CapabilityEnv
 from capabilities.kit import CAMERAS, camera, manifest, stateful
 from capabilities.markers.backend import CameraDevice
-from capabilities.markers.calibration import calibrate_extrinsics
-from capabilities.markers.depth import refine_with_depth
-from capabilities.markers.detection import (
-    MarkerObservation,
-    detect_markers,
-    marker_pose_world,
-    object_pose_from_marker,
-)
 from capabilities.world_model import Detection, WorldModel
 from engine.error_types import ErrorType
 from engine.operations import (
@@ -33,6 +25,12 @@ from engine.operations import (
     PortSpec,
 )
 from engine.types import ObjectModel, ParamType, Pose
+
+if TYPE_CHECKING:
+    from capabilities.markers.detection import MarkerObservation
+
+# Detection and calibration (OpenCV, numpy) are imported where an operation runs, so the
+# manifests (costar ops, validation, XML) load without them.
 
 __all__ = ["capability"]
 
@@ -79,6 +77,8 @@ def _object_detections(
     source: str,
 ) -> list[Detection]:
     """One detection per object: from its most confident visible marker."""
+    from capabilities.markers.detection import object_pose_from_marker
+
     best: dict[str, Detection] = {}
     for marker_id, (observation, world_pose) in seen.items():
         if marker_id not in carriers or observation.confidence < MIN_CONFIDENCE:
@@ -98,6 +98,9 @@ class DetectMarkers:
         self._env = env
 
     def start(self, call: OperationCall) -> Job:
+        from capabilities.markers.depth import refine_with_depth
+        from capabilities.markers.detection import detect_markers, marker_pose_world
+
         camera = self._env.camera(call.input("camera"))
         env = self._env
 
@@ -169,6 +172,9 @@ class CalibrateCamera:
         self._env = env
 
     def start(self, call: OperationCall) -> Job:
+        from capabilities.markers.calibration import calibrate_extrinsics
+        from capabilities.markers.detection import detect_markers
+
         camera = self._env.camera(call.input("camera"))
         if camera.on_wrist:
             raise OperationFailed(

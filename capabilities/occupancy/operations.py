@@ -13,12 +13,11 @@ of cell time passes. ``count_points`` always takes a fresh frame.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from capabilities.base import Capability
+from capabilities.base import Capability, CapabilityEnv
 from capabilities.kit import CAMERAS, manifest
-from capabilities.occupancy.feed import CameraFeed, Capture
-from capabilities.occupancy.state import SETTINGS, OccupancyState, setup
+from capabilities.occupancy.settings import SETTINGS
 from engine.error_types import ErrorType
 from engine.operations import (
     Direction,
@@ -30,6 +29,10 @@ from engine.operations import (
 )
 from engine.status import RUNNING, Status
 from engine.types import ParamType, Region
+
+if TYPE_CHECKING:  # the point-cloud code (numpy) loads with the first cell's setup
+    from capabilities.occupancy.feed import CameraFeed, Capture
+    from capabilities.occupancy.state import OccupancyState
 
 __all__ = ["FeedJob", "capability"]
 
@@ -258,6 +261,13 @@ class CountPoints:
 
         # A frame taken after this call started: stamped at or after now.
         return FeedJob(feed, state.clock, decide, state.clock(), 0.0)
+
+
+def setup(env: CapabilityEnv) -> OccupancyState:
+    """The per-cell hook (``state.setup``), imported when a cell first needs it."""
+    from capabilities.occupancy import state
+
+    return state.setup(env)
 
 
 def capability() -> Capability:

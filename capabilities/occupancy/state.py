@@ -15,9 +15,9 @@ import numpy as np
 
 from capabilities import kit
 from capabilities.base import CapabilityEnv
-from capabilities.kit import Setting
 from capabilities.occupancy.feed import CameraFeed, Capture
 from capabilities.occupancy.region import RegionReading, estimate_table_z, read_region
+from capabilities.occupancy.settings import SETTINGS
 from capabilities.robot_body import (
     RobotBody,
     RobotBodyError,
@@ -29,16 +29,6 @@ from engine.operations import OperationFailed
 from engine.types import Pose, Region
 
 __all__ = ["SETTINGS", "OccupancyState", "setup"]
-
-SETTINGS = (
-    Setting("table_z", float, None, "height (m) of the table top; without it the table plane "
-            "is found in the frames of a fixed camera (the fullest horizontal slice)"),
-    Setting("table_margin", float, 0.008, "points this close (m) to the table plane are the table"),
-    Setting("robot_base", Pose, None, "world pose of the robot's base frame (default: from the arm)"),
-    Setting("mask_inflate", float, 0.02, "how much (m) the robot's capsules grow when masking"),
-    Setting("tool_radius", float, 0.07, "radius (m) of the tool's capsule (the parallel gripper)"),
-    Setting("refresh_period", float, 0.1, "a frame older than this (s of cell time) is renewed"),
-)  # fmt: skip
 
 
 class OccupancyState:

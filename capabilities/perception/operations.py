@@ -15,14 +15,12 @@ from __future__ import annotations
 import math
 import threading
 import weakref
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from capabilities.base import Capability, CapabilityEnv
 from capabilities.kit import CAMERAS, camera, manifest, stateful
 from capabilities.perception.config import SETTINGS, RecognitionConfig
 from capabilities.perception.errors import PerceptionError
-from capabilities.perception.recognizer import Recognizer
-from capabilities.perception.tracker import SurfaceTracker
 from capabilities.world_model import Detection, WorldModel
 from engine.error_types import ErrorType
 from engine.operations import (
@@ -36,6 +34,10 @@ from engine.operations import (
 from engine.types import ObjectModel, ParamType, Pose
 
 __all__ = ["SOURCE_PREFIX", "capability"]
+
+if TYPE_CHECKING:  # recognition (numpy, Open3D, OpenCV) loads when a cell first recognises
+    from capabilities.perception.recognizer import Recognizer
+    from capabilities.perception.tracker import SurfaceTracker
 
 CAP = "perception"
 SOURCE_PREFIX = "perception:"
@@ -53,6 +55,8 @@ class _Shared:
         )
 
     def recognizer(self, library: Any, config: RecognitionConfig) -> Recognizer:
+        from capabilities.perception.recognizer import Recognizer
+
         with self._lock:
             found = self._recognizers.get(library)
             if found is None or found.config != config:
@@ -60,6 +64,8 @@ class _Shared:
             return found
 
     def tracker(self, world: Any, camera: str, library: Any) -> SurfaceTracker:
+        from capabilities.perception.tracker import SurfaceTracker
+
         with self._lock:
             per_camera = self._trackers.setdefault(world, {})
             if camera not in per_camera:

@@ -14,20 +14,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from capabilities.predicates.settings import DIRECTIONS
 from capabilities.robot_body import pose_matrix
 from engine.types import Pose
 
 __all__ = ["DIRECTIONS", "PoseTrack", "Motion", "offset_in_frame", "box_center"]
-
-# relation -> (axis, sign)
-DIRECTIONS: dict[str, tuple[int, float]] = {
-    "left_of": (1, 1.0),
-    "right_of": (1, -1.0),
-    "in_front_of": (0, 1.0),
-    "behind": (0, -1.0),
-    "up_from": (2, 1.0),
-    "down_from": (2, -1.0),
-}
 
 
 def box_center(pose: Pose, height: float) -> np.ndarray:

@@ -9,13 +9,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from capabilities.base import Capability
+from capabilities.base import Capability, CapabilityEnv
 from capabilities.kit import manifest, stateful
 from capabilities.predicates.collision import TOOL, PredicateError
-from capabilities.predicates.geometry import DIRECTIONS, box_center, offset_in_frame
-from capabilities.predicates.state import SETTINGS, PredicatesState, setup
+from capabilities.predicates.settings import DIRECTIONS, SETTINGS
 from engine.operations import (
     Job,
     OperationCall,
@@ -25,6 +24,9 @@ from engine.operations import (
     StartResult,
 )
 from engine.types import ObjectModel, ParamType, Pose
+
+if TYPE_CHECKING:  # the geometry (numpy) loads with the first cell's setup
+    from capabilities.predicates.state import PredicatesState
 
 __all__ = ["capability"]
 
@@ -93,6 +95,8 @@ class Relation:
         self.start = _guarded(self._start)
 
     def _start(self, call: OperationCall) -> Job:
+        from capabilities.predicates.geometry import box_center, offset_in_frame
+
         state = self._state
         state.sample()
         a, b = state.best(call.input("object_a")), state.best(call.input("object_b"))
@@ -242,6 +246,13 @@ class Contact:
         word = "touching" if self._port == "tolerance" else "near collision"
         return _verdict(gap <= limit, f"{label}: {gap_text} apart "
                                       f"({word} at {limit * 1000:.1f} mm or less)")  # fmt: skip
+
+
+def setup(env: CapabilityEnv) -> PredicatesState:
+    """The per-cell hook (``state.setup``), imported when a cell first needs it."""
+    from capabilities.predicates import state
+
+    return state.setup(env)
 
 
 def capability() -> Capability:

@@ -10,21 +10,14 @@ import threading
 from typing import Any
 
 from capabilities.base import CapabilityEnv
-from capabilities.kit import Setting
 from capabilities.predicates.collision import CollisionWorld, PredicateError
 from capabilities.predicates.geometry import PoseTrack
+from capabilities.predicates.settings import SETTINGS
 from capabilities.robot_body import RobotBodyError, robot_base_from_arm
 from capabilities.world_model import Detection
 from engine.types import ObjectModel, Pose
 
 __all__ = ["SETTINGS", "PredicatesState", "setup"]
-
-SETTINGS = (
-    Setting("robot_base", Pose, None, "world pose of the robot's base frame (default: from the arm)"),
-    Setting("tool_size", tuple, (0.06, 0.12, 0.16), "full size (m) of the tool's box (the gripper)", 3),
-    Setting("tool_center", tuple, (0.0, 0.0, -0.065), "the tool box's centre (m) in the TCP frame", 3),
-    Setting("history", float, 10.0, "seconds of detections kept per object"),
-)  # fmt: skip
 
 
 class PredicatesState:
