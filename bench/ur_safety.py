@@ -59,7 +59,11 @@ from engine.types import JointConfig, ParamType  # noqa: E402
 
 HOME = (0.0, -1.5708, 1.5708, -1.5708, -1.5708, 0.0)
 SIGNALS = ("SIGTERM", "SIGINT", "SIGHUP", "SIGKILL")
-FAULTS = tuple(os.environ.get("FAULTS", "protective_stop,emergency_stop,power_off,kill_script,disconnect").split(","))
+FAULTS = tuple(
+    os.environ.get(
+        "FAULTS", "protective_stop,emergency_stop,power_off,kill_script,disconnect"
+    ).split(",")
+)
 STILL_RAD = 1e-4
 
 
@@ -85,9 +89,7 @@ def moves_plan(offsets: tuple[float, ...], speed: float) -> PlanSpec:
 @contextmanager
 def busy_load(jobs: int) -> Iterator[None]:
     """``jobs`` processes that spin (a loaded machine) for the time of the block."""
-    procs = [
-        subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(jobs)
-    ]
+    procs = [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(jobs)]
     try:
         yield
     finally:
@@ -255,7 +257,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.verbose:
         import logging
 
-        logging.basicConfig(level=logging.INFO, format="%(relativeCreated)8.0f %(name)s %(message)s")
+        logging.basicConfig(
+            level=logging.INFO, format="%(relativeCreated)8.0f %(name)s %(message)s"
+        )
     report: dict[str, Any] = {"trials": args.trials, "load": args.load,
                               "cores": multiprocessing.cpu_count()}  # fmt: skip
     with busy_load(args.load):

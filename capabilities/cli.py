@@ -24,10 +24,11 @@ from capabilities.cells import CELL_NAMES, CellError, is_cell_file, open_cell
 from capabilities.collaboration.answers import CONFIRM_MODES, PromptAnswerer
 from capabilities.doctor import cmd_doctor
 from capabilities.faults import hold_check
+from capabilities.hold_watch import DEFAULT_HOLD_TIMEOUT, HoldWatch
 from capabilities.shipped_examples import cmd_examples
 from capabilities.xml_commands import add_xml_commands
 from engine.build import BuildError, build_tree
-from engine.events import Event, LogMessage, RunFinished, RunHeld, StatusChanged
+from engine.events import Event, LogMessage, RunFinished, StatusChanged
 from engine.executor import Executor
 from engine.files import PlanFileError, load_plan, plan_scene
 from engine.instances import runtime_paths
@@ -153,21 +154,6 @@ def _install_interrupt(executor: Executor) -> Callable[[], None]:
     return restore
 
 
-def _print_holds(out: TextIO) -> Callable[[Event], None]:
-    """A listener that says when a run is held by its cell (and when it goes on)."""
-
-    def on_event(event: Event) -> None:
-        if isinstance(event, RunHeld):
-            text = (
-                f"held: {event.reason} (the run goes on once the robot is ready; Ctrl-C stops it)"
-                if event.reason
-                else "the robot is ready: the run goes on"
-            )
-            print(f"tick {event.tick:>5}  {text}", file=out, flush=True)
-
-    return on_event
-
-
 def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     cell = _open(args, err, start=True)
     if cell is None:
@@ -191,7 +177,8 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         listeners: list[Callable[[Event], None]] = []
         if args.trace:  # first: what a line on screen says is already in the trace
             listeners.append(TraceRecorder(args.trace, plan))
-        listeners += [failures, _print_holds(out)]
+        holds = HoldWatch(out, args.hold_timeout, cell)
+        listeners += [failures, holds]
         if args.verbose:
             listeners.append(_VerbosePrinter(plan, out))
         executor = Executor(tree, args.rate, listeners, plan_name=plan.name, hold=hold_check(cell))
@@ -200,7 +187,7 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         answerer = PromptAnswerer(console, args.confirm, args.stdin, out) if console else None
         try:
             executor.start()
-            result = _wait(executor, args.timeout)
+            result = _wait(executor, args.timeout, holds, out)
         finally:
             restore()
             if answerer is not None:
@@ -210,7 +197,7 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         return code
 
 
-def _wait(executor: Executor, timeout: float | None) -> RunFinished:
+def _wait(executor: Executor, timeout: float | None, holds: HoldWatch, out: TextIO) -> RunFinished:
     # Wait in short slices so that Ctrl-C is handled promptly in the main thread.
     waited = 0.0
     while True:
@@ -218,8 +205,14 @@ def _wait(executor: Executor, timeout: float | None) -> RunFinished:
         if result is not None:
             return result
         waited += 0.1
+        reason = ""
         if timeout is not None and waited >= timeout:
-            executor.stop("timeout")
+            reason = "timeout"
+        elif holds.expired():
+            print(holds.give_up(), file=out, flush=True)
+            reason = "hold timeout"
+        if reason:
+            executor.stop(reason)
             final = executor.wait(10.0)
             assert final is not None, "the engine did not stop within 10 s"
             return final
@@ -232,7 +225,7 @@ def _report(
         for key, value in sorted(board.items()):
             print(f"  {key} = {format_value(value)}", file=out)
     name = plan.name or "plan"
-    if result.reason in ("stopped", "timeout"):
+    if result.reason in ("stopped", "timeout", "hold timeout"):
         print(f"{name}: {result.reason} after {result.tick} ticks", file=out)
         return EXIT_STOPPED
     if result.reason == "error":
@@ -357,6 +350,14 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--rate", type=float, default=20.0, help="ticks per second (default 20)")
     run.add_argument("--trace", help="write a trace (JSON lines) to this file")
     run.add_argument("--timeout", type=float, help="stop after this many seconds (exit 3)")
+    run.add_argument(
+        "--hold-timeout",
+        type=float,
+        default=DEFAULT_HOLD_TIMEOUT,
+        metavar="SECONDS",
+        help="give up when the cell holds the run this long without a break (a stop nobody "
+        "clears, a controller that is gone): exit 3 (default 600)",
+    )
     run.add_argument("--verbose", "-v", action="store_true", help="print every status change")
     run.add_argument(
         "--confirm",
@@ -420,6 +421,9 @@ def main(
     args.stdin = inp or sys.stdin
     if args.command == "run" and args.rate <= 0:
         print("error: --rate must be above 0", file=err)
+        return EXIT_INVALID
+    if args.command == "run" and args.hold_timeout <= 0:
+        print("error: --hold-timeout must be above 0", file=err)
         return EXIT_INVALID
     if getattr(args, "plan", None):
         try:

@@ -39,6 +39,7 @@ from instructor_app.panels.cameras import camera_interfaces
 from instructor_app.runtime.controller import RunOutcome
 from instructor_app.runtime.session import CellSession
 from instructor_app.settings import APPLICATION, ORGANIZATION, AppSettings
+from instructor_app.stop_signals import quit_on_signals
 from resources import plan_argument, resource_path
 
 __all__ = [
@@ -141,8 +142,16 @@ def _start_session(args: argparse.Namespace, speed: float | None) -> CellSession
 def _interactive(args: argparse.Namespace) -> int:
     session = _start_session(args, speed=1.0)  # real time on screen
     session.cell_failed.connect(lambda message: print(f"error: {message}", file=sys.stderr))
+    restore = lambda: None  # noqa: E731
     try:
         window = MainWindow(session)
+
+        def end_on_signal() -> None:  # as the close button, without asking to save
+            window.shutdown(keep_recovery=True)
+            session.close()  # the arm halts before the connection closes
+            QApplication.quit()
+
+        restore = quit_on_signals(window, end_on_signal)
         window.show()
         window.switch_cell(args.cell)
         QTimer.singleShot(0, window.offer_recoveries)
@@ -150,6 +159,7 @@ def _interactive(args: argparse.Namespace) -> int:
             QTimer.singleShot(0, lambda: _open_plan(window, args.plan, args.run))
         return QApplication.exec()
     finally:
+        restore()
         session.close()
 
 

@@ -458,14 +458,19 @@ class MainWindow(QMainWindow):
         else:
             self.arrange_cell_views()
 
-    def shutdown(self) -> None:
-        """Stop the run, the robot's teaching commands, background drawing and autosave."""
+    def shutdown(self, keep_recovery: bool = False) -> None:
+        """Stop the run, the robot's teaching commands, background drawing and autosave;
+        with ``keep_recovery`` unsaved work stays in its recovery file (a signal ends the
+        program: nobody was asked to save)."""
         self.controller.shutdown()
         self.cell_views.stop()
         self.views.teacher.shutdown()
         self.views.objects.shutdown()
         self.library.shutdown()
-        self.autosaver.stop()
+        if keep_recovery and self.document.dirty:
+            self.autosaver.write_now()
+        else:
+            self.autosaver.stop()
 
     def closeEvent(self, event: QCloseEvent) -> None:
         if not self.maybe_save():

@@ -25,7 +25,7 @@ from capabilities.ur.connection import (
     URState,
     fault_reason,
 )
-from capabilities.ur.errors import URError
+from capabilities.ur.errors import URError, ur_words
 from capabilities.ur.frames import URFrames
 from capabilities.ur.modes import PolyScopeVersion, RobotMode
 from engine.types import Pose
@@ -276,7 +276,7 @@ def _lost(exc: BaseException, conn: URConnection) -> str:
         return str(exc)
     conn.refresh()
     reason = fault_reason(conn.state)
-    return reason if reason.startswith("connection lost") else f"connection lost ({exc})"
+    return reason if reason.startswith("connection lost") else f"connection lost ({ur_words(exc)})"
 
 
 class _Monitor:
@@ -360,7 +360,7 @@ class _Unlock:
                 try:
                     conn.clear_protective_stop()  # unlock, then upload the script again
                 except Exception as exc:  # too early after the stop: the controller refuses
-                    self.refused = str(exc)
+                    self.refused = ur_words(exc)
             return False
         elif problem == NO_SCRIPT:
             return False  # unlocked: the script is on its way (or the recovery monitor's)

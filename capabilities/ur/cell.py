@@ -194,7 +194,7 @@ class URCellSession:
         """The robot's state for the toolbar (a snapshot; never blocks)."""
         state, fault = self.connection.state, self.connection.fault()
         if not state.connected or fault.startswith(CONNECTION_LOST):
-            return CellStatus(False, "DISCONNECTED", "-", "-", fault)
+            return CellStatus(False, "DISCONNECTED", "-", "-", fault + _last_heard(self.connection))
         return CellStatus(
             True,
             RobotMode(state.robot_mode).name,
@@ -222,6 +222,19 @@ class URCellSession:
         tb: TracebackType | None,
     ) -> None:
         self.close()
+
+
+def _last_heard(connection: URConnection) -> str:
+    """ "; last heard 12 s ago: robot mode RUNNING, safety mode NORMAL, program running"."""
+    last = connection.last_heard
+    if not last.stamp:
+        return ""
+    program = "running" if last.program_running else "stopped"
+    return (
+        f"; last heard {time.monotonic() - last.stamp:.0f} s ago: robot mode "
+        f"{RobotMode(last.robot_mode).name}, safety mode {SafetyMode(last.safety_mode).name}, "
+        f"program {program}"
+    )
 
 
 class _Recovery:

@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
 from capabilities.faults import CONNECTION_LOST, EMERGENCY_STOP, PROTECTIVE_STOP
-from capabilities.ur.errors import URConnectionLost, URError
+from capabilities.ur.errors import URConnectionLost, URError, ur_words
 from capabilities.ur.modes import PolyScopeVersion, RobotMode, SafetyMode, parse_version
 
 __all__ = ["HALT_DECEL", "NO_SCRIPT", "URConnection", "WATCHDOG_HZ", "URState", "fault_reason"]
@@ -122,6 +122,7 @@ class URConnection:
         self._payload = payload
         self._period = 1.0 / rate
         self.state = URState()
+        self.last_heard = URState()  # the last state read while connected
         self._tasks: queue.Queue[Callable[[], None] | None] = queue.Queue()
         self._monitors: list[Monitor] = []
         self._closing = threading.Event()
@@ -157,7 +158,7 @@ class URConnection:
         except Exception as exc:
             self.close()
             raise URConnectionLost(
-                f"cannot connect to the UR controller at {self.host}: {exc}"
+                f"cannot connect to the UR controller at {self.host}: {ur_words(exc)}"
             ) from exc
 
     def close(self) -> None:
@@ -255,8 +256,10 @@ class URConnection:
         """(I/O thread) Kick the control script's watchdog (at most every ``_KICK_PERIOD``
         s unless ``force``); a long wait on the I/O thread calls it to keep the arm going."""
         control, now = self.control, time.monotonic()
-        if not self._watchdog or control is None or (
-            not force and now - self._last_kick < _KICK_PERIOD
+        if (
+            not self._watchdog
+            or control is None
+            or (not force and now - self._last_kick < _KICK_PERIOD)
         ):
             return
         if now - self._last_kick > 1.0 / WATCHDOG_HZ:
@@ -294,7 +297,9 @@ class URConnection:
             self._watchdog = False
             control.stopScript()
         except Exception:
-            _log.warning("halting the arm failed: the controller's watchdog stops it", exc_info=True)
+            _log.warning(
+                "halting the arm failed: the controller's watchdog stops it", exc_info=True
+            )
 
     def _connect(self) -> None:
         import dashboard_client
@@ -374,7 +379,7 @@ class URConnection:
         try:
             self.dashboard.unlockProtectiveStop()
         except Exception as exc:
-            raise URError(f"unlocking the protective stop failed: {exc}") from exc
+            raise URError(f"unlocking the protective stop failed: {ur_words(exc)}") from exc
         # A protective stop ends the control script; the frame that says so may still be on
         # its way (a loaded machine), and a script thought running was never uploaded again.
         self.start_control(reupload=True)
@@ -384,7 +389,9 @@ class URConnection:
         try:
             self.state = self._read_state()
         except Exception as exc:
-            self.state = URState(connected=False, problem=str(exc))
+            self.state = URState(connected=False, problem=ur_words(exc))
+        if self.state.connected:
+            self.last_heard = self.state
 
     def _read_state(self) -> URState:
         receive, control = self.receive, self.control

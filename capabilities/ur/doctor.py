@@ -51,7 +51,7 @@ def _robot_checks(config: CellConfig, timeout: float) -> list[CheckResult]:
     try:
         connection.open(timeout)
     except CapabilityError as exc:
-        return [CheckResult("robot connection", False, f"{exc}; check the address and cable")]
+        return [CheckResult("robot connection", False, f"{exc}")]
     try:
         state = connection.state
         version = ".".join(map(str, connection.version))

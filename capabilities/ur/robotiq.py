@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 
 from capabilities.sim.commands import CommandHandle
 from capabilities.ur.connection import URConnection
-from capabilities.ur.errors import URError
+from capabilities.ur.errors import URError, ur_words
 
 __all__ = ["ROBOTIQ_PORT", "RobotiqGripper"]
 
@@ -115,7 +115,7 @@ class RobotiqGripper:
                     if self._get("PRE") == position:  # the URCap took this command
                         self._obj = self._get("OBJ")
                 except (OSError, URError) as exc:
-                    handle.resolve(False, f"{name}: the gripper stopped answering: {exc}")
+                    handle.resolve(False, f"{name}: the gripper stopped answering: {ur_words(exc)}")
                     return True
                 if self._obj != _MOVING:
                     handle.resolve(True)
@@ -128,7 +128,7 @@ class RobotiqGripper:
         def failed(future: object) -> None:
             exc = getattr(future, "exception", lambda: None)()
             if exc is not None:
-                handle.resolve(False, f"{name}: {exc}")
+                handle.resolve(False, f"{name}: {ur_words(exc)}")
 
         self._conn.submit(start).add_done_callback(failed)
         return handle

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 from capabilities.sim.commands import CommandHandle
 from capabilities.ur.connection import URConnection, fault_reason
-from capabilities.ur.errors import URError
+from capabilities.ur.errors import URError, ur_words
 from engine.types import Pose
 
 __all__ = ["DigitalPin", "TeachButtonReleased", "URDigitalInput", "URSuctionCup"]
@@ -65,7 +65,7 @@ def set_output(connection: URConnection, pin: DigitalPin, on: bool) -> CommandHa
     def failed(future: object) -> None:
         exc = getattr(future, "exception", lambda: None)()
         if exc is not None:
-            handle.resolve(False, f"{handle.name}: connection lost ({exc})")
+            handle.resolve(False, f"{handle.name}: connection lost ({ur_words(exc)})")
 
     connection.submit(run).add_done_callback(failed)
     return handle
