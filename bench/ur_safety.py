@@ -119,10 +119,10 @@ def stop_trial(emulator: EmulatorProcess, cell_file: Path, plan_file: Path, sig:
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env, cwd=str(ROOT),
     )  # fmt: skip
     try:
-        started = wait_for(
-            lambda: emulator.state()["moving"] and emulator.state()["q"][0] > HOME[0] + 0.05,
-            60,
-        )
+        # The first move takes the arm home (from where the last trial stopped it), the
+        # second turns the base joint: wait until the arm was home, then well into the turn.
+        home = wait_for(lambda: abs(emulator.state()["q"][0] - HOME[0]) < 0.02, 120)
+        started = home and wait_for(lambda: emulator.state()["q"][0] > HOME[0] + 0.1, 60)
         if not started:
             return {"ok": False, "why": "the long move never started"}
         time.sleep(1.0)
@@ -156,6 +156,7 @@ def measure_stops(host: str, trials: int, out: Any) -> dict[str, Any]:
                     "standing_still": sum(1 for r in rows if r.get("still")),
                     "stop_s_median": round(statistics.median(times), 3) if times else None,
                     "stop_s_max": round(max(times), 3) if times else None,
+                    "failures": [r.get("why", r) for r in rows if not r["ok"]][:5],
                 }
                 print(f"{sig:8} {results[sig]}", file=out, flush=True)
     return results
