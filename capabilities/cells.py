@@ -107,7 +107,7 @@ def is_cell_file(name: str) -> bool:
 
 
 def _open_cell_file(path: Path, seed: int, scene: str | None, speed: float | None) -> Any:
-    from capabilities.sim.config import CellConfig, CellConfigError
+    from capabilities.robot.cell_file import CellConfig, CellConfigError
 
     try:
         config = CellConfig.load(path)

@@ -70,9 +70,9 @@ def test_operations_do_not_reach_into_the_simulator() -> None:
     # the cell file, one file type for every cell (sim/config.py).
     simulators = (ROOT / "capabilities" / "sim", ROOT / "capabilities" / "ur" / "emulator")
     helpers = {
-        "capabilities.sim.commands",
-        "capabilities.sim.kinematics",
-        "capabilities.sim.config",
+        "capabilities.robot.commands",
+        "capabilities.robot.kinematics",
+        "capabilities.robot.cell_file",
     }
     offenders = []
     for path in sorted((ROOT / "capabilities").rglob("*.py")):

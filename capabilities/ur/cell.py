@@ -28,13 +28,13 @@ from typing import Any
 
 from capabilities.camera_source import CameraSource
 from capabilities.camera_sources import open_source
-from capabilities.cell_robot import TCP_OF_TOOL
 from capabilities.collaboration.console import OperatorConsole
 from capabilities.collaboration.inputs import DigitalInputButton
 from capabilities.faults import CONNECTION_LOST, CellStatus
 from capabilities.jobs import WorkerPool
 from capabilities.object_library import ObjectLibrary
-from capabilities.sim.config import CellConfig
+from capabilities.robot.cell_file import CellConfig
+from capabilities.robot.cell_robot import TCP_OF_TOOL
 from capabilities.ur.arm import URArm
 from capabilities.ur.connection import NO_SCRIPT, URConnection, fault_reason
 from capabilities.ur.frames import URFrames

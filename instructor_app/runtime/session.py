@@ -24,8 +24,8 @@ from typing import Any
 from PySide6.QtCore import QObject, Signal
 
 from capabilities.base import CapabilityRegistry
-from capabilities.cell_robot import read_robot
 from capabilities.cells import CELL_NAMES, CellError, is_cell_file, open_cell
+from capabilities.robot.cell_robot import read_robot
 from engine.json_reader import JsonFileError, JsonReader, read_json_file
 
 __all__ = ["CellSession", "CellOpener", "RegistryFactory", "opening_words"]

@@ -108,7 +108,7 @@ def write_cell_file(
     Raises:
         EmulatorError: the file cannot be written.
     """
-    from capabilities.cell_robot import RobotSettings, ToolSettings
+    from capabilities.robot.cell_robot import RobotSettings, ToolSettings
     from engine.plan_writer import write_atomic
 
     model = "UR5 CB3" if version.startswith("3.") else "UR5e"

@@ -20,8 +20,8 @@ import numpy as np
 from ur_analytic_ik import ur5
 
 from capabilities.geometry import matrix_to_pose, pose_to_matrix
+from capabilities.robot.commands import CommandHandle
 from capabilities.sim.cell import SimCell
-from capabilities.sim.commands import CommandHandle
 from capabilities.ur.emulator.faults import ContactWatch
 from capabilities.ur.emulator.program import ControlProgram
 from capabilities.ur.emulator.robotiq import RobotiqURCap
