@@ -407,7 +407,7 @@ def main(
     err = err or sys.stderr
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv[:1] == ["ur-emulator"]:
-        from capabilities.ur.emulator.__main__ import main as emulator_main
+        from capabilities.ur_emulator.__main__ import main as emulator_main
 
         try:
             return emulator_main(argv[1:], prog="costar ur-emulator")

@@ -11,7 +11,7 @@ import math
 import numpy as np
 
 from capabilities.geometry import matrix_to_pose
-from capabilities.robot.errors import CellError
+from capabilities.robot.errors import RobotCellError
 from engine.types import Pose
 
 __all__ = ["SHOULDER_EYE", "SHOULDER_TARGET", "WRIST_MOUNT", "look_at"]
@@ -48,13 +48,13 @@ def look_at(
     """The OpenCV camera pose at ``eye`` looking at ``target`` (image up toward ``up``).
 
     Raises:
-        CellError: the view direction is parallel to ``up``.
+        RobotCellError: the view direction is parallel to ``up``.
     """
     z = np.subtract(target, eye).astype(float)
     z /= np.linalg.norm(z)
     x = np.cross(z, up)
     if np.linalg.norm(x) < 1e-9:
-        raise CellError(f"look_at: the view direction {tuple(z)} is parallel to up {up}")
+        raise RobotCellError(f"look_at: the view direction {tuple(z)} is parallel to up {up}")
     x /= np.linalg.norm(x)
     m = np.eye(4)
     m[:3, :3] = np.column_stack((x, np.cross(z, x), z))

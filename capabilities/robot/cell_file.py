@@ -17,7 +17,7 @@ from typing import Any
 from capabilities.camera_source import SOURCE_KINDS
 from capabilities.robot.camera_mounts import SHOULDER_EYE, SHOULDER_TARGET, WRIST_MOUNT, look_at
 from capabilities.robot.cell_robot import RobotSettings, read_robot
-from capabilities.robot.errors import CellError
+from capabilities.robot.errors import RobotCellError
 from engine.json_reader import JsonFileError, JsonReader, read_json_file
 from engine.types import ParamType, Pose
 from resources import resource_path
@@ -36,7 +36,7 @@ READABLE_VERSIONS = (1, 2)
 DEFAULT_CONFIG_PATH = resource_path("cells", "sim_default.json")
 
 
-class CellConfigError(CellError):
+class CellConfigError(RobotCellError):
     """A cell configuration file is missing or off; the message names the file and JSON path.
 
     It wraps the reader's :class:`engine.json_reader.JsonFileError` (its ``__cause__``).

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 from capabilities.errors import CapabilityError
 
-__all__ = ["CellError"]
+__all__ = ["RobotCellError"]
 
 
-class CellError(CapabilityError, RuntimeError):
-    """A cell cannot be described or built: a cell file that is off, a missing robot model."""
+class RobotCellError(CapabilityError, RuntimeError):
+    """What every cell shares cannot do what was asked: a cell file that is off, a missing
+    robot model, a camera that cannot look where asked (``capabilities.cells.CellError`` is
+    the other one: a cell that could not be opened)."""

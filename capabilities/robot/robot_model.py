@@ -9,7 +9,7 @@ from __future__ import annotations
 from importlib import metadata
 from pathlib import Path
 
-from capabilities.robot.errors import CellError
+from capabilities.robot.errors import RobotCellError
 from resources import resource_path
 
 __all__ = ["ROBOTS_DIR", "find_ur5_urdf", "ur5_collision_meshes"]
@@ -22,12 +22,12 @@ def find_ur5_urdf() -> Path:
     """Path of the UR5 URDF installed by the example-robot-data package.
 
     Raises:
-        CellError: the package or its UR5 model is not installed.
+        RobotCellError: the package or its UR5 model is not installed.
     """
     try:
         files = metadata.files("example-robot-data") or []
     except metadata.PackageNotFoundError as exc:
-        raise CellError(
+        raise RobotCellError(
             "example-robot-data is not installed (pip install example-robot-data)"
         ) from exc
     for entry in files:
@@ -35,7 +35,7 @@ def find_ur5_urdf() -> Path:
             path = Path(str(entry.locate())).resolve()
             if path.is_file():
                 return path
-    raise CellError(f"example-robot-data has no {_UR5_SUFFIX}")
+    raise RobotCellError(f"example-robot-data has no {_UR5_SUFFIX}")
 
 
 def ur5_collision_meshes(urdf: Path | None = None) -> Path:

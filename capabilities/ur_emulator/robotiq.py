@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from capabilities.robot.commands import CommandHandle
-    from capabilities.ur.emulator.controller import EmulatedController
+    from capabilities.ur_emulator.controller import EmulatedController
 
 __all__ = ["ROBOTIQ_PORT", "RobotiqURCap", "robotiq_client"]
 

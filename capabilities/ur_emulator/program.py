@@ -20,7 +20,7 @@ from capabilities.ur.frames import matrix_from_rotvec_pose
 
 if TYPE_CHECKING:
     from capabilities.robot.commands import CommandHandle
-    from capabilities.ur.emulator.controller import EmulatedController
+    from capabilities.ur_emulator.controller import EmulatedController
 
 __all__ = ["ControlProgram"]
 
