@@ -29,8 +29,9 @@ import numpy as np
 
 from capabilities.camera_source import CameraSource
 from capabilities.camera_sources import open_source
+from capabilities.cell_features import CellStatus
 from capabilities.collaboration.console import OperatorConsole
-from capabilities.faults import PROTECTIVE_STOP, CellStatus
+from capabilities.faults import PROTECTIVE_STOP
 from capabilities.jobs import WorkerPool
 from capabilities.robot.cell_file import CameraSettings, CellConfig
 from capabilities.sim.bender import WireBender, install_scene_bender
