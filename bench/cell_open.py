@@ -42,7 +42,7 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 from PySide6.QtCore import QEventLoop, QTimer
 from PySide6.QtWidgets import QApplication
 
-from capabilities.ur.emulator.process import EmulatorProcess
+from capabilities.ur_emulator.process import EmulatorProcess
 from instructor_app.runtime.session import CellSession
 
 __all__ = ["measure", "main"]

@@ -36,7 +36,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from capabilities.ur.arm import URArm
 from capabilities.ur.connection import URConnection, fault_reason
-from capabilities.ur.emulator.process import EmulatorProcess
+from capabilities.ur_emulator.process import EmulatorProcess
 from engine.types import Pose
 
 

@@ -49,7 +49,7 @@ sys.path.insert(0, str(ROOT))
 from capabilities.base import CapabilityRegistry  # noqa: E402
 from capabilities.cells import open_cell  # noqa: E402
 from capabilities.faults import hold_check  # noqa: E402
-from capabilities.ur.emulator.process import EmulatorProcess  # noqa: E402
+from capabilities.ur_emulator.process import EmulatorProcess  # noqa: E402
 from engine.build import build_tree  # noqa: E402
 from engine.executor import Executor  # noqa: E402
 from engine.files import save_plan  # noqa: E402

@@ -13,7 +13,7 @@ import threading
 import time
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any, Protocol, runtime_checkable
 
 from capabilities.errors import CapabilityError
 from capabilities.kit import CapabilitySettingsError, Setting, parse_settings
@@ -33,6 +33,7 @@ __all__ = [
     "CapabilityRegistry",
     "Cell",
     "NullCell",
+    "SuppliesSettings",
     "OperationDef",
     "ENTRY_POINT_GROUP",
     "load_entry_point_capabilities",
@@ -56,6 +57,15 @@ class Cell(Protocol):
 
     def clock(self) -> float:
         """Seconds; simulated time on the simulated cell."""
+        ...
+
+
+@runtime_checkable
+class SuppliesSettings(Protocol):
+    """A cell whose file gives capability settings (its ``capabilities`` block)."""
+
+    def capability_settings(self) -> tuple[Mapping[str, Any], str]:
+        """The ``capabilities`` block (capability name -> settings) and its file, for errors."""
         ...
 
 
@@ -288,8 +298,6 @@ class CapabilityRegistry:
 
 def _cell_settings(cell: Cell, default_source: str) -> tuple[Mapping[str, Any], str]:
     """The cell's capability settings block and the file it came from (none: empty)."""
-    supplier = getattr(cell, "capability_settings", None)
-    if not callable(supplier):
+    if not isinstance(cell, SuppliesSettings):
         return {}, default_source
-    raw, source = supplier()
-    return raw, source
+    return cell.capability_settings()

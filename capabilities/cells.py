@@ -13,6 +13,7 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any
 
+from capabilities.cell_features import ClosableCell
 from capabilities.collaboration.console import OperatorConsole
 from capabilities.errors import CapabilityError
 
@@ -71,7 +72,7 @@ def open_cell(
     start: bool = True,
     scene: str | None = None,
     speed: float | None = None,
-) -> Any:
+) -> ClosableCell:
     """The cell called ``name``, as a context manager.
 
     Args:
@@ -106,8 +107,8 @@ def is_cell_file(name: str) -> bool:
     return name not in CELL_NAMES and (name.endswith(".json") or Path(name).exists())
 
 
-def _open_cell_file(path: Path, seed: int, scene: str | None, speed: float | None) -> Any:
-    from capabilities.sim.config import CellConfig, CellConfigError
+def _open_cell_file(path: Path, seed: int, scene: str | None, speed: float | None) -> ClosableCell:
+    from capabilities.robot.cell_file import CellConfig, CellConfigError
 
     try:
         config = CellConfig.load(path)

@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from capabilities.base import CapabilityError, CapabilityRegistry
+from capabilities.cell_features import ClosableCell
 from capabilities.cells import CELL_NAMES, CellError, is_cell_file, open_cell
 from capabilities.collaboration.answers import CONFIRM_MODES, PromptAnswerer
 from capabilities.doctor import cmd_doctor
@@ -64,7 +65,7 @@ def _load(path: str, registry: CapabilityRegistry, err: TextIO) -> PlanSpec | No
         return None
 
 
-def _open(args: argparse.Namespace, err: TextIO, start: bool) -> Any:
+def _open(args: argparse.Namespace, err: TextIO, start: bool) -> ClosableCell | None:
     """The cell the command asked for, or None after saying why it could not be opened.
     The simulated cell opens ``--scene``, else the scene the plan was taught on."""
     plan = getattr(args, "plan", None)
@@ -407,7 +408,7 @@ def main(
     err = err or sys.stderr
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv[:1] == ["ur-emulator"]:
-        from capabilities.ur.emulator.__main__ import main as emulator_main
+        from capabilities.ur_emulator.__main__ import main as emulator_main
 
         try:
             return emulator_main(argv[1:], prog="costar ur-emulator")

@@ -7,16 +7,13 @@ the same way. The UR cell's ``fault_reason`` builds its words from these constan
 
 A cell that can stop on its own has ``hold_reason()`` (why it cannot act, in these words; ""
 when it can); :func:`hold_check` makes the executor's hold check of it (``engine.hold``), so
-the CLI and the Instructor wire every cell the same way. Its ``status()`` gives the status
-bar a :class:`CellStatus`, and ``clear()`` is the operator's clear of what the status names.
+the CLI and the Instructor wire every cell the same way (``capabilities.cell_features``
+declares it and the other optional features of a cell as typed protocols).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
-from typing import Any
-
+from capabilities.cell_features import HoldsRuns
 from engine.error_types import ErrorType
 from engine.hold import Hold, HoldCheck
 
@@ -25,7 +22,6 @@ __all__ = [
     "EMERGENCY_STOP",
     "LOOKING",
     "PROTECTIVE_STOP",
-    "CellStatus",
     "fault_error",
     "hold_check",
 ]
@@ -55,34 +51,15 @@ def fault_error(message: str) -> ErrorType:
 LOOKING = frozenset({"occupancy", "markers", "perception"})
 
 
-def hold_check(cell: Any) -> HoldCheck | None:
-    """The executor's hold check of a cell with ``hold_reason()`` (None for one without);
+def hold_check(cell: object) -> HoldCheck | None:
+    """The executor's hold check of a cell that holds runs (None for one that does not);
     its stops spare the operations of the capabilities that only look."""
-    reason_of: Callable[[], str] | None = getattr(cell, "hold_reason", None)
-    if not callable(reason_of):
+    if not isinstance(cell, HoldsRuns):
         return None
-    ask = reason_of
+    ask = cell.hold_reason
 
     def check() -> Hold | None:
         reason = ask()
         return Hold(reason, fault_error(reason), LOOKING) if reason else None
 
     return check
-
-
-@dataclass(frozen=True)
-class CellStatus:
-    """What the status bar shows of the robot: connection, robot mode, safety mode, program.
-
-    Attributes:
-        problem: why the robot cannot move ("" when it can).
-        clear_action: the label of the operator's clear of that problem from here ("" when
-            there is none now: it is cleared on the pendant, or not yet allowed).
-    """
-
-    connected: bool
-    robot_mode: str
-    safety_mode: str
-    program: str
-    problem: str
-    clear_action: str = ""

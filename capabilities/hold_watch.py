@@ -10,8 +10,9 @@ the cell last knew of its robot.
 from __future__ import annotations
 
 import time
-from typing import Any, TextIO
+from typing import TextIO
 
+from capabilities.cell_features import ReportsStatus
 from engine.events import Event, RunHeld
 
 __all__ = ["DEFAULT_HOLD_TIMEOUT", "HoldWatch"]
@@ -25,10 +26,10 @@ class HoldWatch:
     Args:
         out: where the lines go.
         timeout: seconds a single hold may last before :meth:`expired` says so.
-        cell: the run's cell; its ``status()`` (when it has one) names the robot's last state.
+        cell: the run's cell; its ``status()`` (when it reports one) names the robot's last state.
     """
 
-    def __init__(self, out: TextIO, timeout: float = DEFAULT_HOLD_TIMEOUT, cell: Any = None):
+    def __init__(self, out: TextIO, timeout: float = DEFAULT_HOLD_TIMEOUT, cell: object = None):
         self._out = out
         self._timeout = timeout
         self._cell = cell
@@ -59,9 +60,8 @@ class HoldWatch:
         """The line that says why the run ends: the hold, how long, the robot's last state."""
         held = time.monotonic() - (self._since or time.monotonic())
         line = f"gave up after {held:.0f} s held: {self.reason}"
-        status = getattr(self._cell, "status", None)
-        if callable(status):
-            robot = status()
+        robot = self._cell.status() if isinstance(self._cell, ReportsStatus) else None
+        if robot is not None:
             line += (
                 f"; the robot: robot mode {robot.robot_mode}, safety mode {robot.safety_mode}, "
                 f"program {robot.program}"

@@ -16,7 +16,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from capabilities.gripper.backend import GripperBackend
+from capabilities.gripper.backend import GripperBackend, HeldSuctionTool
 from capabilities.jobs import chain_jobs, job_from_handle
 from capabilities.kit import manifest
 from capabilities.motion.backend import ArmBackend
@@ -25,7 +25,6 @@ from capabilities.motion.operations import JOINT_ACCEL, JOINT_SPEED
 from capabilities.motion.symmetry import SymmetryTable
 from capabilities.motion.targets import symmetric_rotations
 from capabilities.object_library import GraspSpec, ObjectLibraryError
-from capabilities.tool.backend import SuctionBackend
 from engine.error_types import ErrorType
 from engine.operations import (
     Job,
@@ -102,7 +101,7 @@ class Grasp:
         self,
         arm: ArmBackend,
         gripper: GripperBackend,
-        suction: SuctionBackend | None,
+        suction: HeldSuctionTool | None,
         table: SymmetryTable,
     ) -> None:
         self._arm = arm

@@ -4,13 +4,12 @@ object at its pose with a grasp of its model, :mod:`capabilities.gripper.grasp`)
 from __future__ import annotations
 
 from capabilities.base import Capability, CapabilityEnv, CapabilityError
-from capabilities.gripper.backend import GRIPPER, GripperBackend
+from capabilities.gripper.backend import GRIPPER, SUCTION, GripperBackend, HeldSuctionTool
 from capabilities.gripper.grasp import Grasp, grasp_manifest
 from capabilities.jobs import job_from_handle
 from capabilities.kit import manifest
 from capabilities.motion.backend import ARM
 from capabilities.motion.symmetry import SymmetryTable
-from capabilities.tool.backend import SUCTION, SuctionBackend
 from engine.operations import Job, OperationCall, OperationKind
 
 __all__ = ["capability"]
@@ -73,7 +72,7 @@ class IsHolding:
         return Job.answer(self._gripper.is_holding())
 
 
-def _suction(env: CapabilityEnv) -> SuctionBackend | None:
+def _suction(env: CapabilityEnv) -> HeldSuctionTool | None:
     try:
         return env.interface(SUCTION)
     except CapabilityError:

@@ -17,9 +17,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from capabilities.bullet import pybullet
-from capabilities.sim.commands import CommandHandle
+from capabilities.robot.commands import CommandHandle
+from capabilities.robot.kinematics import UR5Kinematics
 from capabilities.sim.freedrive import Freedrive
-from capabilities.sim.kinematics import UR5Kinematics
 from capabilities.sim.safety import CollisionWatch, ProtectiveStop
 from capabilities.sim.trajectory import (
     CartesianTrajectory,

@@ -21,9 +21,9 @@ import numpy as np
 
 from capabilities.bullet import pybullet as p
 from capabilities.camera_source import RGBDFrame
+from capabilities.robot.camera_mounts import SHOULDER_EYE, SHOULDER_TARGET, WRIST_MOUNT, look_at
 from capabilities.sim.flat_surfaces import FlatSurfaces
-from capabilities.sim.objects import SceneError
-from capabilities.sim.transforms import matrix_to_pose, pose_to_matrix
+from capabilities.sim.transforms import pose_to_matrix
 from engine.types import Pose
 
 __all__ = [
@@ -34,35 +34,12 @@ __all__ = [
     "RGBDFrame",
     "SimCamera",
     "camera_fps",
-    "look_at",
     "shoulder_camera",
     "wrist_camera",
 ]
 
 # OpenCV camera frame -> OpenGL camera frame (x right, y up, z backward).
 _CV_TO_GL = np.diag([1.0, -1.0, -1.0, 1.0])
-# Where the shoulder camera's stand puts it: behind the robot base, off to its left (+y) so
-# that the arm at home hides little of the table, aimed at the middle of the default table
-# (centre x 0.55 m, top z 0).
-SHOULDER_EYE = (-0.15, 0.45, 1.50)
-SHOULDER_TARGET = (0.58, -0.02, 0.0)
-
-
-def _wrist_mount(
-    offset: float = 0.08, height: float = 0.02, tilt: float = math.radians(15)
-) -> Pose:
-    """The wrist camera in tool0 (z along the tool axis): beside the gripper on tool0's +x,
-    image down toward the tool axis, tilted by ``tilt`` toward it so that the fingertips show
-    at the bottom of the image and the optical axis meets the tool axis ~0.3 m out."""
-    c, s = math.cos(tilt), math.sin(tilt)
-    rot = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])  # 90 deg about z
-    rot = rot @ np.array([[1.0, 0.0, 0.0], [0.0, c, s], [0.0, -s, c]])  # -tilt about x
-    m = np.eye(4)
-    m[:3, :3], m[:3, 3] = rot, (offset, 0.0, height)
-    return matrix_to_pose(m)
-
-
-WRIST_MOUNT = _wrist_mount()
 
 
 @dataclass(frozen=True)
@@ -129,24 +106,6 @@ class LinkMount:
     body_id: int
     link_index: int
     T_link_camera: Pose = WRIST_MOUNT
-
-
-def look_at(
-    eye: tuple[float, float, float],
-    target: tuple[float, float, float],
-    up: tuple[float, float, float] = (0.0, 0.0, 1.0),
-) -> Pose:
-    """The OpenCV camera pose at ``eye`` looking at ``target`` (image up toward ``up``)."""
-    z = np.subtract(target, eye).astype(float)
-    z /= np.linalg.norm(z)
-    x = np.cross(z, up)
-    if np.linalg.norm(x) < 1e-9:
-        raise SceneError(f"look_at: the view direction {tuple(z)} is parallel to up {up}")
-    x /= np.linalg.norm(x)
-    m = np.eye(4)
-    m[:3, :3] = np.column_stack((x, np.cross(z, x), z))
-    m[:3, 3] = eye
-    return matrix_to_pose(m)
 
 
 class SimCamera:

@@ -21,12 +21,12 @@ from typing import TypeVar
 
 import numpy as np
 
+from capabilities.robot.cell_file import DEFAULT_CONFIG_PATH, CellConfig
+from capabilities.robot.kinematics import UR5Kinematics
 from capabilities.sim.arm_controller import ArmController
-from capabilities.sim.config import DEFAULT_CONFIG_PATH, CellConfig
 from capabilities.sim.errors import SimError
 from capabilities.sim.gripper import GripperController, SimGripper
 from capabilities.sim.ground_truth import GroundTruth
-from capabilities.sim.kinematics import UR5Kinematics
 from capabilities.sim.physics_thread import PhysicsThread, StepHook
 from capabilities.sim.robot import SimRobot
 from capabilities.sim.safety import CollisionWatch

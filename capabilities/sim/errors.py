@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from capabilities.errors import CapabilityError
+from capabilities.robot.errors import RobotCellError
 
 __all__ = ["SimError"]
 
 
-class SimError(CapabilityError, RuntimeError):
-    """The simulated cell cannot do what was asked (not started, closed, bad config)."""
+class SimError(RobotCellError):
+    """The simulated cell cannot do what was asked (not started, closed, bad scene)."""

@@ -13,8 +13,8 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from capabilities.sim.commands import CommandHandle
-from capabilities.sim.kinematics import UR5Kinematics
+from capabilities.robot.commands import CommandHandle
+from capabilities.robot.kinematics import UR5Kinematics
 from capabilities.sim.transforms import rotation_angle, rotation_vector
 
 __all__ = ["Freedrive"]

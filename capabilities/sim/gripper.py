@@ -16,7 +16,7 @@ from __future__ import annotations
 import contextlib
 
 from capabilities.bullet import pybullet
-from capabilities.sim.commands import CommandHandle
+from capabilities.robot.commands import CommandHandle
 from capabilities.sim.physics_thread import PhysicsThread
 from capabilities.sim.robot import post_command
 from capabilities.sim.tools import attach, detach, is_dynamic

@@ -36,8 +36,8 @@ from multiprocessing.connection import Connection
 from pathlib import Path
 from typing import Any
 
+from capabilities.robot.cell_file import CellConfig
 from capabilities.sim.cameras import LinkMount, RGBDFrame, SimCamera
-from capabilities.sim.config import CellConfig
 from capabilities.sim.errors import SimError
 from capabilities.sim.mirror_state import CellSnapshot, apply_snapshot
 from engine.types import Pose

@@ -26,7 +26,7 @@ from contextlib import contextmanager
 from typing import Any, TypeVar
 
 from capabilities.bullet import pybullet
-from capabilities.sim.commands import CommandHandle
+from capabilities.robot.commands import CommandHandle
 from capabilities.sim.errors import SimError
 
 __all__ = ["PhysicsThread", "StepHook"]

@@ -13,10 +13,10 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from capabilities.robot.commands import CommandHandle
+from capabilities.robot.kinematics import UR5Kinematics
 from capabilities.sim.arm_controller import MOVING_SPEED, ArmController
-from capabilities.sim.commands import CommandHandle
 from capabilities.sim.errors import SimError
-from capabilities.sim.kinematics import UR5Kinematics
 from capabilities.sim.physics_thread import PhysicsThread
 from capabilities.sim.safety import ProtectiveStop
 from capabilities.sim.transforms import pose_text_mm, pose_to_matrix

@@ -1,4 +1,6 @@
-"""The robot's URDF: the UR5 of example-robot-data with its meshes, plus our gripper.
+"""The robot's URDF for pybullet: the UR5 of example-robot-data, plus our gripper.
+
+The model files themselves are found with ``capabilities.robot.robot_model``.
 
 example-robot-data refers to its meshes with ``package://`` URLs, which pybullet cannot
 resolve; at load time a copy with absolute mesh paths, without the URDF's ``world`` link (so
@@ -21,40 +23,17 @@ import hashlib
 import os
 import re
 import tempfile
-from importlib import metadata
 from pathlib import Path
 
+from capabilities.robot.robot_model import ROBOTS_DIR, find_ur5_urdf, ur5_collision_meshes
 from capabilities.sim.errors import SimError
-from resources import resource_path
 
-__all__ = ["ROBOTS_DIR", "find_ur5_urdf", "robot_urdf_path"]
+__all__ = ["build_robot_urdf", "robot_urdf_path"]
 
-ROBOTS_DIR = resource_path("robots")
-_UR5_SUFFIX = "example-robot-data/robots/ur_description/urdf/ur5_robot.urdf"
 _PACKAGE_PREFIX = "package://example-robot-data/"
 # A visual mesh of the UR5 (COLLADA, with its own colours), to be replaced in the light variant.
 _VISUAL_MESH = re.compile(r'"[^"]*/meshes/ur5/visual/(\w+)\.dae"\s*/>\s*</geometry>')
 _LIGHT_RGBA = "0.72 0.73 0.75 1"  # the UR's grey
-
-
-def find_ur5_urdf() -> Path:
-    """Path of the UR5 URDF installed by the example-robot-data package.
-
-    Raises:
-        SimError: the package or its UR5 model is not installed.
-    """
-    try:
-        files = metadata.files("example-robot-data") or []
-    except metadata.PackageNotFoundError as exc:
-        raise SimError(
-            "example-robot-data is not installed (pip install example-robot-data)"
-        ) from exc
-    for entry in files:
-        if str(entry).endswith(_UR5_SUFFIX):
-            path = Path(str(entry.locate())).resolve()
-            if path.is_file():
-                return path
-    raise SimError(f"example-robot-data has no {_UR5_SUFFIX}")
 
 
 def _share_dir(urdf: Path) -> Path:
@@ -123,7 +102,7 @@ def robot_urdf_path(cache_dir: Path | None = None, light: bool = False) -> Path:
 def _light_meshes(urdf: Path, folder: Path) -> Path:
     """Convert (once) each UR5 collision mesh to an OBJ with normals in ``folder``."""
     folder.mkdir(parents=True, exist_ok=True)
-    for stl in sorted((urdf.parent.parent / "meshes" / "ur5" / "collision").glob("*.stl")):
+    for stl in sorted(ur5_collision_meshes(urdf).glob("*.stl")):
         target = folder / f"{stl.stem}.obj"
         if target.is_file():
             continue

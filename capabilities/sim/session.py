@@ -29,9 +29,11 @@ import numpy as np
 
 from capabilities.camera_source import CameraSource
 from capabilities.camera_sources import open_source
+from capabilities.cell_features import CellStatus
 from capabilities.collaboration.console import OperatorConsole
-from capabilities.faults import PROTECTIVE_STOP, CellStatus
+from capabilities.faults import PROTECTIVE_STOP
 from capabilities.jobs import WorkerPool
+from capabilities.robot.cell_file import CameraSettings, CellConfig
 from capabilities.sim.bender import WireBender, install_scene_bender
 from capabilities.sim.bender_spec import FaultModel
 from capabilities.sim.cameras import (
@@ -42,7 +44,6 @@ from capabilities.sim.cameras import (
     SimCamera,
 )
 from capabilities.sim.cell import SimCell
-from capabilities.sim.config import CameraSettings, CellConfig
 from capabilities.sim.live_view import LiveView, MirrorRecipe
 from capabilities.sim.mirror_state import take_snapshot
 from capabilities.sim.scene import SceneState, default_scene_path, load_scene, yaw_pose

@@ -13,7 +13,7 @@ from collections.abc import Callable
 import numpy as np
 
 from capabilities.bullet import pybullet
-from capabilities.sim.commands import CommandHandle
+from capabilities.robot.commands import CommandHandle
 from capabilities.sim.physics_thread import PhysicsThread
 from capabilities.sim.robot import post_command
 from capabilities.sim.tools import attach, body_frame_matrix, detach, is_dynamic

@@ -5,8 +5,8 @@ from __future__ import annotations
 import math
 
 from capabilities.bullet import pybullet
+from capabilities.robot.commands import CommandHandle
 from capabilities.sim.cell import SimCell
-from capabilities.sim.commands import CommandHandle
 from engine.types import Pose
 
 __all__ = ["DOWN", "run", "down_at", "distance", "angle_between", "add_box"]

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from capabilities.errors import CapabilityError
-from capabilities.sim.kinematics import Joints, UR5Kinematics
+from capabilities.robot.kinematics import Joints, UR5Kinematics
 from capabilities.sim.transforms import (
     matrix_to_pose,
     matrix_to_quat,

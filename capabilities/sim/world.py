@@ -18,10 +18,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from capabilities.bullet import pybullet
-from capabilities.sim.config import CellConfig
+from capabilities.robot.cell_file import CellConfig
+from capabilities.robot.kinematics import UR5_JOINT_NAMES
+from capabilities.robot.robot_model import ROBOTS_DIR
 from capabilities.sim.flat_surfaces import FlatSurface
-from capabilities.sim.kinematics import UR5_JOINT_NAMES
-from capabilities.sim.robot_model import ROBOTS_DIR, robot_urdf_path
+from capabilities.sim.robot_model import robot_urdf_path
 from engine.types import Pose
 
 __all__ = ["World", "build_world", "light_surfaces"]

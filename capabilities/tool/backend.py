@@ -4,27 +4,23 @@ The suction tool rests in a holster; the gripper takes it by its handle. While i
 the cell's TCP is the suction cup's tip. The simulated cell's ``SimSuctionTool`` implements
 :class:`SuctionBackend` as it is; a real cell switches the vacuum through a digital output
 and reads the vacuum sensor from an input. The arm and gripper interfaces are the motion and
-gripper capabilities' backends.
+gripper capabilities' backends; :class:`SuctionBackend` extends what a grasp reads of the
+tool (``capabilities.gripper.backend.HeldSuctionTool``).
 """
 
 from __future__ import annotations
 
 from typing import Protocol
 
+from capabilities.gripper.backend import HeldSuctionTool
 from capabilities.jobs import CommandHandleLike
 from engine.types import Pose
 
-__all__ = ["SUCTION", "SuctionBackend"]
-
-SUCTION = "suction"
+__all__ = ["SuctionBackend"]
 
 
-class SuctionBackend(Protocol):
+class SuctionBackend(HeldSuctionTool, Protocol):
     """The suction tool: vacuum, vacuum sensor, and where its holster is."""
-
-    def suction_on(self) -> CommandHandleLike:
-        """Switch the vacuum on (fails when the tool is not in the gripper)."""
-        ...
 
     def suction_off(self) -> CommandHandleLike:
         """Switch the vacuum off, releasing the part."""
@@ -32,14 +28,6 @@ class SuctionBackend(Protocol):
 
     def vacuum_on(self) -> bool:
         """True while the vacuum is switched on."""
-        ...
-
-    def has_part(self) -> bool:
-        """The vacuum sensor: True while a part is held at the cup."""
-        ...
-
-    def in_hand(self) -> bool:
-        """True while the gripper holds the suction tool."""
         ...
 
     def handle_grasp_pose(self) -> Pose:

@@ -11,11 +11,11 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from capabilities.base import Capability, CapabilityEnv
-from capabilities.gripper.backend import GRIPPER, GripperBackend
+from capabilities.gripper.backend import GRIPPER, SUCTION, GripperBackend
 from capabilities.jobs import chain_jobs, job_from_handle
 from capabilities.kit import manifest
 from capabilities.motion.backend import ARM, ArmBackend
-from capabilities.tool.backend import SUCTION, SuctionBackend
+from capabilities.tool.backend import SuctionBackend
 from engine.operations import (
     Job,
     OperationCall,

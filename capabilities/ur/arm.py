@@ -16,8 +16,8 @@ from concurrent.futures import Future
 from typing import TYPE_CHECKING, Any
 
 from capabilities.faults import PROTECTIVE_STOP
-from capabilities.sim.commands import CommandHandle
-from capabilities.sim.kinematics import UR5Kinematics
+from capabilities.robot.commands import CommandHandle
+from capabilities.robot.kinematics import UR5Kinematics
 from capabilities.ur.connection import (
     HALT_DECEL,
     NO_SCRIPT,

@@ -28,13 +28,14 @@ from typing import Any
 
 from capabilities.camera_source import CameraSource
 from capabilities.camera_sources import open_source
-from capabilities.cell_robot import TCP_OF_TOOL
+from capabilities.cell_features import CellStatus
 from capabilities.collaboration.console import OperatorConsole
 from capabilities.collaboration.inputs import DigitalInputButton
-from capabilities.faults import CONNECTION_LOST, CellStatus
+from capabilities.faults import CONNECTION_LOST
 from capabilities.jobs import WorkerPool
 from capabilities.object_library import ObjectLibrary
-from capabilities.sim.config import CellConfig
+from capabilities.robot.cell_file import CellConfig
+from capabilities.robot.cell_robot import TCP_OF_TOOL
 from capabilities.ur.arm import URArm
 from capabilities.ur.connection import NO_SCRIPT, URConnection, fault_reason
 from capabilities.ur.frames import URFrames
@@ -49,7 +50,7 @@ from capabilities.ur.tool_io import (
 from capabilities.world_model import WorldModel
 from engine.types import Pose
 
-__all__ = ["CellStatus", "TEACH_BUTTON", "URCellSession"]
+__all__ = ["TEACH_BUTTON", "URCellSession"]
 
 _log = logging.getLogger(__name__)
 TEACH_BUTTON = "teach"  # the console button the pendant's teach button presses on release

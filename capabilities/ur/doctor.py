@@ -18,7 +18,7 @@ from capabilities.check_result import CheckResult
 from capabilities.errors import CapabilityError
 
 if TYPE_CHECKING:
-    from capabilities.sim.config import CellConfig
+    from capabilities.robot.cell_file import CellConfig
     from capabilities.ur.connection import URConnection
 
 __all__ = ["cell_checks"]
@@ -26,7 +26,7 @@ __all__ = ["cell_checks"]
 
 def cell_checks(path: str, connect_timeout: float = 10.0) -> list[CheckResult]:
     """The checks of one cell file (a simulated cell gets the file and camera checks only)."""
-    from capabilities.sim.config import CellConfig, CellConfigError
+    from capabilities.robot.cell_file import CellConfig, CellConfigError
 
     try:
         config = CellConfig.load(path)

@@ -1,4 +1,4 @@
-"""Errors of the UR cell and the loopback UR controller."""
+"""Errors of the UR cell."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import logging
 
 from capabilities.errors import CapabilityError
 
-__all__ = ["URError", "URConnectionLost", "EmulatorError", "ur_words"]
+__all__ = ["URError", "URConnectionLost", "ur_words"]
 
 
 class URError(CapabilityError):
@@ -15,10 +15,6 @@ class URError(CapabilityError):
 
 class URConnectionLost(URError):
     """The connection to the UR controller is gone."""
-
-
-class EmulatorError(CapabilityError):
-    """The loopback UR controller cannot start or was asked something it does not do."""
 
 
 # What ur_rtde and its controller say (the text of its exceptions), in this project's words.

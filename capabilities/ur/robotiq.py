@@ -13,7 +13,7 @@ import socket
 import time
 from typing import TYPE_CHECKING
 
-from capabilities.sim.commands import CommandHandle
+from capabilities.robot.commands import CommandHandle
 from capabilities.ur.connection import URConnection
 from capabilities.ur.errors import URError, ur_words
 

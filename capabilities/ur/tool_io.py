@@ -12,7 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from capabilities.sim.commands import CommandHandle
+from capabilities.robot.commands import CommandHandle
 from capabilities.ur.connection import URConnection, fault_reason
 from capabilities.ur.errors import URError, ur_words
 from engine.types import Pose

@@ -25,6 +25,8 @@ from PySide6.QtCore import QPoint, Qt, QTimer, Signal
 from PySide6.QtGui import QPainter, QPixmap
 from PySide6.QtWidgets import QCheckBox, QLabel, QPushButton, QToolBar, QVBoxLayout, QWidget
 
+from capabilities.base import Cell
+from capabilities.cell_features import ShowsGroundTruth
 from capabilities.geometry import pose_to_matrix
 from capabilities.motion.symmetry import SymmetryTable
 from capabilities.motion.targets import TargetResolver
@@ -83,7 +85,7 @@ class Scene3DPanel(PointingMixin, QWidget):
             self.problem_label.setAlignment(Qt.AlignmentFlag.AlignCenter)
             layout.addWidget(self.problem_label)
             return
-        self._cell: Any = None
+        self._cell: Cell | None = None
         self._frames: FrameSource = lambda _name: None
         self._regions: list[tuple[str, Region]] = []
         self._waypoints: list[Waypoint] = []
@@ -136,7 +138,7 @@ class Scene3DPanel(PointingMixin, QWidget):
 
     # ------------------------------------------------------------------ inputs
 
-    def set_cell(self, cell: Any) -> None:
+    def set_cell(self, cell: Cell | None) -> None:
         """Draw another cell (None: only the grid)."""
         if self.view is None:
             return
@@ -364,11 +366,7 @@ class Scene3DPanel(PointingMixin, QWidget):
         elif not self.truth_box.isChecked():
             self._replace("truth", [])
         cell = self._cell
-        if (
-            self.truth_box.isChecked()
-            and callable(getattr(cell, "truth_pose", None))
-            and hasattr(cell, "scene")
-        ):
+        if self.truth_box.isChecked() and isinstance(cell, ShowsGroundTruth):
             names = list(cell.scene.objects)
             self._truth_job = self._workers.submit(lambda: [(n, cell.truth_pose(n)) for n in names])
 

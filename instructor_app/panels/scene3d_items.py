@@ -43,9 +43,9 @@ _LINK_MESHES = {
 
 
 def _ur5_mesh_dir() -> Path:
-    from capabilities.sim.robot_model import find_ur5_urdf
+    from capabilities.robot.robot_model import ur5_collision_meshes
 
-    return find_ur5_urdf().parents[1] / "meshes" / "ur5" / "collision"
+    return ur5_collision_meshes()
 
 
 @functools.lru_cache(maxsize=64)

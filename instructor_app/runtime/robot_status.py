@@ -11,11 +11,10 @@ script" on a UR, "Unlock protective stop" on the simulated cell once the delay h
 
 from __future__ import annotations
 
-from typing import Any
-
 from PySide6.QtCore import QTimer, Signal
 from PySide6.QtWidgets import QLabel, QToolButton, QWidget
 
+from capabilities.cell_features import CellStatus, ClearsStop, ReportsStatus
 from instructor_app.runtime.session import CellSession
 
 __all__ = ["CellClearButton", "RobotStatusLabel"]
@@ -48,7 +47,7 @@ class RobotStatusLabel(QLabel):
         super().__init__(parent)
         self.setObjectName("RobotStatus")
         self._session = session
-        self._shown: Any = None
+        self._shown: CellStatus | None = None
         self._timer = QTimer(self)
         self._timer.setInterval(interval_ms)
         self._timer.timeout.connect(self.refresh)
@@ -58,8 +57,8 @@ class RobotStatusLabel(QLabel):
 
     def refresh(self) -> None:
         """Read the cell's status snapshot and show it (only when it changed)."""
-        status_of = getattr(self._session.cell, "status", None)
-        status = status_of() if callable(status_of) else None
+        cell = self._session.cell
+        status = cell.status() if isinstance(cell, ReportsStatus) else None
         if status == self._shown:
             return
         if (status is None) != (self._shown is None):
@@ -95,12 +94,12 @@ class RobotStatusLabel(QLabel):
     @property
     def fault(self) -> str:
         """The problem shown now ("" when the robot can move or there is no robot)."""
-        return str(getattr(self._shown, "problem", ""))
+        return self._shown.problem if self._shown is not None else ""
 
     @property
     def clear_action(self) -> str:
         """The operator's clear the cell offers now ("" for none)."""
-        return str(getattr(self._shown, "clear_action", ""))
+        return self._shown.clear_action if self._shown is not None else ""
 
 
 class CellClearButton(QToolButton):
@@ -125,6 +124,6 @@ class CellClearButton(QToolButton):
         self.setVisible(bool(action))
 
     def _clear(self) -> None:
-        clear = getattr(self._session.cell, "clear", None)
-        if callable(clear):
-            clear()
+        cell = self._session.cell
+        if isinstance(cell, ClearsStop):
+            cell.clear()

@@ -19,22 +19,22 @@ from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 from PySide6.QtCore import QObject, Signal
 
-from capabilities.base import CapabilityRegistry
-from capabilities.cell_robot import read_robot
+from capabilities.base import CapabilityRegistry, Cell
+from capabilities.cell_features import ClosableCell
 from capabilities.cells import CELL_NAMES, CellError, is_cell_file, open_cell
+from capabilities.robot.cell_robot import read_robot
 from engine.json_reader import JsonFileError, JsonReader, read_json_file
 
 __all__ = ["CellSession", "CellOpener", "RegistryFactory", "opening_words"]
 
-CellOpener = Callable[..., Any]
-RegistryFactory = Callable[[Any], CapabilityRegistry]
+CellOpener = Callable[..., ClosableCell]
+RegistryFactory = Callable[[Cell | None], CapabilityRegistry]
 
 
-def _default_registry(cell: Any) -> CapabilityRegistry:
+def _default_registry(cell: Cell | None) -> CapabilityRegistry:
     return CapabilityRegistry(cell=cell)
 
 
@@ -64,7 +64,7 @@ class _Arrival:
     """What the worker thread hands back: the opened cell, or why it did not open."""
 
     name: str
-    cell: Any
+    cell: ClosableCell | None
     registry: CapabilityRegistry | None
     error: str
     generation: int
@@ -118,7 +118,7 @@ class CellSession(QObject):
         self.scene = scene
         self._opener = opener
         self._registry_factory = registry_factory
-        self.cell: Any = None
+        self.cell: ClosableCell | None = None
         self.registry: CapabilityRegistry = registry_factory(None)
         self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="costar-cell-close")
         self._generations = itertools.count(1)
@@ -222,7 +222,7 @@ class CellSession(QObject):
     def _use(
         self,
         name: str,
-        cell: Any,
+        cell: ClosableCell | None,
         close_old_in_background: bool,
         registry: CapabilityRegistry | None = None,
     ) -> None:
@@ -246,7 +246,7 @@ class CellSession(QObject):
         Returns as :meth:`open`; False while a cell opens in the background."""
         if self._opening:
             return False
-        if self.cell is not None and getattr(self.cell, "name", "") != "sim":
+        if self.cell is not None and self.cell.name != "sim":
             self._use(self.name, self.cell, close_old_in_background=False)
             return True
         cell, self.cell = self.cell, None

@@ -9,7 +9,7 @@ import pytest
 
 from capabilities.base import CapabilityRegistry
 from capabilities.kit import CapabilitySettingsError
-from capabilities.sim.config import DEFAULT_CONFIG_PATH, CellConfig
+from capabilities.robot.cell_file import DEFAULT_CONFIG_PATH, CellConfig
 
 
 def test_the_shipped_cell_file_gives_valid_settings() -> None:

@@ -8,7 +8,7 @@ import pytest
 
 from capabilities.faults import fault_error
 from capabilities.jobs import WorkerPool, chain_jobs, job_from_handle
-from capabilities.sim.commands import CommandHandle
+from capabilities.robot.commands import CommandHandle
 from engine.error_types import ErrorType
 from engine.operations import Job, OperationFailed
 from engine.status import FAILURE

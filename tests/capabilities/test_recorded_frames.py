@@ -15,7 +15,7 @@ from capabilities.camera_sources import open_source
 from capabilities.errors import CapabilityError
 from capabilities.markers import capability
 from capabilities.recorded_frames import FrameRecorder, RecordedCamera, RecordingError, record
-from capabilities.sim.config import DEFAULT_CONFIG_PATH, CellConfig
+from capabilities.robot.cell_file import DEFAULT_CONFIG_PATH, CellConfig
 from engine.build import build_tree
 from engine.executor import run_to_end
 from engine.spec import NodeKind, NodeSpec, PlanSpec

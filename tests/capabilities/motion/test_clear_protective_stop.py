@@ -8,7 +8,7 @@ import time
 import pytest
 
 from capabilities.base import CapabilityRegistry
-from capabilities.sim.commands import CommandHandle
+from capabilities.robot.commands import CommandHandle
 from engine.build import build_tree
 from engine.error_types import ErrorType
 from engine.spec import NodeKind, NodeSpec, PlanSpec

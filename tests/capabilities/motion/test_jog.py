@@ -12,7 +12,7 @@ import pytest
 
 from capabilities.motion.jog import JogFailed, Jogger, jog_target
 from capabilities.motion.targets import ResolvedTarget
-from capabilities.sim.commands import CommandHandle
+from capabilities.robot.commands import CommandHandle
 from engine.types import JointConfig, Pose
 
 DOWN = (1.0, 0.0, 0.0, 0.0)  # the tool's z points down

@@ -11,6 +11,7 @@ import pybullet
 import pytest
 from ur_analytic_ik import ur5
 
+from capabilities.robot.kinematics import UR5_JOINT_NAMES, UR5Kinematics
 from capabilities.robot_body import (
     LINK_NAMES,
     RobotBody,
@@ -18,7 +19,6 @@ from capabilities.robot_body import (
     pose_matrix,
     robot_base_from_arm,
 )
-from capabilities.sim.kinematics import UR5_JOINT_NAMES, UR5Kinematics
 from capabilities.sim.robot_model import robot_urdf_path
 from engine.types import Pose
 

@@ -10,15 +10,14 @@ import numpy as np
 import pybullet as p
 import pytest
 
+from capabilities.robot.camera_mounts import WRIST_MOUNT, look_at
 from capabilities.sim.cameras import (
-    WRIST_MOUNT,
     CameraConfig,
     FixedMount,
     LinkMount,
     NoiseConfig,
     SimCamera,
     camera_fps,
-    look_at,
     shoulder_camera,
     wrist_camera,
 )

@@ -11,7 +11,7 @@ from typing import Any
 import pytest
 
 from capabilities.errors import CapabilityError
-from capabilities.sim.config import DEFAULT_CONFIG_PATH, CellConfig, CellConfigError
+from capabilities.robot.cell_file import DEFAULT_CONFIG_PATH, CellConfig, CellConfigError
 from capabilities.sim.scene import default_scene_path
 from capabilities.sim.scene_spec import SceneFileError, read_scene
 

@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 
 from capabilities.bullet import pybullet as p
-from capabilities.sim.cameras import CameraConfig, FixedMount, SimCamera, look_at
-from capabilities.sim.config import CellConfig
+from capabilities.robot.camera_mounts import look_at
+from capabilities.robot.cell_file import CellConfig
+from capabilities.sim.cameras import CameraConfig, FixedMount, SimCamera
 from capabilities.sim.flat_surfaces import FlatSurfaces
 from capabilities.sim.world import build_world, light_surfaces
 

@@ -11,7 +11,7 @@ from collections.abc import Iterator
 import pytest
 
 from capabilities.jobs import WorkerPool
-from capabilities.sim.commands import CommandHandle
+from capabilities.robot.commands import CommandHandle
 from capabilities.sim.errors import SimError
 from capabilities.sim.physics_thread import PhysicsThread
 from capabilities.sim.session import SimCellSession

@@ -15,11 +15,11 @@ import pytest
 
 from capabilities.base import CapabilityRegistry
 from capabilities.bullet import pybullet
-from capabilities.cell_robot import RobotSettings
 from capabilities.faults import PROTECTIVE_STOP, fault_error, hold_check
+from capabilities.robot.cell_file import CellConfig
+from capabilities.robot.cell_robot import RobotSettings
+from capabilities.robot.commands import CommandHandle
 from capabilities.sim.bender_spec import FaultModel
-from capabilities.sim.commands import CommandHandle
-from capabilities.sim.config import CellConfig
 from capabilities.sim.errors import SimError
 from capabilities.sim.scene import default_scene_path
 from capabilities.sim.session import SimCellSession

@@ -8,8 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from capabilities.sim.config import DEFAULT_CONFIG_PATH, CellConfig
-from capabilities.sim.errors import SimError
+from capabilities.robot.cell_file import DEFAULT_CONFIG_PATH, CellConfig, CellConfigError
 
 
 def test_default_file_matches_the_built_in_defaults() -> None:
@@ -27,12 +26,12 @@ def test_a_bad_field_names_the_file_and_json_path(tmp_path: Path) -> None:
     data["holster_pose"]["position"] = [0.1, "x", 0.0]
     path = tmp_path / "cell.json"
     path.write_text(json.dumps(data))
-    with pytest.raises(SimError, match=r"cell\.json.*\$\.holster_pose\.position"):
+    with pytest.raises(CellConfigError, match=r"cell\.json.*\$\.holster_pose\.position"):
         CellConfig.load(path)
 
 
 def test_the_cell_file_describes_the_cameras() -> None:
-    from capabilities.sim.config import DEFAULT_CONFIG_PATH, CellConfig
+    from capabilities.robot.cell_file import DEFAULT_CONFIG_PATH, CellConfig
 
     config = CellConfig.load(DEFAULT_CONFIG_PATH)
     assert set(config.cameras) == {"shoulder", "wrist"}
@@ -44,7 +43,7 @@ def test_the_cell_file_describes_the_cameras() -> None:
 def test_a_bad_camera_entry_names_its_json_path() -> None:
     import pytest
 
-    from capabilities.sim.config import CellConfig, CellConfigError
+    from capabilities.robot.cell_file import CellConfig, CellConfigError
 
     data = CellConfig().to_json()
     data["cameras"]["shoulder"]["size"] = [640, "tall"]
@@ -57,7 +56,7 @@ def test_a_bad_camera_entry_names_its_json_path() -> None:
 def test_a_session_builds_the_configured_cameras() -> None:
     import dataclasses
 
-    from capabilities.sim.config import CellConfig
+    from capabilities.robot.cell_file import CellConfig
     from capabilities.sim.session import SimCellSession
 
     config = CellConfig()

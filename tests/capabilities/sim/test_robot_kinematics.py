@@ -8,10 +8,11 @@ from pathlib import Path
 import numpy as np
 import pybullet
 
+from capabilities.robot.cell_file import CellConfig
+from capabilities.robot.kinematics import UR5_JOINT_NAMES, UR5Kinematics
+from capabilities.robot.robot_model import find_ur5_urdf
 from capabilities.sim.cell import SimCell
-from capabilities.sim.config import CellConfig
-from capabilities.sim.kinematics import UR5_JOINT_NAMES, UR5Kinematics
-from capabilities.sim.robot_model import build_robot_urdf, find_ur5_urdf, robot_urdf_path
+from capabilities.sim.robot_model import build_robot_urdf, robot_urdf_path
 from capabilities.sim.testing import angle_between, distance
 from engine.types import Pose
 

@@ -6,8 +6,8 @@ import math
 
 import numpy as np
 
+from capabilities.robot.commands import CommandHandle
 from capabilities.sim.cell import SimCell
-from capabilities.sim.commands import CommandHandle
 from capabilities.sim.testing import angle_between, distance, down_at, run
 from engine.types import Pose
 

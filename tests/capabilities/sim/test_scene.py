@@ -14,8 +14,8 @@ from typing import Any
 import pybullet as p
 import pytest
 
-from capabilities.sim.config import CellConfig
-from capabilities.sim.kinematics import UR5Kinematics
+from capabilities.robot.cell_file import CellConfig
+from capabilities.robot.kinematics import UR5Kinematics
 from capabilities.sim.objects import (
     ObjectLibrary,
     ObjectLibraryError,

@@ -9,7 +9,7 @@ import pytest
 
 from capabilities.ur.arm import URArm
 from capabilities.ur.connection import URConnection
-from capabilities.ur.emulator.process import EmulatorProcess
+from capabilities.ur_emulator.process import EmulatorProcess
 from engine.types import Pose
 from tests.capabilities.ur.emulators import HOME, next_host
 

@@ -20,7 +20,7 @@ from capabilities.base import CapabilityRegistry, Cell
 from capabilities.cells import CellError, open_cell
 from capabilities.cli import main
 from capabilities.faults import hold_check
-from capabilities.sim.config import DEFAULT_CONFIG_PATH, CellConfig, CellConfigError
+from capabilities.robot.cell_file import DEFAULT_CONFIG_PATH, CellConfig, CellConfigError
 from capabilities.ur.connection import SILENCE_S
 from engine.build import build_tree
 from engine.events import Event, RunHeld, StatusChanged

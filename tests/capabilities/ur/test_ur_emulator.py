@@ -8,9 +8,9 @@ import rtde_control
 import rtde_io
 import rtde_receive
 
-from capabilities.ur.emulator import UREmulator
-from capabilities.ur.emulator.servers import check_loopback
-from capabilities.ur.errors import EmulatorError
+from capabilities.ur_emulator import UREmulator
+from capabilities.ur_emulator.errors import EmulatorError
+from capabilities.ur_emulator.servers import check_loopback
 from tests.capabilities.ur.emulators import wait_for
 
 pytestmark = pytest.mark.sim

@@ -20,8 +20,8 @@ import pytest
 import rtde_control
 
 from capabilities.cli import main
-from capabilities.ur.emulator.process import EmulatorProcess
 from capabilities.ur.errors import URError, ur_words
+from capabilities.ur_emulator.process import EmulatorProcess
 from engine.files import save_plan
 from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
 from engine.types import JointConfig, ParamType

@@ -13,9 +13,9 @@ import pytest
 from PySide6.QtCore import Qt
 
 from capabilities.bullet import pybullet
-from capabilities.cell_robot import RobotSettings
 from capabilities.faults import PROTECTIVE_STOP
-from capabilities.sim.config import CellConfig
+from capabilities.robot.cell_file import CellConfig
+from capabilities.robot.cell_robot import RobotSettings
 from capabilities.sim.testing import add_box, down_at
 from engine.files import dump_plan
 from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec

@@ -10,7 +10,7 @@ import dashboard_client
 import pytest
 from PySide6.QtCore import Qt
 
-from capabilities.ur.emulator.process import EmulatorProcess
+from capabilities.ur_emulator.process import EmulatorProcess
 from instructor_app.runtime.session import CellSession
 from tests.capabilities.ur.emulators import next_host
 from tests.instructor_app.gui_driver import ScriptedDialogs, make_window

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from capabilities.ur.emulator.process import EmulatorProcess
+from capabilities.ur_emulator.process import EmulatorProcess
 from engine.files import save_plan
 from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
 from engine.types import JointConfig, ParamType

@@ -1,7 +1,8 @@
-"""Command handles: what a simulated-cell command returns to the thread that sent it.
+"""Command handles: what a cell command returns to the thread that sent it.
 
-A handle is finished exactly once, by the physics thread (or at once by the sender when the
-command is refused). Other threads poll ``done()`` or wait on it; callbacks run on the thread
+A handle is finished exactly once, by the thread that runs the command (the simulated cell's
+physics thread, the UR backend's I/O thread) or at once by the sender when the command is
+refused. Other threads poll ``done()`` or wait on it; callbacks run on the thread
 that finishes the handle.
 """
 
@@ -17,7 +18,7 @@ _log = logging.getLogger(__name__)
 
 
 class CommandHandle:
-    """The future result of one command sent to the simulated cell.
+    """The future result of one command sent to a cell.
 
     Attributes:
         name: what the command was, for messages ("move_linear").

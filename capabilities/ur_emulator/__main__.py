@@ -1,11 +1,11 @@
-"""``costar ur-emulator`` (or ``python -m capabilities.ur.emulator``): run the emulator.
+"""``costar ur-emulator`` (or ``python -m capabilities.ur_emulator``): run the emulator.
 
 ``--scene NAME --seed N`` loads a scene of the simulated cell around the emulated arm;
 ``--write-cell FILE`` writes a cell file whose robot is this emulator, so that
 ``costar run PLAN --cell FILE`` takes the real-robot path without a robot.
 
 With ``--control stdin`` it reads fault commands from standard input, one a line, and answers
-each with one JSON line (see :mod:`capabilities.ur.emulator.process`, which drives it so).
+each with one JSON line (see :mod:`capabilities.ur_emulator.process`, which drives it so).
 ur_rtde holds the GIL while it connects, so the emulator always runs in its own process.
 """
 
@@ -22,9 +22,9 @@ from pathlib import Path
 from typing import Any
 
 from capabilities.stream_camera import FRAME_PORT
-from capabilities.ur.emulator import VERSIONS, UREmulator
-from capabilities.ur.emulator.servers import check_loopback
-from capabilities.ur.errors import EmulatorError
+from capabilities.ur_emulator import VERSIONS, UREmulator
+from capabilities.ur_emulator.errors import EmulatorError
+from capabilities.ur_emulator.servers import check_loopback
 
 __all__ = ["main", "run_command"]
 
@@ -108,7 +108,7 @@ def write_cell_file(
     Raises:
         EmulatorError: the file cannot be written.
     """
-    from capabilities.cell_robot import RobotSettings, ToolSettings
+    from capabilities.robot.cell_robot import RobotSettings, ToolSettings
     from engine.plan_writer import write_atomic
 
     model = "UR5 CB3" if version.startswith("3.") else "UR5e"
@@ -141,7 +141,7 @@ def _emulator(args: argparse.Namespace, stack: contextlib.ExitStack) -> UREmulat
     )  # fmt: skip
 
 
-def main(argv: list[str] | None = None, prog: str = "python -m capabilities.ur.emulator") -> int:
+def main(argv: list[str] | None = None, prog: str = "python -m capabilities.ur_emulator") -> int:
     parser = argparse.ArgumentParser(
         prog=prog,
         description="A loopback UR controller (dashboard, script port, RTDE) backed by the "

@@ -10,7 +10,7 @@ from __future__ import annotations
 import re
 import struct
 
-from capabilities.ur.errors import EmulatorError
+from capabilities.ur_emulator.errors import EmulatorError
 
 __all__ = [
     "DATA_PACKAGE",

@@ -2,7 +2,7 @@
 
 One file type describes every cell (``*.cell.json``, schema ``resources/schemas/cell.schema
 .json``; the simulated cell's default is ``resources/cells/sim_default.json``). Its ``robot``
-block (``capabilities/cell_robot.py``) says whether the arm is the simulated one or a UR
+block (``cell_robot``) says whether the arm is the simulated one or a UR
 controller at a host. The world frame has z up; the UR base frame (what the robot's
 controller calls "base") stands at ``robot_base`` (the mounting) and the table top is at
 ``table_top_z``. Format version 2 added ``robot`` and ``objects``; version 1 files still read.
@@ -15,9 +15,9 @@ from pathlib import Path
 from typing import Any
 
 from capabilities.camera_source import SOURCE_KINDS
-from capabilities.cell_robot import RobotSettings, read_robot
-from capabilities.sim.cameras import SHOULDER_EYE, SHOULDER_TARGET, WRIST_MOUNT, look_at
-from capabilities.sim.errors import SimError
+from capabilities.robot.camera_mounts import SHOULDER_EYE, SHOULDER_TARGET, WRIST_MOUNT, look_at
+from capabilities.robot.cell_robot import RobotSettings, read_robot
+from capabilities.robot.errors import RobotCellError
 from engine.json_reader import JsonFileError, JsonReader, read_json_file
 from engine.types import ParamType, Pose
 from resources import resource_path
@@ -36,7 +36,7 @@ READABLE_VERSIONS = (1, 2)
 DEFAULT_CONFIG_PATH = resource_path("cells", "sim_default.json")
 
 
-class CellConfigError(SimError):
+class CellConfigError(RobotCellError):
     """A cell configuration file is missing or off; the message names the file and JSON path.
 
     It wraps the reader's :class:`engine.json_reader.JsonFileError` (its ``__cause__``).
@@ -97,7 +97,7 @@ def _default_cameras() -> dict[str, CameraSettings]:
 
 @dataclass(frozen=True)
 class CellConfig:
-    """Everything the simulated cell needs to build its world.
+    """A cell file, read: where things stand, the tools, the cameras and the robot.
 
     Attributes:
         robot_base: world pose of the UR base frame. The default puts it at the origin,

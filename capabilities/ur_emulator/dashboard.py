@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 from capabilities.ur.modes import RobotMode, SafetyMode
 
 if TYPE_CHECKING:
-    from capabilities.ur.emulator.controller import EmulatedController
+    from capabilities.ur_emulator.controller import EmulatedController
 
 __all__ = ["dashboard_reply"]
 

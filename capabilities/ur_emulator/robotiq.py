@@ -16,8 +16,8 @@ import threading
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from capabilities.sim.commands import CommandHandle
-    from capabilities.ur.emulator.controller import EmulatedController
+    from capabilities.robot.commands import CommandHandle
+    from capabilities.ur_emulator.controller import EmulatedController
 
 __all__ = ["ROBOTIQ_PORT", "RobotiqURCap", "robotiq_client"]
 

@@ -10,7 +10,7 @@ from capabilities.bullet import pybullet
 
 if TYPE_CHECKING:
     from capabilities.sim.cell import SimCell
-    from capabilities.ur.emulator.controller import EmulatedController
+    from capabilities.ur_emulator.controller import EmulatedController
 
 __all__ = ["ContactWatch"]
 

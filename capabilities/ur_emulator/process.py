@@ -16,8 +16,8 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any
 
-from capabilities.ur.emulator.servers import check_loopback
-from capabilities.ur.errors import EmulatorError
+from capabilities.ur_emulator.errors import EmulatorError
+from capabilities.ur_emulator.servers import check_loopback
 from engine.types import Pose
 
 __all__ = ["EmulatorProcess"]
@@ -26,7 +26,7 @@ _ROOT = Path(__file__).resolve().parents[3]
 
 
 class EmulatorProcess:
-    """``python -m capabilities.ur.emulator`` in a child process; a context manager.
+    """``python -m capabilities.ur_emulator`` in a child process; a context manager.
 
     Args:
         host: a loopback address (127.0.0.0/8).
@@ -53,7 +53,7 @@ class EmulatorProcess:
         self.host = check_loopback(host)
         self.version = version
         self._args = [
-            sys.executable, "-m", "capabilities.ur.emulator", "--host", host,
+            sys.executable, "-m", "capabilities.ur_emulator", "--host", host,
             "--version", version, "--speed", str(speed), "--unlock-delay", str(unlock_delay),
             "--control", "stdin",
         ]  # fmt: skip

@@ -19,8 +19,8 @@ import numpy as np
 from capabilities.ur.frames import matrix_from_rotvec_pose
 
 if TYPE_CHECKING:
-    from capabilities.sim.commands import CommandHandle
-    from capabilities.ur.emulator.controller import EmulatedController
+    from capabilities.robot.commands import CommandHandle
+    from capabilities.ur_emulator.controller import EmulatedController
 
 __all__ = ["ControlProgram"]
 

@@ -20,14 +20,14 @@ import numpy as np
 from ur_analytic_ik import ur5
 
 from capabilities.geometry import matrix_to_pose, pose_to_matrix
+from capabilities.robot.commands import CommandHandle
 from capabilities.sim.cell import SimCell
-from capabilities.sim.commands import CommandHandle
-from capabilities.ur.emulator.faults import ContactWatch
-from capabilities.ur.emulator.program import ControlProgram
-from capabilities.ur.emulator.robotiq import RobotiqURCap
-from capabilities.ur.emulator.wire import OUTPUT_TYPES, output_type
 from capabilities.ur.frames import matrix_from_rotvec_pose, rotvec_pose_from_matrix
 from capabilities.ur.modes import RobotMode, RuntimeState, SafetyMode
+from capabilities.ur_emulator.faults import ContactWatch
+from capabilities.ur_emulator.program import ControlProgram
+from capabilities.ur_emulator.robotiq import RobotiqURCap
+from capabilities.ur_emulator.wire import OUTPUT_TYPES, output_type
 
 __all__ = ["EmulatedController", "VERSIONS"]
 

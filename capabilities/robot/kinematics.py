@@ -15,7 +15,7 @@ from collections.abc import Sequence
 import numpy as np
 from ur_analytic_ik import ur5
 
-from capabilities.sim.transforms import matrix_to_pose, pose_to_matrix, rotation_vector
+from capabilities.geometry import matrix_to_pose, pose_to_matrix, rotation_vector
 from engine.types import Pose
 
 __all__ = ["UR5Kinematics", "UR5_JOINT_LIMITS", "UR5_JOINT_NAMES", "Joints"]
@@ -65,7 +65,7 @@ class UR5Kinematics:
         m = self.flange_matrix(q)
         if tcp is not None:
             m = m @ pose_to_matrix(tcp)
-        return matrix_to_pose(m)
+        return matrix_to_pose(m, project=False)
 
     def within_limits(self, q: Joints) -> bool:
         """True when every joint is inside its limits."""

@@ -19,9 +19,9 @@ from types import TracebackType
 from capabilities.camera_source import CameraSource
 from capabilities.sim.cell import SimCell
 from capabilities.stream_camera import FRAME_PORT, serve_frames
-from capabilities.ur.emulator.controller import VERSIONS, EmulatedController
-from capabilities.ur.emulator.robotiq import ROBOTIQ_PORT, robotiq_client
-from capabilities.ur.emulator.servers import (
+from capabilities.ur_emulator.controller import VERSIONS, EmulatedController
+from capabilities.ur_emulator.robotiq import ROBOTIQ_PORT, robotiq_client
+from capabilities.ur_emulator.servers import (
     Server,
     check_loopback,
     dashboard_client,

@@ -16,10 +16,10 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from capabilities.ur.emulator import wire
-from capabilities.ur.emulator.controller import EmulatedController
-from capabilities.ur.emulator.dashboard import dashboard_reply
-from capabilities.ur.errors import EmulatorError
+from capabilities.ur_emulator import wire
+from capabilities.ur_emulator.controller import EmulatedController
+from capabilities.ur_emulator.dashboard import dashboard_reply
+from capabilities.ur_emulator.errors import EmulatorError
 
 __all__ = ["Server", "check_loopback", "rtde_client", "script_client", "dashboard_client"]
 
