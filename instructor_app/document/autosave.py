@@ -11,6 +11,7 @@ start.
 from __future__ import annotations
 
 import json
+import logging
 import os
 import sys
 import tempfile
@@ -22,9 +23,12 @@ from pathlib import Path
 
 from PySide6.QtCore import QObject, QStandardPaths, QTimer, Signal
 
+from engine.json_reader import JsonFileError, JsonReader, read_json_file
 from instructor_app.document.editing import PlanDocument
 from instructor_app.document.model import DocumentError
 from instructor_app.errors import InstructorError
+
+_log = logging.getLogger(__name__)
 
 __all__ = [
     "AutosaveError",
@@ -125,21 +129,38 @@ def find_recoveries(folder: Path, exclude: set[Path] | None = None) -> list[Reco
         if plan_file.resolve() in skip or not plan_file.exists():
             continue
         try:
-            data = json.loads(sidecar.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
+            recovery = _read_sidecar(sidecar, plan_file)
+        except JsonFileError as exc:  # another version's or a broken sidecar: not ours to offer
+            _log.info("recovery sidecar skipped: %s", exc)
             continue
-        if not isinstance(data, dict) or data.get("format") != _FORMAT:
-            continue
-        if _process_alive(int(data.get("pid", 0))):
-            continue
-        original = data.get("original")
-        found.append(
-            Recovery(
-                plan_file, sidecar, str(original) if original else None,
-                float(data.get("saved_at", 0.0)), str(data.get("name", "")),
-            )
-        )  # fmt: skip
+        if recovery is not None:
+            found.append(recovery)
     return sorted(found, key=lambda r: r.saved_at, reverse=True)
+
+
+def _read_sidecar(sidecar: Path, plan_file: Path) -> Recovery | None:
+    """The recovery a sidecar describes; None when it is another running Instructor's.
+
+    Raises:
+        JsonFileError: the sidecar is not one of ours, naming the file and the field.
+    """
+    doc = JsonReader(read_json_file(sidecar, "recovery sidecar"), str(sidecar))
+    doc.as_object()
+    if doc.get("format") != _FORMAT:
+        doc.fail(f"format {_FORMAT!r}", key="format")
+    pid = doc.get("pid")
+    if isinstance(pid, int) and not isinstance(pid, bool) and _process_alive(pid):
+        return None  # a null or missing pid is nobody's: offered
+    original = doc.get("original")
+    saved_at = doc.number("saved_at", default=0.0)
+    name = doc.get("name")
+    return Recovery(
+        plan_file,
+        sidecar,
+        original if isinstance(original, str) and original else None,
+        saved_at,
+        name if isinstance(name, str) else "",
+    )
 
 
 class Autosaver(QObject):

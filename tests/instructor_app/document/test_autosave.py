@@ -139,3 +139,31 @@ def test_a_recovery_of_another_running_instance_is_not_offered(
 
 def _fail(text: str) -> None:
     raise AssertionError(text)
+
+
+@pytest.mark.parametrize("pid", [None, "12", True, 1e300])
+def test_a_sidecar_with_an_odd_pid_is_offered_not_a_crash(
+    document: PlanDocument, recovery_dir: Path, pid: object
+) -> None:
+    """The sidecar is read with the one JSON reader: a pid that is no process id (null, a
+    text, ...) is nobody's, so its plan is offered; it used to raise a TypeError at start-up."""
+    saver = Autosaver(document, recovery_dir, interval_ms=60_000)
+    rename_root(document)
+    saver.write_now()
+    data = json.loads(saver.sidecar.read_text(encoding="utf-8"))
+    data["pid"] = pid
+    saver.sidecar.write_text(json.dumps(data), encoding="utf-8")
+    assert [r.plan_file for r in find_recoveries(recovery_dir)] == [saver.plan_file]
+
+
+def test_a_sidecar_of_another_format_or_a_bad_time_is_skipped(
+    document: PlanDocument, recovery_dir: Path
+) -> None:
+    saver = Autosaver(document, recovery_dir, interval_ms=60_000)
+    rename_root(document)
+    saver.write_now()
+    data = json.loads(saver.sidecar.read_text(encoding="utf-8"))
+    saver.sidecar.write_text(json.dumps({**data, "saved_at": "noon"}), encoding="utf-8")
+    assert find_recoveries(recovery_dir) == []
+    saver.sidecar.write_text(json.dumps({**data, "format": "other"}), encoding="utf-8")
+    assert find_recoveries(recovery_dir) == []
