@@ -1,7 +1,9 @@
 """The dependency direction: instructor_app -> capabilities -> engine, never back.
 
-engine imports no Qt and no robot or vision library; capabilities imports no Qt. Checked on
-the source (every import statement), so a lazy import inside a function counts too.
+engine imports no Qt and no robot or vision library; capabilities imports no Qt; resources
+(shipped data and its locator) imports none of them; nothing shipped imports tools (the
+generators of resources/, not shipped). Checked on the source (every import statement), so a
+lazy import inside a function counts too.
 """
 
 from __future__ import annotations
@@ -16,8 +18,10 @@ ROOT = Path(__file__).resolve().parents[1]
 QT = {"PySide6", "PyQt5", "PyQt6", "shiboken6", "NodeGraphQt", "pyqtgraph", "Qt", "OpenGL"}
 ROBOT = {"pybullet", "rtde_control", "rtde_receive", "rtde_io", "dashboard_client", "cv2", "open3d"}
 FORBIDDEN = {
-    "engine": QT | ROBOT | {"capabilities", "instructor_app", "numpy"},
-    "capabilities": QT | {"instructor_app"},
+    "engine": QT | ROBOT | {"capabilities", "instructor_app", "numpy", "tools"},
+    "capabilities": QT | {"instructor_app", "tools"},
+    "instructor_app": {"tools"},
+    "resources": QT | ROBOT | {"engine", "capabilities", "instructor_app", "numpy", "tools"},
 }
 
 
@@ -42,6 +46,13 @@ def test_package_does_not_import_upward_or_forbidden_libraries(package: str) -> 
         if bad:
             offenders.append(f"{path.relative_to(ROOT)} imports {', '.join(sorted(bad))}")
     assert not offenders, "\n".join(offenders)
+
+
+def test_resources_holds_data_and_its_locator_only() -> None:
+    """No generator in the shipped package: its only Python is resources/__init__.py (the
+    generators of its files live in tools/generators)."""
+    code = sorted(str(p.relative_to(ROOT)) for p in (ROOT / "resources").rglob("*.py"))
+    assert code == ["resources/__init__.py"]
 
 
 def test_the_check_sees_a_forbidden_import(tmp_path: Path) -> None:
