@@ -10,27 +10,17 @@ from pathlib import Path
 import pytest
 from packaging_env import clean_env, fresh_venv, lend_dependencies, pip, source_files
 
-# What the example generators (make_*.py) build with: not shipped, as the generators are not.
-GENERATOR_MODULES = {
-    f"resources/examples/{name}.py" for name in ("plan_builder", "tending_cell", "tending_library")
-}
-
 
 def test_the_wheel_carries_every_shipped_file(built_wheel: Path) -> None:
-    """Every file of resources/ but the generators' Python (the make_*.py scripts and the
-    modules they build with): a new kind of file fails here until pyproject.toml's
-    package-data lists it."""
+    """Every file of resources/ (data and its locator, resources/__init__.py; the generators
+    live in tools/, which is not shipped): a new kind of file fails here until
+    pyproject.toml's package-data lists it."""
     names = set(zipfile.ZipFile(built_wheel).namelist())
-    shipped = {
-        name
-        for name in source_files()
-        if name.startswith("resources/")
-        and not Path(name).name.startswith("make_")
-        and name not in GENERATOR_MODULES
-    }
+    shipped = {name for name in source_files() if name.startswith("resources/")}
     assert {"resources/icons/costar-instructor.svg", "resources/objects/cup/cup.obj"} <= shipped
-    assert "resources/__init__.py" in shipped
+    assert [name for name in shipped if name.endswith(".py")] == ["resources/__init__.py"]
     assert shipped <= names, sorted(shipped - names)
+    assert not [name for name in names if name.startswith("tools/")]
 
 
 @pytest.mark.sim

@@ -5,7 +5,6 @@ simulation) and tests/capabilities/ur/test_ur_protective_stop.py (the UR emulato
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
 import pytest
@@ -16,8 +15,8 @@ from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
 from engine.types import ParamType
 from engine.validation import has_errors, validate_plan
 from tests.resources.test_examples import _InterfacesOnly
+from tools.generators import make_clear_stop
 
-GENERATOR = Path(__file__).resolve().parents[2] / "resources" / "examples" / "make_clear_stop.py"
 FILE = SHIPPED_LIBRARY / "recovery" / "ClearStopAndBackOff.subtree.json"
 
 
@@ -35,11 +34,9 @@ class _URInterfaces:
 
 
 def test_the_file_is_reproduced_by_its_generator() -> None:
-    spec = importlib.util.spec_from_file_location("make_clear_stop", GENERATOR)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    assert dump_subtree(module.clear_stop_and_back_off()) == FILE.read_text(encoding="utf-8")
+    assert dump_subtree(make_clear_stop.clear_stop_and_back_off()) == FILE.read_text(
+        encoding="utf-8"
+    )
 
 
 def test_the_shipped_library_holds_it() -> None:

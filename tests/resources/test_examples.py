@@ -29,16 +29,12 @@ def test_there_is_one_example_per_node_kind() -> None:
 
 
 def test_examples_are_reproduced_by_their_generator() -> None:
-    import importlib.util
+    from tools.generators import make_examples
 
-    spec = importlib.util.spec_from_file_location("make_examples", EXAMPLES / "make_examples.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    assert dump_plan(module.figure3()) == (EXAMPLES / "figure3_debug.costar.json").read_text(
+    assert dump_plan(make_examples.figure3()) == (EXAMPLES / "figure3_debug.costar.json").read_text(
         encoding="utf-8"
     )
-    for name, plan in module.node_examples().items():
+    for name, plan in make_examples.node_examples().items():
         assert dump_plan(plan) == (EXAMPLES / "nodes" / f"{name}.costar.json").read_text(
             encoding="utf-8"
         )
@@ -58,23 +54,21 @@ def test_example_runs_to_the_stated_result(path: Path) -> None:
 
 
 def test_cell_examples_are_reproduced_by_their_generator() -> None:
-    import importlib.util
-
     from capabilities.waypoints import WaypointLibrary, waypoints_path_for
+    from tools.generators import make_cell_examples
 
-    spec = importlib.util.spec_from_file_location(
-        "make_cell_examples", EXAMPLES / "make_cell_examples.py"
-    )
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
     plan_path = EXAMPLES / "cup_to_bin.costar.json"
-    assert dump_plan(module.cup_to_bin()) == plan_path.read_text(encoding="utf-8")
+    assert dump_plan(make_cell_examples.cup_to_bin()) == plan_path.read_text(encoding="utf-8")
     stored = WaypointLibrary.load(waypoints_path_for(plan_path))
-    assert list(stored) == module.waypoints()
+    assert list(stored) == make_cell_examples.waypoints()
+    vision = EXAMPLES / "cup_to_bin_vision.costar.json"
+    assert dump_plan(make_cell_examples.cup_to_bin_vision()) == vision.read_text(encoding="utf-8")
     tending = EXAMPLES / "tending_paper.costar.json"
-    assert dump_plan(module.tending_paper()) == tending.read_text(encoding="utf-8")
-    assert list(WaypointLibrary.load(waypoints_path_for(tending))) == module.tending_waypoints()
+    assert dump_plan(make_cell_examples.tending_paper()) == tending.read_text(encoding="utf-8")
+    assert (
+        list(WaypointLibrary.load(waypoints_path_for(tending)))
+        == make_cell_examples.tending_waypoints()
+    )
 
 
 @pytest.mark.parametrize("name", ["cup_to_bin", "tending_paper"])

@@ -3,10 +3,8 @@
 from __future__ import annotations
 
 import copy
-import importlib.util
 import io
 from pathlib import Path
-from types import ModuleType
 
 import pytest
 
@@ -22,6 +20,7 @@ from engine.status import Status
 from engine.types import ObjectModel
 from engine.validation import has_errors, validate_plan
 from tests.resources.test_examples import _InterfacesOnly
+from tools.generators import make_kitting
 
 
 class _SimInterfaces(_InterfacesOnly):
@@ -35,18 +34,9 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "resources" / "examples"
 KITTING = EXAMPLES / "kitting.costar.json"
 
 
-def _generator() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("make_kitting", EXAMPLES / "make_kitting.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 def test_kitting_files_are_reproduced_by_their_generator() -> None:
-    module = _generator()
-    assert dump_plan(module.kitting()) == KITTING.read_text(encoding="utf-8")
-    for subtree in module.library():
+    assert dump_plan(make_kitting.kitting()) == KITTING.read_text(encoding="utf-8")
+    for subtree in make_kitting.library():
         path = SHIPPED_LIBRARY / "kitting" / f"{subtree.name}.subtree.json"
         assert dump_subtree(subtree) == path.read_text(encoding="utf-8")
 

@@ -4,9 +4,7 @@ each failure to its recovery subtree."""
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
-from types import ModuleType
 
 from capabilities.base import CapabilityRegistry
 from engine.files import dump_plan, load_plan
@@ -14,23 +12,15 @@ from engine.library import SHIPPED_LIBRARY, Library, dump_subtree
 from engine.spec import NodeKind, NodeSpec
 from engine.validation import has_errors, validate_plan
 from tests.resources.test_examples import _InterfacesOnly
+from tools.generators import make_tending
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "resources" / "examples"
 TENDING = EXAMPLES / "tending.costar.json"
 
 
-def _generator() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("make_tending", EXAMPLES / "make_tending.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 def test_tending_files_are_reproduced_by_their_generator() -> None:
-    module = _generator()
-    assert dump_plan(module.tending()) == TENDING.read_text(encoding="utf-8")
-    for folder, subtrees in module.library().items():
+    assert dump_plan(make_tending.tending()) == TENDING.read_text(encoding="utf-8")
+    for folder, subtrees in make_tending.library().items():
         for subtree in subtrees:
             path = SHIPPED_LIBRARY / folder / f"{subtree.name}.subtree.json"
             assert dump_subtree(subtree) == path.read_text(encoding="utf-8")

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import copy
-import importlib.util
 import json
 import math
 import shutil
@@ -71,13 +70,9 @@ def test_library_has_the_paper_objects(library: ObjectLibrary) -> None:
 
 
 def test_generated_meshes_are_reproduced_byte_for_byte() -> None:
-    spec = importlib.util.spec_from_file_location(
-        "make_objects", default_library_path() / "make_objects.py"
-    )
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    files = module.rendered_files()
+    from tools.generators import make_objects
+
+    files = make_objects.rendered_files()
     assert len(files) == 2 * len(MODELS)
     for path, text in files.items():
         assert path.read_bytes() == text.encode("ascii"), f"{path} differs from make_objects.py"

@@ -19,30 +19,27 @@ that way). Ours does the same task composed from library subtrees, with recovery
   to the rack and then the left piece of a scrap it cut short; it never waits for the
   operator.
 
-Usage: python resources/examples/make_tending.py
+Usage: python -m tools.generators.make_tending
 """
 
 from __future__ import annotations
 
-import uuid
-from pathlib import Path
-
 from engine.files import save_plan
 from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec, RunPolicy, SubtreeSpec
 from engine.types import ParamType, Waypoint
-from resources.examples.plan_builder import fixed, write_library
-from resources.examples.tending_cell import (
+from tools.generators import RESOURCES
+from tools.generators.plan_builder import TENDING, fixed, stable_id, write_library
+from tools.generators.tending_cell import (
     ARM_REGION,
-    NAMESPACE,
     PIECES,
     TendingMaker,
     bound,
     observe,
     waypoints,
 )
-from resources.examples.tending_library import LIBRARY, arm_comes, clear_stop, library
+from tools.generators.tending_library import LIBRARY, arm_comes, clear_stop, library
 
-HERE = Path(__file__).resolve().parent
+HERE = RESOURCES / "examples"  # where the plans are written
 PICK_ERRORS = "failed, grasp_failed, object_lost, timeout"
 PLACE_ERRORS = "protective_stop"  # the rack moved into the way: a collision
 
@@ -180,13 +177,13 @@ def tending() -> PlanSpec:
         "never waits for the operator. Runs until stopped, on the simulated scene tending. "
         "Run it with: costar run example:tending.",
         RunPolicy.ONCE, waypoints=waypoints(), objects=["tending_rack"], reset_cell=True,
-        scene="tending", id=uuid.uuid5(NAMESPACE, "tending").hex, subtrees=list(subs.values()),
+        scene="tending", id=stable_id(TENDING, "tending"), subtrees=list(subs.values()),
     )  # fmt: skip
 
 
 def main() -> None:
     for folder, subtrees in library().items():
-        write_library(LIBRARY / folder, subtrees, HERE.parent)
+        write_library(LIBRARY / folder, subtrees, RESOURCES)
     plan = HERE / "tending.costar.json"
     save_plan(tending(), plan)
     print(f"wrote {plan.name}")

@@ -13,31 +13,26 @@ it.
 welding arm swings into an occupancy region and back out, pick the part at the exit with one
 taught waypoint, check it is held, drop it into the rack's tote; on any failure drop what is held, step
 back and wait for the operator's Continue (the paper stopped and reset the robot).
-Usage: python resources/examples/make_cell_examples.py
+Usage: python -m tools.generators.make_cell_examples
 """
 
 from __future__ import annotations
 
-import uuid
-from pathlib import Path
-from typing import Any
-
 from capabilities.waypoints import WaypointLibrary, waypoints_path_for
 from engine.files import save_plan
-from engine.kinds import setting
-from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec, RunPolicy
+from engine.spec import NodeKind, NodeSpec, PlanSpec, RunPolicy
 from engine.types import (
     JointConfig,
-    ObjectModel,
     ParamType,
     Pose,
     Region,
     Waypoint,
     WaypointFrame,
 )
+from tools.generators import RESOURCES
+from tools.generators.plan_builder import CELL_EXAMPLES, PlanBuilder, fixed, obj, stable_id
 
-HERE = Path(__file__).resolve().parent
-_NAMESPACE = uuid.UUID("0b7f2a4e-3c1d-4f5e-8a9b-6c7d8e9f0a1b")
+HERE = RESOURCES / "examples"  # where the plans are written
 
 # The tool pointing straight down (tool z along world -z).
 DOWN = (1.0, 0.0, 0.0, 0.0)
@@ -83,54 +78,32 @@ def tending_waypoints() -> list[Waypoint]:
     ]  # fmt: skip
 
 
-class _Maker:
+class _Cell(PlanBuilder):
+    """The cell examples' nodes (ids in their own namespace), and moves to taught waypoints."""
+
     def __init__(self, example: str, wps: list[Waypoint] | None = None) -> None:
-        self.example = example
-        self.count = 0
+        super().__init__(CELL_EXAMPLES, example)
         self.wps = {w.name: w for w in (wps or waypoints())}
 
-    def _id(self) -> str:
-        self.count += 1
-        return uuid.uuid5(_NAMESPACE, f"{self.example}/{self.count}").hex
-
-    def node(self, kind: NodeKind, name: str, *children: NodeSpec, **config: Any) -> NodeSpec:
-        return NodeSpec(
-            kind,
-            name,
-            self._id(),
-            params={k: setting(kind, k, v) for k, v in config.items()},
-            children=list(children),
-        )
-
-    def op(self, op: str, name: str, **params: Binding) -> NodeSpec:
-        return NodeSpec(NodeKind.OPERATION, name, self._id(), op=op, params=params)
-
-    def move(
-        self, name: str, waypoint: str, reference: str | None = None, linear: bool = False
+    def move_to(
+        self, name: str, waypoint: str, reference: str = "", linear: bool = False
     ) -> NodeSpec:
-        params = {"target": Binding.fixed(self.wps[waypoint], ParamType.WAYPOINT)}
-        if reference:
-            params["reference"] = Binding.reference(reference)
-        if linear:
-            params["mode"] = Binding.fixed("linear", ParamType.TEXT)
-        return self.op("motion.move_to", name, **params)
-
-    def obj(self, name: str) -> Binding:
-        return Binding.fixed(ObjectModel(name), ParamType.OBJECT)
+        """``motion.move_to`` the taught waypoint named ``waypoint``."""
+        return self.move(name, self.wps[waypoint], reference, linear)
 
 
-def _figure3_tree(m: _Maker, finder: str, detect: str, title: str) -> NodeSpec:
+def _figure3_tree(m: _Cell, finder: str, detect: str, title: str) -> NodeSpec:
     """The Figure 3 tree; ``finder`` is the capability that finds objects (markers or
     perception) and ``detect`` its operation that looks."""
     transfer = m.node(
         NodeKind.SEQUENCE, "transfer",
-        m.op(f"{finder}.object_found", "CUP found", object=m.obj("cup")),
-        m.op(f"{finder}.object_pose", "pose of CUP", object=m.obj("cup"), pose=Binding.reference("CUP_POSE")),
-        m.op(f"{finder}.object_pose", "pose of BIN", object=m.obj("waste_bin"),
-             pose=Binding.reference("BIN_POSE")),
-        m.op("gripper.grasp", "grasp CUP at CUP_POSE", object=m.obj("cup"),
-             pose=Binding.reference("CUP_POSE")),
-        m.move("move to BIN_POSE", "over bin", "BIN_POSE"),
+        m.op(f"{finder}.object_found", "CUP found", object=obj("cup")),
+        m.op(f"{finder}.object_pose", "pose of CUP", object=obj("cup"), pose="CUP_POSE"),
+        m.op(f"{finder}.object_pose", "pose of BIN", object=obj("waste_bin"),
+             pose="BIN_POSE"),
+        m.op("gripper.grasp", "grasp CUP at CUP_POSE", object=obj("cup"),
+             pose="CUP_POSE"),
+        m.move_to("move to BIN_POSE", "over bin", "BIN_POSE"),
         m.op("gripper.open", "release"),
     )  # fmt: skip
     wait = m.node(
@@ -139,14 +112,14 @@ def _figure3_tree(m: _Maker, finder: str, detect: str, title: str) -> NodeSpec:
     )  # fmt: skip
     return m.node(
         NodeKind.SEQUENCE, title,
-        m.move("step out of view", "observe"),
+        m.move_to("step out of view", "observe"),
         m.op(f"{finder}.{detect}", "detect CUP and BIN"),  # the shoulder camera, by default
         m.node(NodeKind.SELECTOR, "transfer or wait", transfer, wait),
     )  # fmt: skip
 
 
 def cup_to_bin() -> PlanSpec:
-    tree = _figure3_tree(_Maker("cup_to_bin"), "markers", "detect_markers", "cup to bin")
+    tree = _figure3_tree(_Cell("cup_to_bin"), "markers", "detect_markers", "cup to bin")
     return PlanSpec(
         tree, "Cup to bin (Figure 3, simulated cell)",
         "The paper's Figure 3 on the simulated cell: find the cup and the waste bin through their "
@@ -156,13 +129,13 @@ def cup_to_bin() -> PlanSpec:
         "Run it with: costar run cup_to_bin.costar.json --cell sim --seed N. Runs to SUCCESS.",
         RunPolicy.UNTIL_SUCCESS, waypoints=waypoints(), objects=["cup", "waste_bin"],
         reset_cell=True,  # each run in the Instructor starts from the scene's seed
-        id=uuid.uuid5(_NAMESPACE, "cup_to_bin").hex,
+        id=stable_id(CELL_EXAMPLES, "cup_to_bin"),
     )  # fmt: skip
 
 
 def cup_to_bin_vision() -> PlanSpec:
     """Figure 3 with model-based recognition (perception) in place of the ArUco markers."""
-    m = _Maker("cup_to_bin_vision")
+    m = _Cell("cup_to_bin_vision")
     tree = _figure3_tree(m, "perception", "detect_objects", "cup to bin (vision)")
     return PlanSpec(
         tree, "Cup to bin, by vision (Figure 3, simulated cell)",
@@ -173,56 +146,56 @@ def cup_to_bin_vision() -> PlanSpec:
         "again. Run it with: costar run cup_to_bin_vision.costar.json --cell sim --seed N.",
         RunPolicy.UNTIL_SUCCESS, waypoints=waypoints(), objects=["cup", "waste_bin"],
         reset_cell=True,  # each run in the Instructor starts from the scene's seed
-        id=uuid.uuid5(_NAMESPACE, "cup_to_bin_vision").hex,
+        id=stable_id(CELL_EXAMPLES, "cup_to_bin_vision"),
     )  # fmt: skip
 
 
-def _tending_cycle(m: _Maker) -> NodeSpec:
+def _tending_cycle(m: _Cell) -> NodeSpec:
     """One part: the arm swings down and back up, pick at the exit, out of the arm's swing,
     onto the rack."""
-    region = Binding.fixed(ARM_REGION, ParamType.REGION)
-    long = Binding.fixed(600.0, ParamType.DURATION)
+    region = fixed(ARM_REGION, ParamType.REGION)
+    long = fixed(600.0, ParamType.DURATION)
     # Four looks a second see the arm, which stays over the exit for more than a second.
-    period = Binding.fixed(0.25, ParamType.DURATION)
+    period = fixed(0.25, ParamType.DURATION)
     return m.node(
         NodeKind.SEQUENCE, "one part",
         m.op("occupancy.wait_until_occupied", "wait for the welding arm", region=region,
              timeout=long, period=period),
         m.op("occupancy.wait_until_empty", "wait until the arm is back up", region=region,
              period=period),
-        m.move("over the exit", "over exit"),
-        m.move("down to the part", "at exit", linear=True),
+        m.move_to("over the exit", "over exit"),
+        m.move_to("down to the part", "at exit", linear=True),
         m.op("gripper.close", "close on the part"),
         m.op("gripper.is_holding", "part in the gripper"),
-        m.move("lift the part", "over exit", linear=True),
+        m.move_to("lift the part", "over exit", linear=True),
         m.op("gripper.is_holding", "part still held"),
         # As our plan does (its ReRegisterRack): out by the observe joints first. The joint
         # path from over the exit straight to the rack turns the wrist towards the welding
         # arm's swing (6.7 cm from the resting arm, against 11 cm by observe).
-        m.move("out of the welding arm's swing", "observe"),
-        m.move("over the rack", "over rack", "RACK_POSE"),
-        m.move("down over the tote", "into rack", "RACK_POSE", linear=True),
+        m.move_to("out of the welding arm's swing", "observe"),
+        m.move_to("over the rack", "over rack", "RACK_POSE"),
+        m.move_to("down over the tote", "into rack", "RACK_POSE", linear=True),
         m.op("gripper.open", "let go into the tote"),
-        m.move("up from the rack", "over rack", "RACK_POSE", linear=True),
-        m.move("step out of view", "observe"),
+        m.move_to("up from the rack", "over rack", "RACK_POSE", linear=True),
+        m.move_to("step out of view", "observe"),
     )  # fmt: skip
 
 
 def tending_paper() -> PlanSpec:
     """The paper's wire-bender tending plan: no error handling but the operator's reset."""
-    m = _Maker("tending_paper", tending_waypoints())
+    m = _Cell("tending_paper", tending_waypoints())
     operator = m.node(
         NodeKind.SEQUENCE, "stop and wait for the operator",
         m.op("gripper.open", "drop what is held"),
-        m.move("step back", "observe"),
+        m.move_to("step back", "observe"),
         m.op("collaboration.wait_for_button", "operator resets the cell, presses Continue"),
     )  # fmt: skip
     tree = m.node(
         NodeKind.SEQUENCE, "tend the wire bender",
-        m.move("step out of view", "observe"),
+        m.move_to("step out of view", "observe"),
         m.op("markers.detect_markers", "find the rack"),
-        m.op("markers.object_pose", "pose of RACK", object=m.obj("tending_rack"),
-             pose=Binding.reference("RACK_POSE")),
+        m.op("markers.object_pose", "pose of RACK", object=obj("tending_rack"),
+             pose="RACK_POSE"),
         m.node(NodeKind.ITERATOR, "every part",
                m.node(NodeKind.SELECTOR, "part or operator", _tending_cycle(m), operator)),
     )  # fmt: skip
@@ -240,7 +213,7 @@ def tending_paper() -> PlanSpec:
         RunPolicy.ONCE, waypoints=tending_waypoints(), objects=["tending_rack"],
         reset_cell=True,  # each run in the Instructor starts from the scene's seed
         scene="tending",
-        id=uuid.uuid5(_NAMESPACE, "tending_paper").hex,
+        id=stable_id(CELL_EXAMPLES, "tending_paper"),
     )  # fmt: skip
 
 

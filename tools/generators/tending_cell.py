@@ -7,13 +7,10 @@ waypoints, and the node maker the tending generator builds with (``make_tending.
 from __future__ import annotations
 
 import math
-import uuid
 
 from engine.spec import Binding, NodeKind, NodeSpec
 from engine.types import JointConfig, ParamType, Pose, Region, Waypoint, WaypointFrame
-from resources.examples.plan_builder import PlanBuilder, fixed
-
-NAMESPACE = uuid.UUID("8f3e6a2c-1d4b-4e7a-9c5f-2b8d7e6a5c41")
+from tools.generators.plan_builder import TENDING, PlanBuilder, fixed
 
 OBSERVE_JOINTS = (1.2, -1.9, 2.0, -1.6, -1.57, 0.0)  # out of the shoulder camera's view
 # The tool down, turned as the bender drops its parts (the weld bead along world x, the
@@ -80,7 +77,7 @@ class TendingMaker(PlanBuilder):
     """The tending generator's nodes (ids in its own namespace), and a timed take."""
 
     def __init__(self, scope: str) -> None:
-        super().__init__(NAMESPACE, scope)
+        super().__init__(TENDING, scope)
 
     def take(self, name: str, above: str, at: str) -> NodeSpec:
         """Down from ``above`` to ``at``, close, feel it held, lift, feel it still held; in

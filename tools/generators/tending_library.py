@@ -17,13 +17,12 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from engine.library import load_subtree
 from engine.spec import Binding, NodeKind, NodeSpec, SubtreePort, SubtreeSpec
 from engine.types import ObjectModel, ParamType
-from resources.examples.plan_builder import fixed, port, subtree
-from resources.examples.tending_cell import (
+from tools.generators import RESOURCES
+from tools.generators.plan_builder import fixed, port, subtree
+from tools.generators.tending_cell import (
     ABOVE_Z,
     ARM_TIMEOUT,
     DISCARD_SPEED,
@@ -37,7 +36,7 @@ from resources.examples.tending_cell import (
     observe,
 )
 
-LIBRARY = Path(__file__).resolve().parents[1] / "library"
+LIBRARY = RESOURCES / "library"
 
 
 def _exit_ports() -> list[SubtreePort]:

@@ -1,91 +1,65 @@
 """Write the example plans of resources/examples from code (reproducible byte for byte).
 
 Each plan's description ends with "Runs to SUCCESS." or "Runs to FAILURE.": the tests run
-every example and check that sentence. Usage: python resources/examples/make_examples.py
+every example and check that sentence. Usage: python -m tools.generators.make_examples
 """
 
 from __future__ import annotations
 
-import uuid
 from collections.abc import Callable
-from pathlib import Path
-from typing import Any
 
 from engine.files import save_plan
-from engine.kinds import setting
-from engine.spec import (
-    Binding,
-    NodeKind,
-    NodeSpec,
-    ParameterDecl,
-    PlanSpec,
-    RunPolicy,
-    SubtreePort,
-    SubtreeSpec,
-)
+from engine.spec import Binding, NodeKind, NodeSpec, ParameterDecl, PlanSpec, RunPolicy
 from engine.types import ParamType, Pose
+from tools.generators import RESOURCES
+from tools.generators.plan_builder import (
+    EXAMPLES,
+    PlanBuilder,
+    fixed,
+    port,
+    stable_id,
+    subtree,
+)
 
-HERE = Path(__file__).resolve().parent
-_NAMESPACE = uuid.UUID("6f1c3d0e-8f61-4d0e-9a57-2b8f3c0d7e11")
+HERE = RESOURCES / "examples"  # where the plans are written
+N = NodeKind
 
 
-class _Ids:
-    """Stable ids: the same example always gets the same node ids."""
+class _Debug(PlanBuilder):
+    """The examples' nodes (ids in their own namespace), built from debug operations."""
 
     def __init__(self, example: str) -> None:
-        self.example = example
-        self.count = 0
+        super().__init__(EXAMPLES, example)
 
-    def __call__(self) -> str:
-        self.count += 1
-        return uuid.uuid5(_NAMESPACE, f"{self.example}/{self.count}").hex
-
-
-def _fixed(value: Any, ptype: ParamType) -> Binding:
-    return Binding.fixed(value, ptype)
-
-
-class _Maker:
-    def __init__(self, example: str) -> None:
-        self.ids = _Ids(example)
-
-    def node(self, kind: NodeKind, name: str = "", *children: NodeSpec, **config: Any) -> NodeSpec:
-        return NodeSpec(
-            kind,
-            name,
-            self.ids(),
-            params={k: setting(kind, k, v) for k, v in config.items()},
-            children=list(children),
-        )
-
-    def op(self, op: str, label: str = "", **params: Binding) -> NodeSpec:
-        return NodeSpec(NodeKind.OPERATION, label, self.ids(), op=f"debug.{op}", params=params)
+    def debug(self, op: str, name: str, /, **params: Binding) -> NodeSpec:
+        """The debug operation ``debug.<op>``."""
+        return self.op(f"debug.{op}", name, **params)
 
     def running(self, name: str, ticks: int, then: str = "SUCCESS") -> NodeSpec:
-        return self.op(
+        return self.debug(
             "running",
             name,
-            ticks=_fixed(ticks, ParamType.NUMBER),
-            then=_fixed(then, ParamType.TEXT),
+            ticks=fixed(ticks, ParamType.NUMBER),
+            then=fixed(then, ParamType.TEXT),
         )
 
     def set_flag(self, name: str, key: str, value: bool) -> NodeSpec:
-        return self.op(
-            "set_param", name, value=_fixed(value, ParamType.BOOL), name=Binding.reference(key)
+        return self.debug(
+            "set_param", name, value=fixed(value, ParamType.BOOL), name=Binding.reference(key)
         )
 
     def flag_is(self, name: str, key: str, value: bool) -> NodeSpec:
-        return self.op(
+        return self.debug(
             "check_param",
             name,
             value=Binding.reference(key),
-            expected=_fixed(value, ParamType.BOOL),
+            expected=fixed(value, ParamType.BOOL),
         )
 
 
 def figure3() -> PlanSpec:
     """The paper's Figure 3: find a cup, take it to the bin, fall back to waiting."""
-    m = _Maker("figure3")
+    m = _Debug("figure3")
     cup = Pose((0.55, -0.10, 0.05), (1.0, 0.0, 0.0, 0.0))
     tree = m.node(
         NodeKind.SEQUENCE,
@@ -102,23 +76,23 @@ def figure3() -> PlanSpec:
             m.node(
                 NodeKind.SEQUENCE,
                 "transfer",
-                m.op("succeed_after", "CUP found", failures=_fixed(2, ParamType.NUMBER)),
-                m.op(
+                m.debug("succeed_after", "CUP found", failures=fixed(2, ParamType.NUMBER)),
+                m.debug(
                     "query",
                     "pose of CUP",
-                    value=_fixed(cup, ParamType.POSE),
+                    value=fixed(cup, ParamType.POSE),
                     result=Binding.reference("CUP_POSE"),
                 ),
-                m.op(
+                m.debug(
                     "query",
                     "pose of BIN",
-                    value=_fixed(Pose((0.40, 0.35, 0.30), (1.0, 0, 0, 0)), ParamType.POSE),
+                    value=fixed(Pose((0.40, 0.35, 0.30), (1.0, 0, 0, 0)), ParamType.POSE),
                     result=Binding.reference("BIN_POSE"),
                 ),
-                m.op("pretend_move", "move to CUP_POSE", target=Binding.reference("CUP_POSE")),
-                m.op("log", "grasp", message=_fixed("closing the gripper", ParamType.TEXT)),
-                m.op("pretend_move", "move to BIN_POSE", target=Binding.reference("BIN_POSE")),
-                m.op("log", "release", message=_fixed("opening the gripper", ParamType.TEXT)),
+                m.debug("pretend_move", "move to CUP_POSE", target=Binding.reference("CUP_POSE")),
+                m.debug("log", "grasp", message=fixed("closing the gripper", ParamType.TEXT)),
+                m.debug("pretend_move", "move to BIN_POSE", target=Binding.reference("BIN_POSE")),
+                m.debug("log", "release", message=fixed("opening the gripper", ParamType.TEXT)),
             ),
             m.node(
                 NodeKind.FORCE_FAILURE, "then try again", m.node(NodeKind.WAIT, "WAIT", seconds=0.2)
@@ -141,42 +115,40 @@ def _one(
     example: str,
     title: str,
     text: str,
-    build: Callable[[_Maker], NodeSpec],
+    build: Callable[[_Debug], NodeSpec],
     parameters: list[ParameterDecl] | None = None,
 ) -> PlanSpec:
-    m = _Maker(example)
+    m = _Debug(example)
     return PlanSpec(
         build(m),
         title,
         text,
         RunPolicy.ONCE,
         parameters=parameters or [],
-        id=uuid.uuid5(_NAMESPACE, example).hex,
+        id=stable_id(EXAMPLES, example),
     )
 
 
 def _subtree_example() -> PlanSpec:
     """Two instances of one subtree, each with its own target, each keeping its own GOAL."""
-    inner = _Maker("subtree/inside")
-    go_to = SubtreeSpec(
+    inner = _Debug("subtree/inside")
+    go_to = subtree(
         "examples.go_to", "Go to",
+        "Finds where to go (a private GOAL) and goes there.",
         inner.node(
             NodeKind.SEQUENCE, "Go to",
-            inner.op("query", "find", value=Binding.reference("TARGET"), result=Binding.reference("GOAL")),
-            inner.op("pretend_move", "go", target=Binding.reference("GOAL")),
-            inner.op("set_param", "report", value=Binding.reference("GOAL"), name=Binding.reference("REACHED")),
+            inner.debug("query", "find", value=Binding.reference("TARGET"), result=Binding.reference("GOAL")),
+            inner.debug("pretend_move", "go", target=Binding.reference("GOAL")),
+            inner.debug("set_param", "report", value=Binding.reference("GOAL"), name=Binding.reference("REACHED")),
         ),
-        version=1, date="2026-11-24T00:00:00Z",
-        description="Finds where to go (a private GOAL) and goes there.",
-        inputs=[SubtreePort("TARGET", ParamType.POSE, "where to go")],
-        outputs=[SubtreePort("REACHED", ParamType.ANY, "where it went")],
+        inputs=[port("TARGET", ParamType.POSE, "where to go")],
+        outputs=[port("REACHED", ParamType.ANY, "where it went")],
     )  # fmt: skip
-    m = _Maker("subtree")
+    m = _Debug("subtree")
 
     def visit(name: str, x: float, out: str) -> NodeSpec:
-        params = {"TARGET": _fixed(Pose((x, 0.1, 0.2)), ParamType.POSE),
-                  "REACHED": Binding.reference(out)}  # fmt: skip
-        return NodeSpec(NodeKind.SUBTREE, name, m.ids(), params=params, subtree=go_to.ref)
+        return m.instance(go_to, name, TARGET=fixed(Pose((x, 0.1, 0.2)), ParamType.POSE),
+                          REACHED=Binding.reference(out))  # fmt: skip
 
     tree = m.node(
         NodeKind.SEQUENCE, "two visits", visit("left", 0.3, "LEFT"), visit("right", 0.5, "RIGHT")
@@ -185,15 +157,12 @@ def _subtree_example() -> PlanSpec:
         tree, "Subtree instances",
         "One subtree used twice with different targets: each instance keeps its own GOAL and "
         "passes out where it went. Runs to SUCCESS.",
-        RunPolicy.ONCE, id=uuid.uuid5(_NAMESPACE, "subtree").hex, subtrees=[go_to],
+        RunPolicy.ONCE, id=stable_id(EXAMPLES, "subtree"), subtrees=[go_to],
     )  # fmt: skip
 
 
-def node_examples() -> dict[str, PlanSpec]:
-    """One plan per node kind."""
-    N = NodeKind
-    flag = [ParameterDecl("PERSON_AWAY", ParamType.BOOL, True, "no one near the robot")]
-    done = [ParameterDecl("PART_READY", ParamType.BOOL, False, "the machine dropped a part")]
+def _composites() -> dict[str, PlanSpec]:
+    """Sequence, Selector and the three Parallel policies."""
     return {
         "sequence": _one(
             "sequence",
@@ -202,9 +171,9 @@ def node_examples() -> dict[str, PlanSpec]:
             lambda m: m.node(
                 N.SEQUENCE,
                 "steps",
-                m.op("succeed", "one"),
+                m.debug("succeed", "one"),
                 m.running("two", 3),
-                m.op("succeed", "three"),
+                m.debug("succeed", "three"),
             ),
         ),
         "selector": _one(
@@ -214,9 +183,9 @@ def node_examples() -> dict[str, PlanSpec]:
             lambda m: m.node(
                 N.SELECTOR,
                 "options",
-                m.op("fail", "first"),
-                m.op("succeed", "second"),
-                m.op("fail", "never tried"),
+                m.debug("fail", "first"),
+                m.debug("succeed", "second"),
+                m.debug("fail", "never tried"),
             ),
         ),
         "parallel": _one(
@@ -249,6 +218,14 @@ def node_examples() -> dict[str, PlanSpec]:
                 failure=2,
             ),
         ),
+    }
+
+
+def _reactive() -> dict[str, PlanSpec]:
+    """The reactive Sequence and Selector, each halting a child when a flag changes."""
+    flag = [ParameterDecl("PERSON_AWAY", ParamType.BOOL, True, "no one near the robot")]
+    done = [ParameterDecl("PART_READY", ParamType.BOOL, False, "the machine dropped a part")]
+    return {
         "reactive_sequence": _one(
             "reactive_sequence",
             "Reactive sequence",
@@ -296,6 +273,12 @@ def node_examples() -> dict[str, PlanSpec]:
             ),
             done,
         ),
+    }
+
+
+def _loops() -> dict[str, PlanSpec]:
+    """The decorators that run their child again: Iterator, Enforce, Repeat, Retry."""
+    return {
         "iterator": _one(
             "iterator",
             "Iterator",
@@ -309,25 +292,15 @@ def node_examples() -> dict[str, PlanSpec]:
             lambda m: m.node(
                 N.ENFORCE,
                 "until found",
-                m.op("succeed_after", "found", failures=_fixed(2, ParamType.NUMBER)),
+                m.debug("succeed_after", "found", failures=fixed(2, ParamType.NUMBER)),
                 count=5,
-            ),
-        ),
-        "inverter": _one(
-            "inverter",
-            "Inverter",
-            "A failing check, inverted. Runs to SUCCESS.",
-            lambda m: m.node(
-                N.INVERTER,
-                "not",
-                m.op("condition", "is busy", result=_fixed(False, ParamType.BOOL)),
             ),
         ),
         "repeat": _one(
             "repeat",
             "Repeat",
             "Runs its child 4 times. Runs to SUCCESS.",
-            lambda m: m.node(N.REPEAT, "four times", m.op("succeed", "pick"), count=4),
+            lambda m: m.node(N.REPEAT, "four times", m.debug("succeed", "pick"), count=4),
         ),
         "retry": _one(
             "retry",
@@ -336,10 +309,26 @@ def node_examples() -> dict[str, PlanSpec]:
             lambda m: m.node(
                 N.RETRY,
                 "three attempts",
-                m.op(
-                    "fail", "grasp", message=_fixed("nothing between the fingers", ParamType.TEXT)
+                m.debug(
+                    "fail", "grasp", message=fixed("nothing between the fingers", ParamType.TEXT)
                 ),
                 count=3,
+            ),
+        ),
+    }
+
+
+def _decorators() -> dict[str, PlanSpec]:
+    """The decorators that change or bound one run of their child."""
+    return {
+        "inverter": _one(
+            "inverter",
+            "Inverter",
+            "A failing check, inverted. Runs to SUCCESS.",
+            lambda m: m.node(
+                N.INVERTER,
+                "not",
+                m.debug("condition", "is busy", result=fixed(False, ParamType.BOOL)),
             ),
         ),
         "timeout": _one(
@@ -356,13 +345,13 @@ def node_examples() -> dict[str, PlanSpec]:
             lambda m: m.node(
                 N.CATCH,
                 "on a failed grasp",
-                m.op(
+                m.debug(
                     "fail",
                     "grasp",
-                    message=_fixed("nothing between the fingers", ParamType.TEXT),
-                    error=_fixed("grasp_failed", ParamType.TEXT),
+                    message=fixed("nothing between the fingers", ParamType.TEXT),
+                    error=fixed("grasp_failed", ParamType.TEXT),
                 ),
-                m.op("log", "report it", message=Binding.reference("CAUGHT")),
+                m.debug("log", "report it", message=Binding.reference("CAUGHT")),
                 errors="grasp_failed, object_lost",
                 error="CAUGHT",
             ),
@@ -371,14 +360,20 @@ def node_examples() -> dict[str, PlanSpec]:
             "force_success",
             "Force success",
             "A failing action made to succeed. Runs to SUCCESS.",
-            lambda m: m.node(N.FORCE_SUCCESS, "ignore errors", m.op("fail", "optional step")),
+            lambda m: m.node(N.FORCE_SUCCESS, "ignore errors", m.debug("fail", "optional step")),
         ),
         "force_failure": _one(
             "force_failure",
             "Force failure",
             "A succeeding action made to fail. Runs to FAILURE.",
-            lambda m: m.node(N.FORCE_FAILURE, "then fail", m.op("succeed", "step")),
+            lambda m: m.node(N.FORCE_FAILURE, "then fail", m.debug("succeed", "step")),
         ),
+    }
+
+
+def _leaves() -> dict[str, PlanSpec]:
+    """Wait, an action, a query and a condition."""
+    return {
         "wait": _one(
             "wait",
             "Wait",
@@ -398,21 +393,32 @@ def node_examples() -> dict[str, PlanSpec]:
             lambda m: m.node(
                 N.SEQUENCE,
                 "find and go",
-                m.op(
+                m.debug(
                     "query",
                     "find goal",
-                    value=_fixed(Pose((0.4, 0.1, 0.2)), ParamType.POSE),
+                    value=fixed(Pose((0.4, 0.1, 0.2)), ParamType.POSE),
                     result=Binding.reference("GOAL"),
                 ),
-                m.op("pretend_move", "go", target=Binding.reference("GOAL")),
+                m.debug("pretend_move", "go", target=Binding.reference("GOAL")),
             ),
         ),
         "condition": _one(
             "condition",
             "Condition",
             "A predicate that is false. Runs to FAILURE.",
-            lambda m: m.op("condition", "door closed", result=_fixed(False, ParamType.BOOL)),
+            lambda m: m.debug("condition", "door closed", result=fixed(False, ParamType.BOOL)),
         ),
+    }
+
+
+def node_examples() -> dict[str, PlanSpec]:
+    """One plan per node kind (a subtree instance included), by file name."""
+    return {
+        **_composites(),
+        **_reactive(),
+        **_loops(),
+        **_decorators(),
+        **_leaves(),
         "subtree": _subtree_example(),
     }
 

@@ -1,9 +1,10 @@
-"""Build the nodes of a generated library or plan, with ids that stay the same between runs.
+"""Build the nodes of a generated plan or library, with ids that stay the same between runs.
 
-The generators of the shipped library (``make_kitting.py``, ``make_tending.py``) build their
-subtrees and plans with a :class:`PlanBuilder` each: node ids are uuid5 of the generator's own
-namespace and a running count within a scope, so writing the files again gives them byte for
-byte. ``write_library`` writes subtrees where the palette finds them.
+Every generator of ``resources/`` builds its plans and subtrees with a :class:`PlanBuilder`
+(a subclass adds a generator's own steps): node ids are uuid5 of the generator's namespace
+and a running count within a scope, plan ids uuid5 of the namespace and the plan's name
+(:func:`stable_id`), and every shipped subtree carries :data:`DATE`, so writing the files
+again gives them byte for byte. ``write_library`` writes subtrees where the palette finds them.
 """
 
 from __future__ import annotations
@@ -18,9 +19,36 @@ from engine.plan_writer import write_atomic
 from engine.spec import Binding, NodeKind, NodeSpec, SubtreePort, SubtreeSpec
 from engine.types import ObjectModel, ParamType, Waypoint
 
-__all__ = ["PlanBuilder", "fixed", "obj", "port", "subtree", "write_library"]
+__all__ = [
+    "CELL_EXAMPLES",
+    "CLEAR_STOP",
+    "DATE",
+    "EXAMPLES",
+    "KITTING",
+    "TENDING",
+    "PlanBuilder",
+    "fixed",
+    "obj",
+    "port",
+    "stable_id",
+    "subtree",
+    "write_library",
+]
 
 DATE = "2026-11-24T00:00:00Z"  # the shipped subtrees' date: fixed, so they are written alike
+
+# Each generator's uuid5 namespace: the ids in the files it wrote come from it, so a value
+# never changes (a new generator gets a new one).
+EXAMPLES = uuid.UUID("6f1c3d0e-8f61-4d0e-9a57-2b8f3c0d7e11")  # make_examples
+CELL_EXAMPLES = uuid.UUID("0b7f2a4e-3c1d-4f5e-8a9b-6c7d8e9f0a1b")  # make_cell_examples
+CLEAR_STOP = uuid.UUID("3f0c5b1e-8a47-4d2a-b6e1-5c9d2e7a4f10")  # make_clear_stop
+KITTING = uuid.UUID("5d1c7a0e-2b4f-4c8e-9a3d-7e6f5a4b3c2d")  # make_kitting
+TENDING = uuid.UUID("8f3e6a2c-1d4b-4e7a-9c5f-2b8d7e6a5c41")  # make_tending, tending_library
+
+
+def stable_id(namespace: uuid.UUID, name: str) -> str:
+    """The id of ``name`` in a generator's ``namespace``: the same on every run."""
+    return uuid.uuid5(namespace, name).hex
 
 
 class PlanBuilder:
@@ -32,15 +60,26 @@ class PlanBuilder:
         self.count = 0
 
     def id(self) -> str:
+        """The next id of the scope (a node takes its id once its children have theirs)."""
         self.count += 1
-        return uuid.uuid5(self.namespace, f"{self.scope}/{self.count}").hex
+        return stable_id(self.namespace, f"{self.scope}/{self.count}")
 
-    def node(self, kind: NodeKind, name: str, *children: NodeSpec, **config: Any) -> NodeSpec:
+    def node(
+        self,
+        kind: NodeKind,
+        name: str,
+        *children: NodeSpec,
+        node_id: str | None = None,
+        **config: Any,
+    ) -> NodeSpec:
+        """A logic node; ``config`` are its settings (``engine.kinds.setting``). ``node_id``:
+        an id taken earlier with :meth:`id` (a tree numbered from its root down)."""
         params = {k: setting(kind, k, v) for k, v in config.items()}
-        return NodeSpec(kind, name, self.id(), params=params, children=list(children))
+        return NodeSpec(kind, name, node_id or self.id(), params=params, children=list(children))
 
-    def op(self, op: str, name: str, **params: Binding | str) -> NodeSpec:
-        """An operation; a text parameter is a blackboard reference."""
+    def op(self, op: str, name: str, /, **params: Binding | str) -> NodeSpec:
+        """An operation; a text parameter is a blackboard reference (a parameter may be
+        called ``name``: the label is positional only)."""
         return NodeSpec(NodeKind.OPERATION, name, self.id(), op=op, params=_bound(params))
 
     def move(
@@ -65,7 +104,7 @@ class PlanBuilder:
                        "accel": fixed(speed, ParamType.NUMBER)}  # fmt: skip
         return self.op("motion.move_to", name, **params)
 
-    def instance(self, subtree: SubtreeSpec, name: str, **params: Binding | str) -> NodeSpec:
+    def instance(self, subtree: SubtreeSpec, name: str, /, **params: Binding | str) -> NodeSpec:
         """An instance of a library subtree; a text parameter is a blackboard reference."""
         return NodeSpec(
             NodeKind.SUBTREE, name, self.id(), params=_bound(params), subtree=subtree.ref

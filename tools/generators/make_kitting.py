@@ -9,14 +9,12 @@ as in Figure 7: Handoff, Unholster, one each of the 3-, 4- and 8-hole plates int
 (three instances of Transfer, reparameterized as in Figure 6, under a selector that takes
 whichever plate is still on the table), Holster, Return.
 
-Usage: python resources/examples/make_kitting.py
+Usage: python -m tools.generators.make_kitting
 """
 
 from __future__ import annotations
 
 import math
-import uuid
-from pathlib import Path
 from typing import Any
 
 from engine.files import save_plan
@@ -28,11 +26,20 @@ from engine.spec import (
     SubtreeSpec,
 )
 from engine.types import JointConfig, ObjectModel, ParamType, Pose, Region, Waypoint, WaypointFrame
-from resources.examples.plan_builder import PlanBuilder, fixed, obj, port, subtree, write_library
+from tools.generators import RESOURCES
+from tools.generators.plan_builder import (
+    KITTING,
+    PlanBuilder,
+    fixed,
+    obj,
+    port,
+    stable_id,
+    subtree,
+    write_library,
+)
 
-HERE = Path(__file__).resolve().parent
-LIBRARY = HERE.parent / "library" / "kitting"
-_NAMESPACE = uuid.UUID("5d1c7a0e-2b4f-4c8e-9a3d-7e6f5a4b3c2d")
+HERE = RESOURCES / "examples"  # where the plans are written
+LIBRARY = RESOURCES / "library" / "kitting"
 
 DOWN = (1.0, 0.0, 0.0, 0.0)  # the tool pointing straight down
 OBSERVE_JOINTS = (1.2, -1.9, 2.0, -1.6, -1.57, 0.0)  # out of the shoulder camera's view
@@ -83,7 +90,7 @@ class _Maker(PlanBuilder):
     """The kitting generator's nodes (ids in its own namespace), and a straight vertical move."""
 
     def __init__(self, scope: str) -> None:
-        super().__init__(_NAMESPACE, scope)
+        super().__init__(KITTING, scope)
 
     def vertical(self, name: str, dz: str | float) -> NodeSpec:
         return self.op(
@@ -264,12 +271,12 @@ def kitting() -> PlanSpec:
         "cell opens for it. Run it with: costar run example:kitting --seed N.",
         RunPolicy.ONCE, objects=["kit_bin", *PLATE_THICKNESS], reset_cell=True,
         scene="kitting_handoff",
-        id=uuid.uuid5(_NAMESPACE, "kitting").hex, subtrees=list(subs.values()),
+        id=stable_id(KITTING, "kitting"), subtrees=list(subs.values()),
     )  # fmt: skip
 
 
 def main() -> None:
-    write_library(LIBRARY, library(), HERE.parent)
+    write_library(LIBRARY, library(), RESOURCES)
     plan = HERE / "kitting.costar.json"
     save_plan(kitting(), plan)
     print(f"wrote {plan.name}")

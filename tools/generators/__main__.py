@@ -1,0 +1,27 @@
+"""Run every generator, in the order their files depend on (make_tending reads the
+ClearStopAndBackOff that make_clear_stop writes)."""
+
+from __future__ import annotations
+
+import sys
+
+from tools.generators import (
+    make_cell_examples,
+    make_clear_stop,
+    make_examples,
+    make_kitting,
+    make_objects,
+    make_tending,
+)
+
+
+def main() -> int:
+    status = make_objects.main([])
+    for generator in (make_clear_stop, make_examples, make_cell_examples, make_kitting,
+                      make_tending):  # fmt: skip
+        generator.main()
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main())
