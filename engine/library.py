@@ -52,6 +52,7 @@ from engine.json_reader import JsonFileError, read_json_file
 from engine.plan_format import MAX_NESTING, SUBTREE_FIELDS, PlanFileError
 from engine.plan_reader import read_subtree
 from engine.plan_writer import dump_json, encode_subtree, write_atomic
+from engine.processes import process_alive
 from engine.spec import SubtreeSpec
 from resources import resource_path
 
@@ -450,7 +451,7 @@ def _is_stale(owner: dict[str, object] | None, age: float) -> bool:
         return age > UNREADABLE_LOCK_GRACE_SECONDS
     pid = owner["pid"]
     if owner["host"] == _HOST and isinstance(pid, int):
-        return not _process_alive(pid)
+        return not process_alive(pid)
     return False  # another host's live lock: waited for
 
 
@@ -482,41 +483,6 @@ def _break_if_stale(lock: Path) -> bool:
     except OSError:
         return False
     return True
-
-
-def _process_alive(pid: int) -> bool:
-    """Whether a process of this host has this id (one of another user counts: it is alive)."""
-    if pid <= 0:
-        return False
-    if sys.platform == "win32":
-        return _windows_process_alive(pid)
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    except OSError:
-        return True  # cannot tell: keep the lock (it goes stale by age)
-    return True
-
-
-def _windows_process_alive(pid: int) -> bool:  # pragma: no cover - Windows only
-    """os.kill(pid, 0) would end the process on Windows: ask OpenProcess instead."""
-    import ctypes
-
-    kernel32 = ctypes.WinDLL("kernel32", use_last_error=True)  # type: ignore[attr-defined,unused-ignore]
-    kernel32.OpenProcess.restype = ctypes.c_void_p
-    handle = kernel32.OpenProcess(0x1000, False, pid)  # PROCESS_QUERY_LIMITED_INFORMATION
-    if not handle:
-        return bool(ctypes.get_last_error() == 5)  # type: ignore[attr-defined,unused-ignore]
-    try:
-        code = ctypes.c_ulong()
-        if not kernel32.GetExitCodeProcess(ctypes.c_void_p(handle), ctypes.byref(code)):
-            return True
-        return bool(code.value == 259)  # STILL_ACTIVE
-    finally:
-        kernel32.CloseHandle(ctypes.c_void_p(handle))
 
 
 def _remove_temps_of(target: Path) -> None:

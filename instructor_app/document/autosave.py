@@ -13,7 +13,6 @@ from __future__ import annotations
 import json
 import logging
 import os
-import sys
 import tempfile
 import time
 import uuid
@@ -24,6 +23,7 @@ from pathlib import Path
 from PySide6.QtCore import QObject, QStandardPaths, QTimer, Signal
 
 from engine.json_reader import JsonFileError, JsonReader, read_json_file
+from engine.processes import process_alive
 from instructor_app.document.editing import PlanDocument
 from instructor_app.document.model import DocumentError
 from instructor_app.errors import InstructorError
@@ -101,21 +101,6 @@ def _write_atomically(path: Path, text: str) -> None:
         raise
 
 
-def _process_alive(pid: int) -> bool:
-    """Whether another process with this id runs (POSIX only: signal 0 checks, never kills)."""
-    if pid == os.getpid() or sys.platform == "win32" or pid <= 0:
-        return False
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    except OSError:
-        return False
-    return True
-
-
 def find_recoveries(folder: Path, exclude: set[Path] | None = None) -> list[Recovery]:
     """Recoveries in ``folder``, newest first.
 
@@ -149,7 +134,8 @@ def _read_sidecar(sidecar: Path, plan_file: Path) -> Recovery | None:
     if doc.get("format") != _FORMAT:
         doc.fail(f"format {_FORMAT!r}", key="format")
     pid = doc.get("pid")
-    if isinstance(pid, int) and not isinstance(pid, bool) and _process_alive(pid):
+    mine = pid == os.getpid()  # this window's own copy is excluded by path, not here
+    if isinstance(pid, int) and not isinstance(pid, bool) and not mine and process_alive(pid):
         return None  # a null or missing pid is nobody's: offered
     original = doc.get("original")
     saved_at = doc.number("saved_at", default=0.0)

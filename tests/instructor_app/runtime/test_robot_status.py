@@ -3,30 +3,18 @@ cell file, and the toolbar shows connection, robot mode, safety mode and program
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from pathlib import Path
 
 import dashboard_client
 import pytest
 from PySide6.QtCore import Qt
 
-from capabilities.ur_emulator.process import EmulatorProcess
 from instructor_app.runtime.session import CellSession
-from tests.capabilities.ur.emulators import next_host
 from tests.instructor_app.gui_driver import ScriptedDialogs, make_window
 
 pytestmark = pytest.mark.sim
 
 WAIT_MS = 15_000
-
-
-@pytest.fixture
-def emulator(tmp_path: Path) -> Iterator[EmulatorProcess]:
-    process = EmulatorProcess(
-        next_host(), "5.12", unlock_delay=0.0, write_cell=tmp_path / "emulated.cell.json"
-    )
-    with process:
-        yield process
 
 
 def test_the_toolbar_shows_each_robot_state(qtbot, tmp_path: Path, emulator) -> None:

@@ -7,7 +7,6 @@ import os
 import signal
 import subprocess
 import sys
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -17,7 +16,7 @@ from engine.files import save_plan
 from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
 from engine.types import JointConfig, ParamType
 from instructor_app.runtime.session import CellSession
-from tests.capabilities.ur.emulators import HOME, next_host, wait_for
+from tests.capabilities.ur.emulators import HOME, wait_for
 from tests.instructor_app.gui_driver import make_window
 
 pytestmark = pytest.mark.sim
@@ -25,15 +24,6 @@ pytestmark = pytest.mark.sim
 ROOT = Path(__file__).resolve().parents[3]
 FAR = 2.4  # rad: the base joint's turn, which the arm must not finish
 STILL = 1e-4  # rad
-
-
-@pytest.fixture
-def emulator(tmp_path: Path) -> Iterator[EmulatorProcess]:
-    process = EmulatorProcess(
-        next_host(), "5.12", unlock_delay=0.0, write_cell=tmp_path / "emulated.cell.json"
-    )
-    with process:
-        yield process
 
 
 def _turn_plan(tmp_path: Path) -> Path:
