@@ -293,6 +293,7 @@ class _Monitor:
         self.started = False
         self.deadline = 0.0
         self.script_gone_at: float | None = None
+        self.script_run = -1  # the connection's script_runs when the move was sent
 
     def _debounce(self, now: float) -> bool:
         """True while a stopped script has been seen for less than the grace time."""
@@ -302,11 +303,17 @@ class _Monitor:
 
     def attach(self, conn: URConnection) -> None:
         self.deadline = time.monotonic() + _START_TIMEOUT
+        self.script_run = conn.script_runs
         conn.add_monitor(self)
 
     def __call__(self, conn: URConnection) -> bool:
         handle, state = self.handle, conn.state
         if handle.done():
+            return True
+        if conn.script_runs != self.script_run:
+            # The script that ran this move ended and another runs now: the move ended with
+            # it, and a stop sent now would end the new script's move instead.
+            handle.resolve(False, f"{handle.name}: {NO_SCRIPT}")
             return True
         problem = fault_reason(state)
         if problem == NO_SCRIPT and self._debounce(time.monotonic()):

@@ -130,6 +130,9 @@ class URConnection:
         self._watchdog = False  # set on the running control script
         self._last_kick = 0.0
         self._halted = False  # close() halted the arm: no more work runs
+        # Counts the control scripts this connection started: a move's monitor never stops
+        # the arm through a script other than the one that ran its move.
+        self.script_runs = 0
         # When the I/O thread last resumed after a stall longer than the watchdog's period
         # (another thread held the GIL: an import, a long C call): the script may have
         # stopped on it, which is ours to restart (see capabilities.ur.cell._Recovery).
@@ -321,9 +324,11 @@ class URConnection:
 
         if self.control is None:
             self.control = _control_interface(rtde_control, self.host)
+            self.script_runs += 1
         elif reupload or not self.control.isProgramRunning():
             if not self.control.isConnected():
                 self.control.reconnect()
+            self.script_runs += 1
             self.control.reuploadScript()
             deadline = time.monotonic() + 5.0
             while not self.control.isProgramRunning() and time.monotonic() < deadline:
