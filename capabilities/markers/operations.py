@@ -59,7 +59,7 @@ class _Env:
         self.library = env.interface("objects")
 
     def camera(self, name: str) -> CameraDevice:
-        return camera(self.env, name)  # type: ignore[no-any-return]  # an interface is Any
+        return camera(self.env, name)
 
     def markers_on_objects(self) -> dict[int, tuple[str, Pose]]:
         """marker id -> (object model name, marker pose in the object frame)."""
