@@ -326,7 +326,9 @@ class Scene3DPanel(PointingMixin, QWidget):
     ) -> list[Any]:
         library = (self._cell.interfaces() if self._cell else {}).get("objects")
         try:
-            data = mesh_data(str(library.get(name).mesh_file))  # type: ignore[union-attr]
+            if library is None:
+                raise LookupError("no object library")
+            data = mesh_data(str(library.get(name).mesh_file))
         except Exception:  # no library or an unknown class: a ball marks where it was seen
             data = gl.MeshData.sphere(rows=6, cols=8, radius=0.03)
         mesh = gl.GLMeshItem(meshdata=data, color=colour, shader="shaded",

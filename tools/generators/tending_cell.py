@@ -50,8 +50,10 @@ def observe() -> Waypoint:
     return Waypoint("observe", WaypointFrame.JOINTS, joints=JointConfig(OBSERVE_JOINTS))
 
 
-def _world(name: str, x: float, y: float, z: float, turn: tuple[float, ...]) -> Waypoint:
-    return Waypoint(name, WaypointFrame.WORLD, Pose((x, y, z), turn))  # type: ignore[arg-type]  # four values
+def _world(
+    name: str, x: float, y: float, z: float, turn: tuple[float, float, float, float]
+) -> Waypoint:
+    return Waypoint(name, WaypointFrame.WORLD, Pose((x, y, z), turn))
 
 
 def _on_rack(name: str, z: float) -> Waypoint:
