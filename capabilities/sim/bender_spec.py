@@ -129,8 +129,18 @@ def _spec(r: JsonReader) -> BenderSpec:
     )
 
 
-_FIELDS = ("fixture", "parts", "shapes", "first_at", "interval", "swing", "hold", "spread",
-           "faults", "lift")  # fmt: skip
+_FIELDS = (
+    "fixture",
+    "parts",
+    "shapes",
+    "first_at",
+    "interval",
+    "swing",
+    "hold",
+    "spread",
+    "faults",
+    "lift",
+)
 
 
 def parse_bender(data: Any, source: str = "<scene>") -> BenderSpec | None:
