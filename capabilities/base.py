@@ -288,8 +288,9 @@ class CapabilityRegistry:
             with self._lock:  # setup runs once per cell, even when two threads build trees
                 if capability.name not in self._states:
                     self._states[capability.name] = capability.setup(env)
-            env = CapabilityEnv(env.cell, env.capability, env.settings, self,
-                                self._states[capability.name])  # fmt: skip
+            env = CapabilityEnv(
+                env.cell, env.capability, env.settings, self, self._states[capability.name]
+            )
         return op.factory(env)
 
     def aliases(self) -> Mapping[str, str]:

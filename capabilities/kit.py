@@ -81,8 +81,13 @@ def stateful(cls: Callable[..., Any], *extra: Any) -> Callable[[CapabilityEnv], 
     return lambda env: cls(env.state, *extra)
 
 
-_PY_TYPES: dict[type, str] = {float: "a number", int: "an integer", bool: "true or false",
-                              str: "a text", Pose: "a pose"}  # fmt: skip
+_PY_TYPES: dict[type, str] = {
+    float: "a number",
+    int: "an integer",
+    bool: "true or false",
+    str: "a text",
+    Pose: "a pose",
+}
 
 
 @dataclass(frozen=True)

@@ -49,9 +49,20 @@ __all__ = [
 
 FORMAT_VERSION = 1
 _KNOWN_FIELDS = {
-    "format_version", "name", "description", "mesh", "collision", "mass", "center_of_mass",
-    "dimensions", "symmetry", "markers", "color", "friction", "grasps",
-}  # fmt: skip
+    "format_version",
+    "name",
+    "description",
+    "mesh",
+    "collision",
+    "mass",
+    "center_of_mass",
+    "dimensions",
+    "symmetry",
+    "markers",
+    "color",
+    "friction",
+    "grasps",
+}
 GRASP_TOOLS = ("gripper", "suction")
 _MIN_APPROACH = 0.01  # m: an approach closer to the grasp than this is no approach
 

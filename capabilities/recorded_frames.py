@@ -65,9 +65,13 @@ class FrameRecorder:
         except OSError as exc:
             raise RecordingError(f"{self.folder}: cannot make the folder: {exc}") from exc
         self._index: dict[str, Any] = {
-            "format": FORMAT, "format_version": FORMAT_VERSION, "camera": camera,
-            "on_wrist": on_wrist, "depth_unit": DEPTH_UNIT, "frames": [],
-        }  # fmt: skip
+            "format": FORMAT,
+            "format_version": FORMAT_VERSION,
+            "camera": camera,
+            "on_wrist": on_wrist,
+            "depth_unit": DEPTH_UNIT,
+            "frames": [],
+        }
 
     def add(self, frame: RGBDFrame) -> None:
         """Save one frame (its images, then the index that names them)."""
@@ -79,11 +83,15 @@ class FrameRecorder:
         for name, image in ((rgb_name, bgr), (depth_name, counts)):
             if not cv2.imwrite(str(self.folder / name), image):
                 raise RecordingError(f"{self.folder / name}: cannot write the image")
-        self._index["frames"].append({
-            "rgb": rgb_name, "depth": depth_name,
-            "K": np.asarray(frame.K, dtype=float).tolist(),
-            "T_world_camera": _pose_json(frame.T_world_camera), "stamp": float(frame.stamp),
-        })  # fmt: skip
+        self._index["frames"].append(
+            {
+                "rgb": rgb_name,
+                "depth": depth_name,
+                "K": np.asarray(frame.K, dtype=float).tolist(),
+                "T_world_camera": _pose_json(frame.T_world_camera),
+                "stamp": float(frame.stamp),
+            }
+        )
         try:
             write_atomic(self.folder / INDEX, json.dumps(self._index, indent=1).encode("utf-8"))
         except Exception as exc:
@@ -140,10 +148,12 @@ class RecordedCamera:
             k.fail("a 3x3 matrix (three rows of three numbers)")
         rows = [k.at(i).as_vector(3) for i in range(3)]
         return {
-            "rgb": f.text("rgb", nonempty=True), "depth": f.text("depth", nonempty=True),
+            "rgb": f.text("rgb", nonempty=True),
+            "depth": f.text("depth", nonempty=True),
             "K": np.array(rows, dtype=np.float64),
-            "pose": f.typed("T_world_camera", ParamType.POSE), "stamp": f.number("stamp"),
-        }  # fmt: skip
+            "pose": f.typed("T_world_camera", ParamType.POSE),
+            "stamp": f.number("stamp"),
+        }
 
     @property
     def intrinsics(self) -> np.ndarray:

@@ -192,8 +192,14 @@ class RobotBody:
         out = []
         for link, a, b, radius in _LINK_CAPSULES:
             m = frames[link]
-            out.append(Capsule(m[:3, :3] @ a + m[:3, 3], m[:3, :3] @ b + m[:3, 3],
-                               radius + inflate, LINK_NAMES[link]))  # fmt: skip
+            out.append(
+                Capsule(
+                    m[:3, :3] @ a + m[:3, 3],
+                    m[:3, :3] @ b + m[:3, 3],
+                    radius + inflate,
+                    LINK_NAMES[link],
+                )
+            )
         if tcp_offset is not None:
             flange = frames[-1]
             tip = np.asarray(tcp_offset.position, dtype=float)

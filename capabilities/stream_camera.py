@@ -126,10 +126,13 @@ def frame_header(frame: RGBDFrame) -> dict[str, Any]:
     height, width = frame.depth.shape
     pose = frame.T_world_camera
     return {
-        "ok": True, "width": width, "height": height, "K": np.asarray(frame.K).tolist(),
+        "ok": True,
+        "width": width,
+        "height": height,
+        "K": np.asarray(frame.K).tolist(),
         "T_world_camera": {"position": list(pose.position), "orientation": list(pose.orientation)},
         "stamp": float(frame.stamp),
-    }  # fmt: skip
+    }
 
 
 def serve_frames(

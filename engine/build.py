@@ -135,9 +135,17 @@ def _operation_leaf(spec: NodeSpec, build: _Build, path: str, scope: Scope) -> N
         else:
             fixed[port.name] = binding.value
     return OperationLeaf(
-        build.ctx, scope.node_id(spec.id), spec.label, manifest.kind, operation, fixed, refs,
-        outputs, ports=manifest.inputs, capability=manifest.capability,
-    )  # fmt: skip
+        build.ctx,
+        scope.node_id(spec.id),
+        spec.label,
+        manifest.kind,
+        operation,
+        fixed,
+        refs,
+        outputs,
+        ports=manifest.inputs,
+        capability=manifest.capability,
+    )
 
 
 @dataclass(frozen=True)

@@ -315,11 +315,12 @@ class Executor:
         for leaf in leaves:
             self._dispatcher.put(
                 LogMessage(
-                    self.tree.ctx.tick_count, leaf.id,
+                    self.tree.ctx.tick_count,
+                    leaf.id,
                     f"the cell threw {hold.error.value} into the plan: {hold.reason}",
                     time.monotonic(),
                 )
-            )  # fmt: skip
+            )
         self._thrown = hold
         return True
 

@@ -161,9 +161,14 @@ def make_subtree(
             raise ValueError(f"{out_name} is not written inside {root.label!r}")
         declared_outputs.append(SubtreePort(out_name, writes[out_name], doc))
     return SubtreeSpec(
-        new_id(), name, tree, version=0, description=description,
-        inputs=inputs, outputs=declared_outputs,
-    )  # fmt: skip
+        new_id(),
+        name,
+        tree,
+        version=0,
+        description=description,
+        inputs=inputs,
+        outputs=declared_outputs,
+    )
 
 
 def instance_of(

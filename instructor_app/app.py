@@ -62,22 +62,44 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "plan", nargs="?", help="a plan file (*.costar.json) or example:NAME (costar examples)"
     )
-    parser.add_argument("--cell", type=_cell, default="sim",
-                        help="the cell to work with: sim (the default, the simulated cell), "
-                        "none, or a cell file (*.cell.json); it opens after the window shows")  # fmt: skip
+    parser.add_argument(
+        "--cell",
+        type=_cell,
+        default="sim",
+        help="the cell to work with: sim (the default, the simulated cell), "
+        "none, or a cell file (*.cell.json); it opens after the window shows",
+    )
     parser.add_argument("--seed", type=int, default=0, help="scene seed of the simulated cell")
-    parser.add_argument("--scene", help="scene of the simulated cell (name or path; default "
-                        "cup_to_bin), e.g. tending for the wire bender")  # fmt: skip
+    parser.add_argument(
+        "--scene",
+        help="scene of the simulated cell (name or path; default "
+        "cup_to_bin), e.g. tending for the wire bender",
+    )
     parser.add_argument("--run", action="store_true", help="run the plan once it is open")
-    parser.add_argument("--library", metavar="FOLDER",
-                        help="the subtree library folder (default: $COSTAR_LIBRARY, else the "
-                        "setting, else the user's)")  # fmt: skip
-    parser.add_argument("--screenshot", metavar="PNG",
-                        help="render the window to PNG and exit (after the run with --run)")  # fmt: skip
-    parser.add_argument("--size", type=_size, default=(1920, 1080), metavar="WxH",
-                        help="with --screenshot: the window's size (default 1920x1080)")  # fmt: skip
-    parser.add_argument("--timeout", type=float, default=120.0,
-                        help="with --screenshot --run: give up after this many seconds (exit 3)")  # fmt: skip
+    parser.add_argument(
+        "--library",
+        metavar="FOLDER",
+        help="the subtree library folder (default: $COSTAR_LIBRARY, else the "
+        "setting, else the user's)",
+    )
+    parser.add_argument(
+        "--screenshot",
+        metavar="PNG",
+        help="render the window to PNG and exit (after the run with --run)",
+    )
+    parser.add_argument(
+        "--size",
+        type=_size,
+        default=(1920, 1080),
+        metavar="WxH",
+        help="with --screenshot: the window's size (default 1920x1080)",
+    )
+    parser.add_argument(
+        "--timeout",
+        type=float,
+        default=120.0,
+        help="with --screenshot --run: give up after this many seconds (exit 3)",
+    )
     return parser
 
 

@@ -5,8 +5,15 @@ from __future__ import annotations
 from PySide6.QtWidgets import QFileDialog, QMessageBox, QWidget
 
 __all__ = [
-    "APP_TITLE", "CANCEL", "CELL_FILTER", "DISCARD", "PLAN_FILTER", "SAVE", "XML_FILTER", "Dialogs",
-]  # fmt: skip
+    "APP_TITLE",
+    "CANCEL",
+    "CELL_FILTER",
+    "DISCARD",
+    "PLAN_FILTER",
+    "SAVE",
+    "XML_FILTER",
+    "Dialogs",
+]
 
 APP_TITLE = "CoSTAR Instructor"
 PLAN_FILTER = "CoSTAR plans (*.costar.json);;JSON files (*.json);;All files (*)"

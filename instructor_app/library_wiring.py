@@ -42,10 +42,11 @@ InsertionPoint = Callable[[], "tuple[str | None, int | None]"]
 def library_palette_items(library: Library) -> list[PaletteItem]:
     """One palette entry per library subtree (search finds them; Enter inserts an instance)."""
     return [
-        PaletteItem(NodeKind.SUBTREE, e.subtree.id, e.subtree.name, e.subtree.description,
-                    "library")
+        PaletteItem(
+            NodeKind.SUBTREE, e.subtree.id, e.subtree.name, e.subtree.description, "library"
+        )
         for e in sorted(library.entries, key=lambda e: e.subtree.name)
-    ]  # fmt: skip
+    ]
 
 
 @dataclass(frozen=True)
@@ -154,9 +155,13 @@ class LibraryController(QObject):
             return False
         try:
             made = self.editor.save_as_subtree(
-                node_id, choices.name, self.registry(), choices.open_ports, choices.outputs,
+                node_id,
+                choices.name,
+                self.registry(),
+                choices.open_ports,
+                choices.outputs,
                 choices.description,
-            )  # fmt: skip
+            )
             pending = _PendingSave(node_id, copy.deepcopy(self.document.node(node_id)), choices)
         except DocumentError as exc:
             self.message.emit(f"Cannot save the subtree: {exc}")

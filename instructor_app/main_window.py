@@ -97,19 +97,34 @@ class MainWindow(QMainWindow):
         self.selection: list[str] = []
         self.cell_views = CellViews(self.document, session, self._selected_node, parent=self)
         self.library = LibraryController(
-            self.document, self.views, lambda: self.session.registry, self._insertion_point,
-            library_folder(setting=self.settings.library_folder()), self,
-        )  # fmt: skip
+            self.document,
+            self.views,
+            lambda: self.session.registry,
+            self._insertion_point,
+            library_folder(setting=self.settings.library_folder()),
+            self,
+        )
         self.library.message.connect(self.show_message)
         self.cells = CellControl(
-            session, self.controller, self.document, self.views, self.run_actions,
-            self.dialogs, self.show_message, self,
-        )  # fmt: skip
+            session,
+            self.controller,
+            self.document,
+            self.views,
+            self.run_actions,
+            self.dialogs,
+            self.show_message,
+            self,
+        )
         self.cell_combo = self.cells.combo
         self.files = PlanFiles(
-            self.document, self.autosaver, self.dialogs, self.settings, self.show_message,
-            self.show_canvas, self,
-        )  # fmt: skip
+            self.document,
+            self.autosaver,
+            self.dialogs,
+            self.settings,
+            self.show_message,
+            self.show_canvas,
+            self,
+        )
         self._build_layout()
         self.actions_by_name: dict[str, QAction] = {}
         self._build_menus()

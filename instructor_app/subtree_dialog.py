@@ -150,20 +150,27 @@ class SaveSubtreeDialog(QDialog):
     def choices(self) -> SubtreeChoices:
         """What the dialog says now."""
         open_ports = [
-            OpenPort(node.id, port.name, self._text(self.params_table, row, 2).strip(),
-                     self._text(self.params_table, row, 3).strip())
+            OpenPort(
+                node.id,
+                port.name,
+                self._text(self.params_table, row, 2).strip(),
+                self._text(self.params_table, row, 3).strip(),
+            )
             for row, (node, port) in enumerate(self._params)
             if self._checked(self.params_table, row)
-        ]  # fmt: skip
+        ]
         outputs = {
             self._text(self.outputs_table, row, 0): self._text(self.outputs_table, row, 1)
             for row in range(self.outputs_table.rowCount())
             if self._checked(self.outputs_table, row)
         }
         return SubtreeChoices(
-            self.name_field.text().strip(), self.folder_field.text().strip(),
-            self.description_field.text().strip(), open_ports, outputs,
-        )  # fmt: skip
+            self.name_field.text().strip(),
+            self.folder_field.text().strip(),
+            self.description_field.text().strip(),
+            open_ports,
+            outputs,
+        )
 
     @staticmethod
     def _cell(table: QTableWidget, row: int, column: int) -> QTableWidgetItem:

@@ -17,9 +17,16 @@ from instructor_app.runtime.session import CellSession
 __all__ = ["CANVAS_ACTIONS", "Views", "make_views"]
 
 CANVAS_ACTIONS = (
-    "cut", "copy", "paste", "duplicate", "delete",
-    "move_left", "move_right", "toggle_collapse", "auto_layout",
-)  # fmt: skip
+    "cut",
+    "copy",
+    "paste",
+    "duplicate",
+    "delete",
+    "move_left",
+    "move_right",
+    "toggle_collapse",
+    "auto_layout",
+)
 
 
 @dataclass

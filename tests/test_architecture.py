@@ -56,6 +56,17 @@ def _base_of(node: ast.ImportFrom, module: str, is_package: bool) -> str:
     return f"{base}.{node.module}" if node.module else base
 
 
+def _pop_group(stack: list[str], on_stack: set[str], node: str) -> list[str]:
+    """Pops Tarjan's stack down to ``node``: the strongly connected group it is the root of."""
+    group = []
+    while True:
+        member = stack.pop()
+        on_stack.discard(member)
+        group.append(member)
+        if member == node:
+            return group
+
+
 class ModuleGraph:
     """The project's modules and, for each, the project modules and names it imports."""
 
@@ -112,13 +123,7 @@ class ModuleGraph:
                     if work:
                         low[work[-1][0]] = min(low[work[-1][0]], low[node])
                     if low[node] == index[node]:
-                        group = []
-                        while True:
-                            member = stack.pop()
-                            on_stack.discard(member)
-                            group.append(member)
-                            if member == node:
-                                break
+                        group = _pop_group(stack, on_stack, node)
                         if len(group) > 1:
                             groups.append(sorted(group))
                 elif child not in index:

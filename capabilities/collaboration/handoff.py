@@ -197,14 +197,19 @@ class HandoffJob(Job):
                 and since is not None
                 and seen.stamp - since.stamp >= settings.settle
             ):
-                self._log(f"{self._target.name} handed over at {_xyz(seen.pose)} "
-                          f"(frame at {seen.stamp:.2f} s)")  # fmt: skip
+                self._log(
+                    f"{self._target.name} handed over at {_xyz(seen.pose)} "
+                    f"(frame at {seen.stamp:.2f} s)"
+                )
                 self.decided = seen.stamp
                 self.succeed(outputs={"pose": seen.pose})
                 return
             if settings.timeout > 0 and self._clock() - start >= settings.timeout:
-                self.fail(f"timed out: no {self._target.name} put down in the region "
-                          f"within {settings.timeout:g} s", ErrorType.TIMEOUT)  # fmt: skip
+                self.fail(
+                    f"timed out: no {self._target.name} put down in the region "
+                    f"within {settings.timeout:g} s",
+                    ErrorType.TIMEOUT,
+                )
                 return
 
     def _still_since(self, since: Detection | None, seen: Detection | None) -> Detection | None:

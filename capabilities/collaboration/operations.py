@@ -65,8 +65,9 @@ def _object_name(value: Any) -> str:
 class _PromptJob(Job):
     """RUNNING while the prompt is open; a timeout (cell clock) or a halt withdraws it."""
 
-    def __init__(self, console: OperatorConsole, prompt: Prompt, call: OperationCall,
-                 deadline: float | None) -> None:  # fmt: skip
+    def __init__(
+        self, console: OperatorConsole, prompt: Prompt, call: OperationCall, deadline: float | None
+    ) -> None:
         super().__init__(on_cancel=self._withdraw)
         self._console, self._prompt, self._clock = console, prompt, call.clock
         self._deadline = deadline
@@ -121,8 +122,9 @@ class _ButtonJob(Job):
     """RUNNING until the button is pressed: a press finishes it at once from the thread that
     pressed (no wait for the next tick); a timeout is checked on the cell's clock."""
 
-    def __init__(self, console: OperatorConsole, button: str, call: OperationCall,
-                 timeout: float) -> None:  # fmt: skip
+    def __init__(
+        self, console: OperatorConsole, button: str, call: OperationCall, timeout: float
+    ) -> None:
         super().__init__(on_cancel=lambda: console.remove_listener(self._heard))
         self._console, self._button, self._clock = console, button, call.clock
         self._deadline = call.clock() + timeout if timeout > 0 else None
@@ -184,9 +186,10 @@ class WaitForHandoff:
         if not target.markers:
             raise OperationFailed(f"{name} carries no marker: a handoff cannot be seen")
         settings = HandoffSettings(
-            interval=max(_seconds(call, "interval"), 0.01), settle=_seconds(call, "settle"),
+            interval=max(_seconds(call, "interval"), 0.01),
+            settle=_seconds(call, "settle"),
             timeout=_seconds(call, "timeout"),
-        )  # fmt: skip
+        )
         region: Region = call.input("region")
         return HandoffJob(device, target, region, world, call.clock, settings, call.log)
 
@@ -232,39 +235,103 @@ def _manifests() -> list[tuple[OperationManifest, Any]]:
     region = _port("region", (ParamType.REGION,), "where it must be (a sphere)")
     console = lambda env: env.interface("operator")  # noqa: E731
     return [
-        (manifest(CAP, "confirm", OperationKind.ACTION,
-            "Asks the operator a yes/no question; succeeds on yes, fails on no.",
-            _port("prompt", (ParamType.TEXT,), "the question shown to the operator"),
-            _port("timeout", TIME, "give up after this long (0: wait for ever)", default=0.0,
-                  unit="s")),
-         lambda env: Confirm(console(env))),
-        (manifest(CAP, "button_pressed", OperationKind.CONDITION,
-            "True when the operator pressed the button since it was last checked.", button),
-         lambda env: ButtonPressed(console(env))),
-        (manifest(CAP, "wait_for_button", OperationKind.ACTION,
-            "Waits until the operator presses the button (or the foot pedal).", button,
-            _port("timeout", TIME, "give up after this long (0: wait for ever)", default=0.0,
-                  unit="s"),
-            _port("earlier_press_counts", (ParamType.BOOL,),
-                  "a press made before this node started counts", default=False)),
-         lambda env: WaitForButton(console(env))),
-        (manifest(CAP, "wait_for_handoff", OperationKind.ACTION,
-            "Waits until a person puts the object down in the region (seen by its markers).",
-            obj, region,
-            _port("camera", (ParamType.TEXT,), "which camera watches", default="shoulder",
-                  choices=CAMERAS),
-            _port("timeout", TIME, "give up after this long (0: wait for ever)", default=0.0,
-                  unit="s"),
-            _port("settle", TIME, "how long it must lie still first", default=0.0, unit="s"),
-            _port("interval", TIME, "time between camera frames", default=0.1, unit="s"),
-            PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where it was put")),
-         WaitForHandoff),
-        (manifest(CAP, "object_in_region", OperationKind.CONDITION,
-            "True when the object was last seen inside the region.", obj, region,
-            _port("max_age", TIME, "ignore sightings older than this (0: any age)",
-                  default=0.0, unit="s")),
-         ObjectInRegion),
-    ]  # fmt: skip
+        (
+            manifest(
+                CAP,
+                "confirm",
+                OperationKind.ACTION,
+                "Asks the operator a yes/no question; succeeds on yes, fails on no.",
+                _port("prompt", (ParamType.TEXT,), "the question shown to the operator"),
+                _port(
+                    "timeout",
+                    TIME,
+                    "give up after this long (0: wait for ever)",
+                    default=0.0,
+                    unit="s",
+                ),
+            ),
+            lambda env: Confirm(console(env)),
+        ),
+        (
+            manifest(
+                CAP,
+                "button_pressed",
+                OperationKind.CONDITION,
+                "True when the operator pressed the button since it was last checked.",
+                button,
+            ),
+            lambda env: ButtonPressed(console(env)),
+        ),
+        (
+            manifest(
+                CAP,
+                "wait_for_button",
+                OperationKind.ACTION,
+                "Waits until the operator presses the button (or the foot pedal).",
+                button,
+                _port(
+                    "timeout",
+                    TIME,
+                    "give up after this long (0: wait for ever)",
+                    default=0.0,
+                    unit="s",
+                ),
+                _port(
+                    "earlier_press_counts",
+                    (ParamType.BOOL,),
+                    "a press made before this node started counts",
+                    default=False,
+                ),
+            ),
+            lambda env: WaitForButton(console(env)),
+        ),
+        (
+            manifest(
+                CAP,
+                "wait_for_handoff",
+                OperationKind.ACTION,
+                "Waits until a person puts the object down in the region (seen by its markers).",
+                obj,
+                region,
+                _port(
+                    "camera",
+                    (ParamType.TEXT,),
+                    "which camera watches",
+                    default="shoulder",
+                    choices=CAMERAS,
+                ),
+                _port(
+                    "timeout",
+                    TIME,
+                    "give up after this long (0: wait for ever)",
+                    default=0.0,
+                    unit="s",
+                ),
+                _port("settle", TIME, "how long it must lie still first", default=0.0, unit="s"),
+                _port("interval", TIME, "time between camera frames", default=0.1, unit="s"),
+                PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where it was put"),
+            ),
+            WaitForHandoff,
+        ),
+        (
+            manifest(
+                CAP,
+                "object_in_region",
+                OperationKind.CONDITION,
+                "True when the object was last seen inside the region.",
+                obj,
+                region,
+                _port(
+                    "max_age",
+                    TIME,
+                    "ignore sightings older than this (0: any age)",
+                    default=0.0,
+                    unit="s",
+                ),
+            ),
+            ObjectInRegion,
+        ),
+    ]
 
 
 def capability() -> Capability:

@@ -25,13 +25,20 @@ CAP = "freedrive"
 START = manifest(CAP, "start", OperationKind.ACTION, "Lets the worker guide the arm by hand.")
 STOP = manifest(CAP, "stop", OperationKind.ACTION, "Ends hand guiding; the arm holds where it is.")
 RECORD_WAYPOINT = manifest(
-    CAP, "record_waypoint", OperationKind.QUERY,
+    CAP,
+    "record_waypoint",
+    OperationKind.QUERY,
     "Records where the arm is now as a waypoint (typically after guiding it by hand).",
     PortSpec("name", (ParamType.TEXT,), default="waypoint", doc="the waypoint's name"),
-    PortSpec("frame", (ParamType.TEXT,), default="world", choices=("world", "joints"),
-             doc="world: the tool pose; joints: the joint positions"),
+    PortSpec(
+        "frame",
+        (ParamType.TEXT,),
+        default="world",
+        choices=("world", "joints"),
+        doc="world: the tool pose; joints: the joint positions",
+    ),
     PortSpec("waypoint", (ParamType.WAYPOINT,), Direction.OUT, doc="the recorded waypoint"),
-)  # fmt: skip
+)
 
 
 def _off_thread(fn: Callable[[], None], describe: str) -> Job:

@@ -46,16 +46,25 @@ _LINEAR_SPEED, _LINEAR_ACCEL = 0.15, 1.0  # m/s, m/s^2: gentle near the object
 def grasp_manifest(capability: str, grasp_names: tuple[str, ...]) -> OperationManifest:
     """The manifest of ``<capability>.grasp``; ``grasp_names`` are the library's grasps."""
     return manifest(
-        capability, "grasp", OperationKind.ACTION,
+        capability,
+        "grasp",
+        OperationKind.ACTION,
         "Takes an object at its pose with a grasp of its model: approach, straight down, "
         "close (or vacuum on), check it is held, lift back.",
         PortSpec("object", (ParamType.OBJECT,), doc="the object (by its model name)"),
-        PortSpec("pose", (ParamType.POSE,),
-                 doc="where the object is (from a markers or perception pose query)"),
-        PortSpec("grasp", (ParamType.TEXT,), default=FIRST,
-                 choices=(FIRST, *(n for n in grasp_names if n != FIRST)),
-                 doc="which grasp of the object's model ('first': the model's first grasp)"),
-    )  # fmt: skip
+        PortSpec(
+            "pose",
+            (ParamType.POSE,),
+            doc="where the object is (from a markers or perception pose query)",
+        ),
+        PortSpec(
+            "grasp",
+            (ParamType.TEXT,),
+            default=FIRST,
+            choices=(FIRST, *(n for n in grasp_names if n != FIRST)),
+            doc="which grasp of the object's model ('first': the model's first grasp)",
+        ),
+    )
 
 
 @dataclass(frozen=True)

@@ -40,8 +40,9 @@ MIN_CONFIDENCE = 0.05
 
 
 def _camera_port(default: str = "shoulder") -> PortSpec:
-    return PortSpec("camera", (ParamType.TEXT,), default=default, doc="which camera looks",
-                    choices=CAMERAS)  # fmt: skip
+    return PortSpec(
+        "camera", (ParamType.TEXT,), default=default, doc="which camera looks", choices=CAMERAS
+    )
 
 
 def _object_port() -> PortSpec:
@@ -59,7 +60,7 @@ class _Env:
         self.library = env.interface("objects")
 
     def camera(self, name: str) -> CameraDevice:
-        return camera(self.env, name)  # type: ignore[no-any-return]  # an interface is Any
+        return camera(self.env, name)
 
     def markers_on_objects(self) -> dict[int, tuple[str, Pose]]:
         """marker id -> (object model name, marker pose in the object frame)."""
@@ -117,8 +118,10 @@ class DetectMarkers:
             source = f"markers:{camera.name}"
             objects = _object_detections(seen, env.markers_on_objects(), frame.stamp, source)
             env.world.replace(source, objects)
-            call.log(f"{camera.name} camera: markers {sorted(seen) or 'none'}; "
-                     f"objects {sorted(d.object_class for d in objects) or 'none'}")  # fmt: skip
+            call.log(
+                f"{camera.name} camera: markers {sorted(seen) or 'none'}; "
+                f"objects {sorted(d.object_class for d in objects) or 'none'}"
+            )
             return {"count": float(len(seen))} if "count" in call.outputs else {}
 
         job: Job = env.workers.submit(look, f"detect markers ({camera.name} camera)")
@@ -193,8 +196,10 @@ class CalibrateCamera:
                     f"calibration error {report.rms_px:.2f} px is above {max_rms:g} px"
                 )
             camera.set_extrinsics(pose)
-            call.log(f"{camera.name} camera calibrated from markers {sorted(report.inliers)}: "
-                     f"{report.rms_px:.3f} px")  # fmt: skip
+            call.log(
+                f"{camera.name} camera calibrated from markers {sorted(report.inliers)}: "
+                f"{report.rms_px:.3f} px"
+            )
             return {}
 
         job: Job = env.workers.submit(calibrate, f"calibrate the {camera.name} camera")
@@ -209,26 +214,64 @@ def capability() -> Capability:
         setup=_Env,  # the per-cell state: the interfaces every markers operation uses
     )
 
-    cap.add(manifest(CAP, "detect_markers", OperationKind.ACTION,
-               "Looks through a camera and remembers every marker and marked object it sees.",
-               _camera_port(),
-               PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="how many markers were seen")),
-            stateful(DetectMarkers))  # fmt: skip
-    cap.add(manifest(CAP, "marker_pose", OperationKind.QUERY, "The pose of a marker last seen.",
-               PortSpec("marker_id", (ParamType.NUMBER,), doc="the marker's id"),
-               PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where it is")),
-            stateful(MarkerPose))  # fmt: skip
-    cap.add(manifest(CAP, "object_pose", OperationKind.QUERY, "The pose of an object, from its marker.",
-               _object_port(),
-               PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the object is")),
-            stateful(ObjectPose))  # fmt: skip
-    cap.add(manifest(CAP, "object_found", OperationKind.CONDITION, "True when the object's marker was seen.",
-               _object_port()),
-            stateful(ObjectFound))  # fmt: skip
-    cap.add(manifest(CAP, "calibrate_camera", OperationKind.ACTION,
-               "Finds a fixed camera's pose from the markers of known pose (table, fixtures).",
-               _camera_port(),
-               PortSpec("max_error_px", (ParamType.NUMBER,), default=1.5, unit="px",
-                        doc="refuse a calibration worse than this")),
-            stateful(CalibrateCamera))  # fmt: skip
+    cap.add(
+        manifest(
+            CAP,
+            "detect_markers",
+            OperationKind.ACTION,
+            "Looks through a camera and remembers every marker and marked object it sees.",
+            _camera_port(),
+            PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="how many markers were seen"),
+        ),
+        stateful(DetectMarkers),
+    )
+    cap.add(
+        manifest(
+            CAP,
+            "marker_pose",
+            OperationKind.QUERY,
+            "The pose of a marker last seen.",
+            PortSpec("marker_id", (ParamType.NUMBER,), doc="the marker's id"),
+            PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where it is"),
+        ),
+        stateful(MarkerPose),
+    )
+    cap.add(
+        manifest(
+            CAP,
+            "object_pose",
+            OperationKind.QUERY,
+            "The pose of an object, from its marker.",
+            _object_port(),
+            PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the object is"),
+        ),
+        stateful(ObjectPose),
+    )
+    cap.add(
+        manifest(
+            CAP,
+            "object_found",
+            OperationKind.CONDITION,
+            "True when the object's marker was seen.",
+            _object_port(),
+        ),
+        stateful(ObjectFound),
+    )
+    cap.add(
+        manifest(
+            CAP,
+            "calibrate_camera",
+            OperationKind.ACTION,
+            "Finds a fixed camera's pose from the markers of known pose (table, fixtures).",
+            _camera_port(),
+            PortSpec(
+                "max_error_px",
+                (ParamType.NUMBER,),
+                default=1.5,
+                unit="px",
+                doc="refuse a calibration worse than this",
+            ),
+        ),
+        stateful(CalibrateCamera),
+    )
     return cap

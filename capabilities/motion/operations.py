@@ -41,13 +41,17 @@ LINEAR_ACCEL = 1.2  # m/s^2
 
 _N = (ParamType.NUMBER,)
 SPEED = PortSpec(
-    "speed", _N, default=1.0,
+    "speed",
+    _N,
+    default=1.0,
     doc="fraction of the nominal speed (1.05 rad/s joint, 0.25 m/s linear), 0 to 2",
-)  # fmt: skip
+)
 ACCEL = PortSpec(
-    "accel", _N, default=1.0,
+    "accel",
+    _N,
+    default=1.0,
     doc="fraction of the nominal acceleration (1.4 rad/s^2 joint, 1.2 m/s^2 linear), 0 to 2",
-)  # fmt: skip
+)
 
 _MAX_SCALE = 2.0
 
@@ -86,29 +90,37 @@ def _via_approach(
     )
 
 
-MOVE_TO = manifest(CAP, "move_to",
+MOVE_TO = manifest(
+    CAP,
+    "move_to",
     OperationKind.ACTION,
     "Moves the tool to a pose or waypoint (relative waypoints follow the detected object; "
     "an object's pose with a grasp reference goes to that grasp through its approach).",
     PortSpec(
-        "target", (ParamType.WAYPOINT, ParamType.POSE),
+        "target",
+        (ParamType.WAYPOINT, ParamType.POSE),
         doc="where the tool goes (world pose, or a waypoint in any frame)",
     ),
     PortSpec(
-        "reference", (ParamType.POSE, ParamType.TEXT), default="",
+        "reference",
+        (ParamType.POSE, ParamType.TEXT),
+        default="",
         doc="for a relative waypoint: the object's (marker's) pose, or a class name / marker id "
         "to look up; empty: the waypoint's own reference in the world model. For a Pose "
         "target that is an object's pose: a grasp reference, 'cup' (its model's first grasp) "
         "or 'cup/rim'",
     ),
     PortSpec(
-        "mode", (ParamType.TEXT,), default="joint", choices=("joint", "linear"),
+        "mode",
+        (ParamType.TEXT,),
+        default="joint",
+        choices=("joint", "linear"),
         doc="joint: fastest path in joint space; linear: a straight line of the tool (a grasp "
         "reference: joint to the approach, then straight to the grasp)",
     ),
     SPEED,
     ACCEL,
-)  # fmt: skip
+)
 
 
 class MoveTo:
@@ -169,19 +181,24 @@ class MoveJoints:
         return _joint_move(self._arm, target.positions, call, "move_joints")
 
 
-MOVE_RELATIVE = manifest(CAP, "move_relative",
+MOVE_RELATIVE = manifest(
+    CAP,
+    "move_relative",
     OperationKind.ACTION,
     "Moves the tool by an offset on a straight line.",
     PortSpec("dx", _N, default=0.0, unit="m", doc="offset along x"),
     PortSpec("dy", _N, default=0.0, unit="m", doc="offset along y"),
     PortSpec("dz", _N, default=0.0, unit="m", doc="offset along z"),
     PortSpec(
-        "frame", (ParamType.TEXT,), default="world", choices=("world", "tool"),
+        "frame",
+        (ParamType.TEXT,),
+        default="world",
+        choices=("world", "tool"),
         doc="axes of the offset: the world's or the tool's",
     ),
     SPEED,
     ACCEL,
-)  # fmt: skip
+)
 
 
 class MoveRelative:
@@ -206,11 +223,14 @@ class MoveRelative:
 
 
 MOVE_RELATIVE_TOOL = manifest(
-    CAP, "move_relative_tool", OperationKind.ACTION,
+    CAP,
+    "move_relative_tool",
+    OperationKind.ACTION,
     "Moves the tool by an offset along its own axes, on a straight line.",
     PortSpec("dz", _N, default=0.0, unit="m", doc="offset along the tool's z (its approach)"),
-    SPEED, ACCEL,
-)  # fmt: skip
+    SPEED,
+    ACCEL,
+)
 
 
 class MoveRelativeTool:
@@ -334,13 +354,15 @@ class IsHome:
         return Job.answer(max(abs(a - b) for a, b in zip(now, home, strict=True)) <= tolerance)
 
 
-CLEAR_PROTECTIVE_STOP = manifest(CAP, "clear_protective_stop",
+CLEAR_PROTECTIVE_STOP = manifest(
+    CAP,
+    "clear_protective_stop",
     OperationKind.ACTION,
     "Clears a protective stop (after a collision): waits until the robot allows it (5 s "
     "after the stop on a UR), unlocks it and waits until the arm can move again. Succeeds at "
     "once when the arm is not stopped. An emergency stop, power off or a lost connection "
     "fails it with its type: those are for the operator.",
-)  # fmt: skip
+)
 
 
 class ClearProtectiveStop:

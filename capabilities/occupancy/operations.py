@@ -125,13 +125,26 @@ def _region_port() -> PortSpec:
 def _common_ports() -> tuple[PortSpec, ...]:
     return (
         _region_port(),
-        PortSpec("camera", (ParamType.TEXT,), default="shoulder", choices=CAMERAS,
-                 doc="which camera's depth image looks"),
-        PortSpec("min_points", (ParamType.NUMBER,), default=30.0,
-                 doc="this many points in the region make it occupied"),
-        PortSpec("mask_robot", (ParamType.BOOL,), default=True,
-                 doc="leave the robot's own arm and tool out"),
-    )  # fmt: skip
+        PortSpec(
+            "camera",
+            (ParamType.TEXT,),
+            default="shoulder",
+            choices=CAMERAS,
+            doc="which camera's depth image looks",
+        ),
+        PortSpec(
+            "min_points",
+            (ParamType.NUMBER,),
+            default=30.0,
+            doc="this many points in the region make it occupied",
+        ),
+        PortSpec(
+            "mask_robot",
+            (ParamType.BOOL,),
+            default=True,
+            doc="leave the robot's own arm and tool out",
+        ),
+    )
 
 
 _MAX_AGE = PortSpec(
@@ -144,8 +157,9 @@ _MAX_AGE = PortSpec(
 _TIMEOUT = PortSpec(
     "timeout", (ParamType.DURATION,), default=10.0, unit="s", doc="fail after this long (cell time)"
 )
-_PERIOD = PortSpec("period", (ParamType.DURATION,), default=0.1, unit="s",
-                   doc="look again this often")  # fmt: skip
+_PERIOD = PortSpec(
+    "period", (ParamType.DURATION,), default=0.1, unit="s", doc="look again this often"
+)
 
 
 class _Args:
@@ -160,16 +174,28 @@ class _Args:
 
 def _region_text(region: Region) -> str:
     c = region.center
-    return (f"region ({c[0] * 1000:.0f}, {c[1] * 1000:.0f}, {c[2] * 1000:.0f}) mm "
-            f"r {region.radius * 1000:.0f} mm")  # fmt: skip
+    return (
+        f"region ({c[0] * 1000:.0f}, {c[1] * 1000:.0f}, {c[2] * 1000:.0f}) mm "
+        f"r {region.radius * 1000:.0f} mm"
+    )
 
 
-IS_OCCUPIED = manifest(CAP, "is_occupied", OperationKind.CONDITION,
-                       "True when something (not the table, not the robot) is in the region.",
-                       *_common_ports(), _MAX_AGE)  # fmt: skip
-IS_EMPTY = manifest(CAP, "is_empty", OperationKind.CONDITION,
-                    "True when nothing (but the table or the robot) is in the region.",
-                    *_common_ports(), _MAX_AGE)  # fmt: skip
+IS_OCCUPIED = manifest(
+    CAP,
+    "is_occupied",
+    OperationKind.CONDITION,
+    "True when something (not the table, not the robot) is in the region.",
+    *_common_ports(),
+    _MAX_AGE,
+)
+IS_EMPTY = manifest(
+    CAP,
+    "is_empty",
+    OperationKind.CONDITION,
+    "True when nothing (but the table or the robot) is in the region.",
+    *_common_ports(),
+    _MAX_AGE,
+)
 
 
 class RegionCondition:
@@ -195,12 +221,24 @@ class RegionCondition:
         return FeedJob(feed, state.clock, decide, state.clock() - max_age, state.refresh_period)
 
 
-WAIT_UNTIL_OCCUPIED = manifest(CAP, "wait_until_occupied", OperationKind.ACTION,
-                               "Waits until something is in the region; fails after the timeout.",
-                               *_common_ports(), _TIMEOUT, _PERIOD)  # fmt: skip
-WAIT_UNTIL_EMPTY = manifest(CAP, "wait_until_empty", OperationKind.ACTION,
-                            "Waits until the region is clear; fails after the timeout.",
-                            *_common_ports(), _TIMEOUT, _PERIOD)  # fmt: skip
+WAIT_UNTIL_OCCUPIED = manifest(
+    CAP,
+    "wait_until_occupied",
+    OperationKind.ACTION,
+    "Waits until something is in the region; fails after the timeout.",
+    *_common_ports(),
+    _TIMEOUT,
+    _PERIOD,
+)
+WAIT_UNTIL_EMPTY = manifest(
+    CAP,
+    "wait_until_empty",
+    OperationKind.ACTION,
+    "Waits until the region is clear; fails after the timeout.",
+    *_common_ports(),
+    _TIMEOUT,
+    _PERIOD,
+)
 
 
 class WaitForRegion:
@@ -229,19 +267,29 @@ class WaitForRegion:
 
         word = "occupied" if want else "empty"
         job = FeedJob(
-            feed, state.clock, decide, now - period, period, now + timeout,
-            lambda last: f"timed out after {timeout:g} s: {_region_text(args.region)} "
-                         f"never {word}; last frame: {last}",
-        )  # fmt: skip
+            feed,
+            state.clock,
+            decide,
+            now - period,
+            period,
+            now + timeout,
+            lambda last: (
+                f"timed out after {timeout:g} s: {_region_text(args.region)} "
+                f"never {word}; last frame: {last}"
+            ),
+        )
         holder.append(job)
         return job
 
 
-COUNT_POINTS = manifest(CAP, "count_points", OperationKind.QUERY,
-                        "How many points of a fresh frame are in the region (table and robot left out).",
-                        *_common_ports(),
-                        PortSpec("count", (ParamType.NUMBER,), Direction.OUT,
-                                 doc="the occupant points counted"))  # fmt: skip
+COUNT_POINTS = manifest(
+    CAP,
+    "count_points",
+    OperationKind.QUERY,
+    "How many points of a fresh frame are in the region (table and robot left out).",
+    *_common_ports(),
+    PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="the occupant points counted"),
+)
 
 
 class CountPoints:

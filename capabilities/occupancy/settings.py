@@ -16,4 +16,4 @@ SETTINGS = (
     Setting("mask_inflate", float, 0.02, "how much (m) the robot's capsules grow when masking"),
     Setting("tool_radius", float, 0.07, "radius (m) of the tool's capsule (the parallel gripper)"),
     Setting("refresh_period", float, 0.1, "a frame older than this (s of cell time) is renewed"),
-)  # fmt: skip
+)  # fmt: skip  # a table: one setting a row

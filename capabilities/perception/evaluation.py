@@ -64,10 +64,14 @@ def score_recognitions(
         nearest = min(near, default=(math.inf, ""))
         scores.append(
             ObjectScore(
-                name, model, pos <= max_position and rot <= max_rotation, pos, rot,
+                name,
+                model,
+                pos <= max_position and rot <= max_rotation,
+                pos,
+                rot,
                 nearest[1] if nearest[0] <= class_radius else "",
             )
-        )  # fmt: skip
+        )
     return scores
 
 

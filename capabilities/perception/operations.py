@@ -119,8 +119,10 @@ class DetectObjects:
             ]
             env.world.replace(source, detections)
             names = sorted(instance for instance, _ in tracked)
-            call.log(f"{camera.name} camera: {', '.join(names) or 'no objects'} "
-                     f"({1000 * recognizer.last_seconds:.0f} ms)")  # fmt: skip
+            call.log(
+                f"{camera.name} camera: {', '.join(names) or 'no objects'} "
+                f"({1000 * recognizer.last_seconds:.0f} ms)"
+            )
             return {"count": float(len(detections))}
 
         job: Job = env.workers.submit(look, f"detect objects ({camera.name} camera)")
@@ -200,35 +202,83 @@ def capability() -> Capability:
         setup=lambda env: _Env(env, _Shared()),
     )
 
-    cap.add(manifest(CAP, "detect_objects", OperationKind.ACTION,
-               "Looks through a camera and recognises the known objects on the table "
-               "(point cloud matched to the object models).",
-               PortSpec("camera", (ParamType.TEXT,), default="shoulder", doc="which camera looks",
-                        choices=CAMERAS),
-               PortSpec("count", (ParamType.NUMBER,), Direction.OUT,
-                        doc="how many objects were recognised")),
-            stateful(DetectObjects))  # fmt: skip
-    cap.add(manifest(CAP, "object_found", OperationKind.CONDITION,
-               "True when the last look recognised an object of this class.", _object_port()),
-            stateful(ObjectFound))  # fmt: skip
-    cap.add(manifest(CAP, "object_pose", OperationKind.QUERY,
-               "The pose of the most confidently recognised object of a class.", _object_port(),
-               PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the object is")),
-            stateful(ObjectPose))  # fmt: skip
-    cap.add(manifest(CAP, "objects_of_class", OperationKind.QUERY,
-               "How many objects of a class the last look recognised, and their poses.",
-               _object_port(),
-               PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="how many"),
-               PortSpec("poses", (ParamType.ANY,), Direction.OUT,
-                        doc="their poses, most confident first")),
-            stateful(ObjectsOfClass))  # fmt: skip
-    cap.add(manifest(CAP, "plate_type", OperationKind.QUERY,
-               "Which plate (by its holes) lies nearest to a pose.",
-               PortSpec("near", (ParamType.POSE,), default=Pose(),
-                        doc="the plate nearest this pose (default: nearest the robot base)"),
-               PortSpec("within", (ParamType.NUMBER,), default=2.0, unit="m",
-                        doc="fail when the nearest plate is farther than this"),
-               PortSpec("model", (ParamType.OBJECT,), Direction.OUT, doc="the plate's model"),
-               PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the plate is")),
-            stateful(PlateType))  # fmt: skip
+    cap.add(
+        manifest(
+            CAP,
+            "detect_objects",
+            OperationKind.ACTION,
+            "Looks through a camera and recognises the known objects on the table "
+            "(point cloud matched to the object models).",
+            PortSpec(
+                "camera",
+                (ParamType.TEXT,),
+                default="shoulder",
+                doc="which camera looks",
+                choices=CAMERAS,
+            ),
+            PortSpec(
+                "count", (ParamType.NUMBER,), Direction.OUT, doc="how many objects were recognised"
+            ),
+        ),
+        stateful(DetectObjects),
+    )
+    cap.add(
+        manifest(
+            CAP,
+            "object_found",
+            OperationKind.CONDITION,
+            "True when the last look recognised an object of this class.",
+            _object_port(),
+        ),
+        stateful(ObjectFound),
+    )
+    cap.add(
+        manifest(
+            CAP,
+            "object_pose",
+            OperationKind.QUERY,
+            "The pose of the most confidently recognised object of a class.",
+            _object_port(),
+            PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the object is"),
+        ),
+        stateful(ObjectPose),
+    )
+    cap.add(
+        manifest(
+            CAP,
+            "objects_of_class",
+            OperationKind.QUERY,
+            "How many objects of a class the last look recognised, and their poses.",
+            _object_port(),
+            PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="how many"),
+            PortSpec(
+                "poses", (ParamType.ANY,), Direction.OUT, doc="their poses, most confident first"
+            ),
+        ),
+        stateful(ObjectsOfClass),
+    )
+    cap.add(
+        manifest(
+            CAP,
+            "plate_type",
+            OperationKind.QUERY,
+            "Which plate (by its holes) lies nearest to a pose.",
+            PortSpec(
+                "near",
+                (ParamType.POSE,),
+                default=Pose(),
+                doc="the plate nearest this pose (default: nearest the robot base)",
+            ),
+            PortSpec(
+                "within",
+                (ParamType.NUMBER,),
+                default=2.0,
+                unit="m",
+                doc="fail when the nearest plate is farther than this",
+            ),
+            PortSpec("model", (ParamType.OBJECT,), Direction.OUT, doc="the plate's model"),
+            PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the plate is"),
+        ),
+        stateful(PlateType),
+    )
     return cap

@@ -76,9 +76,11 @@ def top_view(scene: SceneCloud, cluster: Cluster, config: RecognitionConfig) -> 
     plane_to_camera = np.column_stack((t[:3, 0], t[:3, 1], t[:3, 2] * top + t[:3, 3]))
     homography = scene.K @ plane_to_camera @ to_table
     warped = cv2.warpPerspective(
-        mask, homography, (int(size[0]), int(size[1])),
+        mask,
+        homography,
+        (int(size[0]), int(size[1])),
         flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
-    )  # fmt: skip
+    )
     image = np.where(warped > 127, 255, 0).astype(np.uint8)
     contours, hierarchy = cv2.findContours(image, cv2.RETR_CCOMP, cv2.CHAIN_APPROX_SIMPLE)
     if not contours:

@@ -146,12 +146,20 @@ def _global_hypothesis(
     cloud.normals = o3d.utility.Vector3dVector(cluster.normals)
     reg = o3d.pipelines.registration
     result = reg.registration_ransac_based_on_feature_matching(
-        model.down, cloud, model.features, fpfh(cloud, voxel), True, 2.0 * voxel,
-        reg.TransformationEstimationPointToPoint(False), 3,
-        [reg.CorrespondenceCheckerBasedOnEdgeLength(0.9),
-         reg.CorrespondenceCheckerBasedOnDistance(2.0 * voxel)],
+        model.down,
+        cloud,
+        model.features,
+        fpfh(cloud, voxel),
+        True,
+        2.0 * voxel,
+        reg.TransformationEstimationPointToPoint(False),
+        3,
+        [
+            reg.CorrespondenceCheckerBasedOnEdgeLength(0.9),
+            reg.CorrespondenceCheckerBasedOnDistance(2.0 * voxel),
+        ],
         reg.RANSACConvergenceCriteria(20000, 0.99),
-    )  # fmt: skip
+    )
     if result.fitness <= 0.0:
         return None
     t = np.asarray(result.transformation)
@@ -159,9 +167,12 @@ def _global_hypothesis(
 
 
 def _score(
-    scene: SceneCloud, cluster: Cluster, model: ModelCloud, hyp: tuple[float, float, float],
+    scene: SceneCloud,
+    cluster: Cluster,
+    model: ModelCloud,
+    hyp: tuple[float, float, float],
     config: RecognitionConfig,
-) -> Fit:  # fmt: skip
+) -> Fit:
     x, y, yaw = hyp
     _, dist2 = model.nearest(_to_model(cluster.points, x, y, yaw))
     inliers = dist2 < config.inlier_distance**2
@@ -189,9 +200,12 @@ def fit_model(
 
 
 def _refine_best(
-    scene: SceneCloud, cluster: Cluster, model: ModelCloud,
-    hypotheses: list[tuple[float, float, float]], config: RecognitionConfig,
-) -> Fit:  # fmt: skip
+    scene: SceneCloud,
+    cluster: Cluster,
+    model: ModelCloud,
+    hypotheses: list[tuple[float, float, float]],
+    config: RecognitionConfig,
+) -> Fit:
     rotate = model.spec.symmetry.kind != "continuous"
     best: Fit | None = None
     for hyp in hypotheses:

@@ -106,19 +106,28 @@ class CollisionWorld:
             raise PredicateError(f"no object model {name!r}: {exc}") from exc
         c, client = spec.collision, self._client
         if c.kind == "cylinder":
-            return int(p.createCollisionShape(
-                p.GEOM_CYLINDER, radius=c.radius, height=c.height,
-                collisionFramePosition=(0.0, 0.0, c.height / 2), physicsClientId=client,
-            ))  # fmt: skip
+            return int(
+                p.createCollisionShape(
+                    p.GEOM_CYLINDER,
+                    radius=c.radius,
+                    height=c.height,
+                    collisionFramePosition=(0.0, 0.0, c.height / 2),
+                    physicsClientId=client,
+                )
+            )
         if c.kind in ("box", "compound"):
-            return int(p.createCollisionShapeArray(
-                [p.GEOM_BOX] * len(c.boxes),
-                halfExtents=[[s / 2 for s in b.size] for b in c.boxes],
-                collisionFramePositions=[list(b.position) for b in c.boxes],
-                physicsClientId=client,
-            ))  # fmt: skip
+            return int(
+                p.createCollisionShapeArray(
+                    [p.GEOM_BOX] * len(c.boxes),
+                    halfExtents=[[s / 2 for s in b.size] for b in c.boxes],
+                    collisionFramePositions=[list(b.position) for b in c.boxes],
+                    physicsClientId=client,
+                )
+            )
         if c.kind == "convex_hull":
-            return int(p.createCollisionShape(
-                p.GEOM_MESH, fileName=str(spec.mesh_file), physicsClientId=client
-            ))  # fmt: skip
+            return int(
+                p.createCollisionShape(
+                    p.GEOM_MESH, fileName=str(spec.mesh_file), physicsClientId=client
+                )
+            )
         raise PredicateError(f"object model {name!r} has an unknown collision type {c.kind!r}")

@@ -64,8 +64,10 @@ def _object_port(name: str, doc: str) -> PortSpec:
     return PortSpec(name, (ParamType.OBJECT,), doc=doc)
 
 
-_PAIR = (_object_port("object_a", "the object the predicate is about"),
-         _object_port("object_b", "the object it is compared with"))  # fmt: skip
+_PAIR = (
+    _object_port("object_a", "the object the predicate is about"),
+    _object_port("object_b", "the object it is compared with"),
+)
 _ONE = _object_port("object", "the object")
 _FRAME = PortSpec(
     "frame",
@@ -74,16 +76,27 @@ _FRAME = PortSpec(
     choices=FRAMES,
     doc="directions along the world's, the robot base's or object_b's axes",
 )
-_MARGIN = PortSpec("margin", (ParamType.NUMBER,), default=0.01, unit="m",
-                   doc="by more than this (a tie under sensor noise is neither)")  # fmt: skip
+_MARGIN = PortSpec(
+    "margin",
+    (ParamType.NUMBER,),
+    default=0.01,
+    unit="m",
+    doc="by more than this (a tie under sensor noise is neither)",
+)
 
 RELATIONS = {
-    relation: manifest(CAP, relation, CONDITION,
-                       f"True when object_a is {relation.replace('_', ' ')} object_b (centres, "
-                       "along the frame's axes: front +x, left +y, up +z).",
-                       *_PAIR, _FRAME, _MARGIN)
+    relation: manifest(
+        CAP,
+        relation,
+        CONDITION,
+        f"True when object_a is {relation.replace('_', ' ')} object_b (centres, "
+        "along the frame's axes: front +x, left +y, up +z).",
+        *_PAIR,
+        _FRAME,
+        _MARGIN,
+    )
     for relation in DIRECTIONS
-}  # fmt: skip
+}
 
 
 class Relation:
@@ -146,9 +159,16 @@ IS_MOVING = manifest(
     _WINDOW,
     _SPEED,
 )
-IS_STATIONARY = manifest(CAP, "is_stationary", CONDITION,
-                         "True when the object's detections stayed (slower than the speed); "
-                         "false when too few were seen.", _ONE, _WINDOW, _SPEED)  # fmt: skip
+IS_STATIONARY = manifest(
+    CAP,
+    "is_stationary",
+    CONDITION,
+    "True when the object's detections stayed (slower than the speed); "
+    "false when too few were seen.",
+    _ONE,
+    _WINDOW,
+    _SPEED,
+)
 
 
 class Moving:
@@ -167,11 +187,15 @@ class Moving:
         threshold: float = call.input("speed")
         motion = state.track(name).motion(call.clock() - window)
         if motion.samples < 2 or motion.span < window / 4:
-            return _verdict(False, f"{name}: {motion.samples} detection(s) in the last "
-                                   f"{window:g} s, too few to tell")  # fmt: skip
+            return _verdict(
+                False,
+                f"{name}: {motion.samples} detection(s) in the last {window:g} s, too few to tell",
+            )
         moving = motion.speed > threshold
-        text = (f"{name} moves at {motion.speed * 1000:.0f} mm/s over {motion.samples} "
-                f"detections in {motion.span:.2f} s (threshold {threshold * 1000:.0f} mm/s)")  # fmt: skip
+        text = (
+            f"{name} moves at {motion.speed * 1000:.0f} mm/s over {motion.samples} "
+            f"detections in {motion.span:.2f} s (threshold {threshold * 1000:.0f} mm/s)"
+        )
         return _verdict(moving == self._want, text)
 
 
@@ -213,9 +237,14 @@ TOOL_TOUCHING = manifest(
     _ONE,
     _TOLERANCE,
 )
-TOOL_NEAR_COLLISION = manifest(CAP, "tool_near_collision", CONDITION,
-                               "True when the tool is closer to the object than the distance "
-                               "(touching included).", _ONE, _DISTANCE)  # fmt: skip
+TOOL_NEAR_COLLISION = manifest(
+    CAP,
+    "tool_near_collision",
+    CONDITION,
+    "True when the tool is closer to the object than the distance (touching included).",
+    _ONE,
+    _DISTANCE,
+)
 
 
 class Contact:
@@ -244,8 +273,9 @@ class Contact:
         gap = state.collision().distance(first, second)
         gap_text = "over 1 m" if math.isinf(gap) else f"{gap * 1000:.1f} mm"
         word = "touching" if self._port == "tolerance" else "near collision"
-        return _verdict(gap <= limit, f"{label}: {gap_text} apart "
-                                      f"({word} at {limit * 1000:.1f} mm or less)")  # fmt: skip
+        return _verdict(
+            gap <= limit, f"{label}: {gap_text} apart ({word} at {limit * 1000:.1f} mm or less)"
+        )
 
 
 def setup(env: CapabilityEnv) -> PredicatesState:

@@ -13,7 +13,7 @@ SETTINGS = (
     Setting("tool_size", tuple, (0.06, 0.12, 0.16), "full size (m) of the tool's box (the gripper)", 3),
     Setting("tool_center", tuple, (0.0, 0.0, -0.065), "the tool box's centre (m) in the TCP frame", 3),
     Setting("history", float, 10.0, "seconds of detections kept per object"),
-)  # fmt: skip
+)  # fmt: skip  # a table: one setting a row
 
 # relation -> (axis, sign)
 DIRECTIONS: dict[str, tuple[int, float]] = {

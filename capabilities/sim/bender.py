@@ -163,8 +163,9 @@ class WireBender(ScheduledActor[PlannedPart, BenderEvent]):
 
     @staticmethod
     def _event(now: float, kind: str, planned: PlannedPart, pose: Pose | None) -> BenderEvent:
-        return BenderEvent(now, kind, planned.name, planned.shape, planned.bad_weld,
-                           planned.bad_grasp, pose)  # fmt: skip
+        return BenderEvent(
+            now, kind, planned.name, planned.shape, planned.bad_weld, planned.bad_grasp, pose
+        )
 
     def _each_step(self, elapsed: float, now: float) -> None:
         self._move_arm(elapsed)
@@ -278,10 +279,13 @@ def _machine(model: ObjectModelSpec) -> _Machine:
     try:
         arm, exit_ = r.child("welding_arm", optional=False), r.child("exit", optional=False)
         return _Machine(
-            arm.text("model", nonempty=True), arm.vector3("pivot"), arm.number("rest_pitch"),
-            arm.number("release_pitch"), exit_.vector2("position"),
+            arm.text("model", nonempty=True),
+            arm.vector3("pivot"),
+            arm.number("rest_pitch"),
+            arm.number("release_pitch"),
+            exit_.vector2("position"),
             exit_.number("drop_height", 0.03, lo=0.0, hi=0.5),
-        )  # fmt: skip
+        )
     except JsonFileError as exc:
         raise SceneError(f"model {model.name!r} is no wire bender: {exc}") from exc
 
@@ -305,19 +309,25 @@ def _spawn_piece(client: int, model: ObjectModelSpec, boxes: list[int], frame: P
     half = [[s / 2 for s in b.size] for b in parts]
     where = [list(b.position) for b in parts]
     col = p.createCollisionShapeArray(
-        shapeTypes=[p.GEOM_BOX] * len(parts), halfExtents=half,
-        collisionFramePositions=where, physicsClientId=client,
-    )  # fmt: skip
+        shapeTypes=[p.GEOM_BOX] * len(parts),
+        halfExtents=half,
+        collisionFramePositions=where,
+        physicsClientId=client,
+    )
     vis = p.createVisualShapeArray(
-        shapeTypes=[p.GEOM_BOX] * len(parts), halfExtents=half, visualFramePositions=where,
-        rgbaColors=[list(model.color)] * len(parts), physicsClientId=client,
-    )  # fmt: skip
+        shapeTypes=[p.GEOM_BOX] * len(parts),
+        halfExtents=half,
+        visualFramePositions=where,
+        rgbaColors=[list(model.color)] * len(parts),
+        physicsClientId=client,
+    )
     volumes = [b.size[0] * b.size[1] * b.size[2] for b in parts]
     total = sum(b.size[0] * b.size[1] * b.size[2] for b in model.collision.boxes)
     # Its centre of mass is the middle of its own wire, not the part's frame: with the mass
     # at the frame (off an L-shaped piece) the piece toppled onto its edge into the surface.
-    centroid = [sum(v * w[i] for v, w in zip(volumes, where, strict=True)) / sum(volumes)
-                for i in range(3)]  # fmt: skip
+    centroid = [
+        sum(v * w[i] for v, w in zip(volumes, where, strict=True)) / sum(volumes) for i in range(3)
+    ]
     return int(
         p.createMultiBody(
             baseMass=model.mass * sum(volumes) / total,
@@ -332,9 +342,13 @@ def _spawn_piece(client: int, model: ObjectModelSpec, boxes: list[int], frame: P
 
 
 def install_scene_bender(
-    cell: Any, scene: SceneState, path: Path | str, seed: int | None,
-    faults: FaultModel | None = None, start: bool = True,
-) -> WireBender | None:  # fmt: skip
+    cell: Any,
+    scene: SceneState,
+    path: Path | str,
+    seed: int | None,
+    faults: FaultModel | None = None,
+    start: bool = True,
+) -> WireBender | None:
     """Make (and with ``start`` start) the bender of a scene file; None when it has none."""
     spec = read_bender(path)
     if spec is None:

@@ -129,8 +129,18 @@ def _spec(r: JsonReader) -> BenderSpec:
     )
 
 
-_FIELDS = ("fixture", "parts", "shapes", "first_at", "interval", "swing", "hold", "spread",
-           "faults", "lift")  # fmt: skip
+_FIELDS = (
+    "fixture",
+    "parts",
+    "shapes",
+    "first_at",
+    "interval",
+    "swing",
+    "hold",
+    "spread",
+    "faults",
+    "lift",
+)
 
 
 def parse_bender(data: Any, source: str = "<scene>") -> BenderSpec | None:
@@ -178,9 +188,9 @@ def plan_parts(
         shape = spec.shapes[int(rng.integers(len(spec.shapes)))]
         bad_weld = bool(rng.random() < rates.bad_weld)
         bad_grasp = bool(rng.random() < rates.bad_grasp)
-        shift = tuple(float(rng.uniform(-s, s)) for s in spec.spread)
+        sx, sy, syaw = (float(rng.uniform(-s, s)) for s in spec.spread)
         parts.append(
-            PlannedPart(at, f"part_{index + 1:03d}", shape, bad_weld, bad_grasp, shift)  # type: ignore[arg-type]  # three values
+            PlannedPart(at, f"part_{index + 1:03d}", shape, bad_weld, bad_grasp, (sx, sy, syaw))
         )
         at += float(rng.uniform(lo, hi))
     return parts

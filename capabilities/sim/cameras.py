@@ -135,9 +135,11 @@ class SimCamera:
         if isinstance(self.mount, FixedMount):
             return self.mount.T_world_camera
         state = p.getLinkState(
-            self.mount.body_id, self.mount.link_index, computeForwardKinematics=True,
+            self.mount.body_id,
+            self.mount.link_index,
+            computeForwardKinematics=True,
             physicsClientId=client,
-        )  # fmt: skip
+        )
         return Pose(state[4], state[5]).compose(self.mount.T_link_camera)
 
     def capture(
@@ -155,11 +157,16 @@ class SimCamera:
         pose = self.pose(client)
         view = np.linalg.inv(pose_to_matrix(pose) @ _CV_TO_GL)
         _, _, rgba, buffer, _ = p.getCameraImage(
-            c.width, c.height, viewMatrix=view.T.ravel().tolist(),
-            projectionMatrix=self._projection, renderer=p.ER_TINY_RENDERER,
-            lightDirection=list(c.light_direction), shadow=int(c.shadows),
-            flags=p.ER_NO_SEGMENTATION_MASK, physicsClientId=client,
-        )  # fmt: skip
+            c.width,
+            c.height,
+            viewMatrix=view.T.ravel().tolist(),
+            projectionMatrix=self._projection,
+            renderer=p.ER_TINY_RENDERER,
+            lightDirection=list(c.light_direction),
+            shadow=int(c.shadows),
+            flags=p.ER_NO_SEGMENTATION_MASK,
+            physicsClientId=client,
+        )
         rgb = np.asarray(rgba, dtype=np.uint8).reshape(c.height, c.width, 4)[:, :, :3]
         d = np.asarray(buffer, dtype=np.float64).reshape(c.height, c.width)
         depth = c.far * c.near / (c.far - (c.far - c.near) * d)

@@ -93,15 +93,24 @@ class SimCell:
         self.robot_body_id = world.robot
         self.table_top_z = world.table_top_z
         self.robot = SimRobot(
-            self._physics, self._arm, self.kinematics, self.config.home_joints,
-            self.tcp_offset, world.robot, world.flange_link, self.config.robot.unlock_delay,
-        )  # fmt: skip
+            self._physics,
+            self._arm,
+            self.kinematics,
+            self.config.home_joints,
+            self.tcp_offset,
+            world.robot,
+            world.flange_link,
+            self.config.robot.unlock_delay,
+        )
         self.gripper = SimGripper(self._physics, self._gripper)
         self.suction = SimSuctionTool(
-            self._physics, self._suction, self._suction_in_hand,
-            self.config.holster_pose, self.config.handle_grasp,
+            self._physics,
+            self._suction,
+            self._suction_in_hand,
+            self.config.holster_pose,
+            self.config.handle_grasp,
             (self.config.tcp_offsets["gripper"], self.config.tcp_offsets["suction"]),
-        )  # fmt: skip
+        )
         self.ground_truth = GroundTruth(self._physics, world, self._gripper, self._suction)
 
     def close(self) -> None:

@@ -61,10 +61,16 @@ def shaded_colour(
         view = p.computeViewMatrix((0, 0, 1), (0, 0, 0), (0, 1, 0))
         projection = p.computeProjectionMatrixFOV(40.0, 1.0, 0.1, 3.0)
         rgba_image = p.getCameraImage(
-            _PROBE_SIZE, _PROBE_SIZE, view, projection, renderer=p.ER_TINY_RENDERER,
-            lightDirection=list(light_direction), shadow=0, flags=p.ER_NO_SEGMENTATION_MASK,
+            _PROBE_SIZE,
+            _PROBE_SIZE,
+            view,
+            projection,
+            renderer=p.ER_TINY_RENDERER,
+            lightDirection=list(light_direction),
+            shadow=0,
+            flags=p.ER_NO_SEGMENTATION_MASK,
             physicsClientId=client,
-        )[2]  # fmt: skip
+        )[2]
     finally:
         p.disconnect(client)
     centre = _PROBE_SIZE // 2
@@ -89,9 +95,14 @@ class FlatSurfaces:
         self._rays: dict[tuple[int, int, bytes], tuple[np.ndarray, np.ndarray]] = {}
 
     def draw(
-        self, rgb: np.ndarray, depth: np.ndarray, K: np.ndarray, T_world_camera: Pose,
-        near: float, far: float,
-    ) -> None:  # fmt: skip
+        self,
+        rgb: np.ndarray,
+        depth: np.ndarray,
+        K: np.ndarray,
+        T_world_camera: Pose,
+        near: float,
+        far: float,
+    ) -> None:
         """Draw every surface into ``rgb`` (HxWx3 uint8) and ``depth`` (HxW float32, metric
         depth along the optical axis, NaN where nothing was hit), in place.
 

@@ -93,9 +93,13 @@ def _serve(conn: Connection) -> None:
     client = p.connect(p.DIRECT)
     world = build_world(client, recipe.config, light=True)
     scene = load_scene(
-        client, recipe.scene, recipe.seed, table_top_z=recipe.table_top_z, make_table=False,
+        client,
+        recipe.scene,
+        recipe.seed,
+        table_top_z=recipe.table_top_z,
+        make_table=False,
         keep_out=recipe.keep_out,
-    )  # fmt: skip
+    )
     if isinstance(camera.mount, LinkMount):  # the mirror's robot body, not the cell's id
         camera = SimCamera(
             name, camera.config, dataclasses.replace(camera.mount, body_id=world.robot)
@@ -207,9 +211,12 @@ class _Mirror:
         ours, theirs = socket.socketpair()
         env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
         self.process = subprocess.Popen(
-            [sys.executable, "-m", __name__, str(theirs.fileno())], pass_fds=(theirs.fileno(),),
-            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, env=env,
-        )  # fmt: skip
+            [sys.executable, "-m", __name__, str(theirs.fileno())],
+            pass_fds=(theirs.fileno(),),
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            env=env,
+        )
         theirs.close()  # only the child holds its end: its death reads as end-of-file here
         return Connection(ours.detach())
 
@@ -304,9 +311,13 @@ class LiveView:
         (rgb, depth, true_pose, stamp), pose = mirror.render(self._snapshot, size, believed, ahead)
         config = dataclasses.replace(mirror.camera.config, width=size[0], height=size[1])
         return RGBDFrame(
-            rgb=rgb, depth=depth, K=config.intrinsics(),
-            T_world_camera=pose or true_pose, stamp=stamp, camera=name,
-        )  # fmt: skip
+            rgb=rgb,
+            depth=depth,
+            K=config.intrinsics(),
+            T_world_camera=pose or true_pose,
+            stamp=stamp,
+            camera=name,
+        )
 
     def pids(self) -> dict[str, int]:
         """Process id of each running mirror (for tests and diagnostics)."""

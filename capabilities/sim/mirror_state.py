@@ -47,7 +47,7 @@ class CellSnapshot:
 
 def _base_pose(client: int, body: int) -> BasePose:
     position, orientation = p.getBasePositionAndOrientation(body, physicsClientId=client)
-    return tuple(position), tuple(orientation)  # type: ignore[return-value]
+    return tuple(position), tuple(orientation)
 
 
 def take_snapshot(

@@ -124,9 +124,13 @@ def spawn_object(
         physicsClientId=client,
     )
     p.changeDynamics(
-        body, -1, lateralFriction=model.friction, rollingFriction=1e-4, spinningFriction=1e-3,
+        body,
+        -1,
+        lateralFriction=model.friction,
+        rollingFriction=1e-4,
+        spinningFriction=1e-3,
         physicsClientId=client,
-    )  # fmt: skip
+    )
     links = {}
     for index, marker in enumerate(markers):
         textures.apply(client, body, index, marker.marker_id)

@@ -127,9 +127,11 @@ class SceneState:
             return self.fixed_markers[marker_id].pose
         obj = self.objects[owner]
         state = p.getLinkState(
-            obj.body_id, obj.marker_links[marker_id], computeForwardKinematics=True,
+            obj.body_id,
+            obj.marker_links[marker_id],
+            computeForwardKinematics=True,
             physicsClientId=client,
-        )  # fmt: skip
+        )
         return Pose(state[4], state[5])
 
     def spawn(self, client: int, name: str, model: str, pose: Pose, fixed: bool = False) -> int:
@@ -237,6 +239,14 @@ def load_scene(
             )
     absent = tuple(n for n, v in placements.items() if v is None)
     return SceneState(
-        name=spec.name, seed=seed, table_top_z=top_z, table_body=table, objects=objects,
-        fixed_markers=markers, absent=absent, spec=spec, library=library, textures=textures,
-    )  # fmt: skip
+        name=spec.name,
+        seed=seed,
+        table_top_z=top_z,
+        table_body=table,
+        objects=objects,
+        fixed_markers=markers,
+        absent=absent,
+        spec=spec,
+        library=library,
+        textures=textures,
+    )

@@ -189,10 +189,14 @@ class SimCellSession:
             holster = self.sim.config.holster_pose.position
             self.scene: SceneState = self.sim.call(
                 lambda client: load_scene(
-                    client, path, seed, table_top_z=self.sim.table_top_z, make_table=False,
+                    client,
+                    path,
+                    seed,
+                    table_top_z=self.sim.table_top_z,
+                    make_table=False,
                     keep_out=((holster[0], holster[1], 0.12),),
                 )
-            )  # fmt: skip
+            )
             sizes = {"shoulder": shoulder_size, "wrist": wrist_size}
             self.cameras: dict[str, CameraSource] = {
                 name: self._device(name, settings, sizes.get(name))
@@ -242,9 +246,12 @@ class SimCellSession:
         """A simulated camera as the cell configuration describes it."""
         width, height = size or settings.size
         optics = CameraConfig(
-            width=width, height=height, fov_y=math.radians(settings.fov_y_deg),
-            near=settings.near, far=settings.far,
-        )  # fmt: skip
+            width=width,
+            height=height,
+            fov_y=math.radians(settings.fov_y_deg),
+            near=settings.near,
+            far=settings.far,
+        )
         if settings.on_wrist:
             mount = LinkMount(self.sim.robot_body_id, self.sim.robot.flange_link(), settings.pose)
             return SimCamera(name, optics, mount)
@@ -346,9 +353,13 @@ class SimCellSession:
             return None
         allowed = self.sim.time() - stop.time >= self.sim.robot.unlock_delay
         return CellStatus(
-            True, "RUNNING", "PROTECTIVE_STOP", "STOPPED", PROTECTIVE_STOP,
+            True,
+            "RUNNING",
+            "PROTECTIVE_STOP",
+            "STOPPED",
+            PROTECTIVE_STOP,
             "Unlock protective stop" if allowed else "",
-        )  # fmt: skip
+        )
 
     def clear(self) -> None:
         """The operator's clear from the status bar: unlock the protective stop as soon as

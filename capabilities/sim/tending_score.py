@@ -212,14 +212,21 @@ def lost_parts(
             continue
         if kept is not None:
             where = [
-                "taken away" if b in removed else _where(client, scene, _body_pose(client, b),
-                                                          event.pose)
+                "taken away"
+                if b in removed
+                else _where(client, scene, _body_pose(client, b), event.pose)
                 for b in kept
-            ]  # fmt: skip
+            ]
         elif event.part in scene.objects:
             where = [_where(client, scene, scene.truth_pose(client, event.part), event.pose)]
         else:
             where = ["taken away"]
-        out.append({"part": event.part, "released": round(event.time, 1),
-                    "fault": faults.get(event.part, ""), "where": where})  # fmt: skip
+        out.append(
+            {
+                "part": event.part,
+                "released": round(event.time, 1),
+                "fault": faults.get(event.part, ""),
+                "where": where,
+            }
+        )
     return out

@@ -124,12 +124,15 @@ def _handoff(r: JsonReader) -> HandoffSpec:
     for key in ("x", "y", "yaw"):
         ranges[key] = _range(area, key, -math.inf, (0.0, 0.0) if key == "yaw" else None)
     return HandoffSpec(
-        object=r.text("object"), model=r.text("model"), area=ranges,
-        place_at=_range(r, "place_at"), hold=_range(r, "hold"),
+        object=r.text("object"),
+        model=r.text("model"),
+        area=ranges,
+        place_at=_range(r, "place_at"),
+        hold=_range(r, "hold"),
         cycles=r.integer("cycles", 1, lo=1),
         gap=_range(r, "gap", default=(2.0, 4.0)),
         drop_height=r.number("drop_height", 0.01, lo=0.0, hi=0.5),
-    )  # fmt: skip
+    )
 
 
 def _nudge(r: JsonReader) -> NudgeSpec:

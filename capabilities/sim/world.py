@@ -95,9 +95,13 @@ def _table_sides(client: int, config: CellConfig) -> int:
         normals += [((by - ay) / length, (ax - bx) / length, 0.0)] * 4
         indices += [k, k + 1, k + 2, k, k + 2, k + 3]
     visual = pybullet.createVisualShape(
-        pybullet.GEOM_MESH, vertices=vertices, indices=indices, normals=normals,
-        rgbaColor=_TABLE_RGBA, physicsClientId=client,
-    )  # fmt: skip
+        pybullet.GEOM_MESH,
+        vertices=vertices,
+        indices=indices,
+        normals=normals,
+        rgbaColor=_TABLE_RGBA,
+        physicsClientId=client,
+    )
     return int(pybullet.createMultiBody(0.0, -1, visual, physicsClientId=client))
 
 

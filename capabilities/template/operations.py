@@ -44,11 +44,18 @@ def setup(env: CapabilityEnv) -> LampState:
 
 
 LAMP_IS_LIT = manifest(
-    CAP, "lamp_is_lit", OperationKind.CONDITION,
+    CAP,
+    "lamp_is_lit",
+    OperationKind.CONDITION,
     "True when the stack light shows the given colour.",
-    PortSpec("colour", (ParamType.TEXT,), default="green", doc="which light",
-             choices=("green", "amber", "red")),
-)  # fmt: skip
+    PortSpec(
+        "colour",
+        (ParamType.TEXT,),
+        default="green",
+        doc="which light",
+        choices=("green", "amber", "red"),
+    ),
+)
 
 
 class LampIsLit:
@@ -63,7 +70,8 @@ class LampIsLit:
 
 def capability() -> Capability:
     """The template capability (requires the ``lamp`` interface)."""
-    cap = Capability(CAP, "An example to copy.", requires=(INTERFACE,), settings=SETTINGS,
-                     setup=setup)  # fmt: skip
+    cap = Capability(
+        CAP, "An example to copy.", requires=(INTERFACE,), settings=SETTINGS, setup=setup
+    )
     cap.add(LAMP_IS_LIT, lambda env: LampIsLit(env.state))
     return cap

@@ -20,12 +20,24 @@ __all__ = ["WAIT_UNTIL", "capability"]
 CAP = "timing"
 
 WAIT_UNTIL = manifest(
-    CAP, "wait_until", OperationKind.ACTION,
+    CAP,
+    "wait_until",
+    OperationKind.ACTION,
     "Checks a condition every tick; succeeds when it holds, fails when the time is up.",
-    PortSpec("condition", (ParamType.TEXT,), names_kind=OperationKind.CONDITION,
-             doc="id of a condition operation (e.g. gripper.is_holding); its inputs take their defaults"),
-    PortSpec("timeout", (ParamType.DURATION, ParamType.NUMBER), default=10.0, unit="s", doc="how long to wait"),
-)  # fmt: skip
+    PortSpec(
+        "condition",
+        (ParamType.TEXT,),
+        names_kind=OperationKind.CONDITION,
+        doc="id of a condition operation (e.g. gripper.is_holding); its inputs take their defaults",
+    ),
+    PortSpec(
+        "timeout",
+        (ParamType.DURATION, ParamType.NUMBER),
+        default=10.0,
+        unit="s",
+        doc="how long to wait",
+    ),
+)
 
 
 class WaitUntil:

@@ -68,9 +68,14 @@ class ConditionRunner:
         self.op_id = op_id
         self._operation: Operation = source.create(op_id)
         self._call = OperationCall(
-            parent.node_id, f"{parent.node_name} ({op_id})", {}, _no_write,
-            lambda _node, message: parent.log(message), parent.wake, parent.clock,
-        )  # fmt: skip
+            parent.node_id,
+            f"{parent.node_name} ({op_id})",
+            {},
+            _no_write,
+            lambda _node, message: parent.log(message),
+            parent.wake,
+            parent.clock,
+        )
         self._call.args = {p.name: typed_input(p, p.default) for p in manifest.inputs}
         self._job: Job | None = None
 

@@ -117,16 +117,22 @@ class URArm:
         if len(target) != 6 or not all(math.isfinite(v) for v in target):
             return CommandHandle.failed("move_joints", f"moveJ needs 6 finite joints, got {target}")
         return self._move(
-            "move_joints", lambda c: c.moveJ(target, speed, accel, True), "stopJ",
-            lambda s: max(abs(a - b) for a, b in zip(s.q, target, strict=False)) <= _JOINT_TOLERANCE,
-        )  # fmt: skip
+            "move_joints",
+            lambda c: c.moveJ(target, speed, accel, True),
+            "stopJ",
+            lambda s: (
+                max(abs(a - b) for a, b in zip(s.q, target, strict=False)) <= _JOINT_TOLERANCE
+            ),
+        )
 
     def move_linear(self, pose: Pose, speed: float = 0.25, accel: float = 1.2) -> CommandHandle:
         target = self.frames.to_ur(pose)
         return self._move(
-            "move_linear", lambda c: c.moveL(target, speed, accel, True), "stopL",
+            "move_linear",
+            lambda c: c.moveL(target, speed, accel, True),
+            "stopL",
             lambda s: math.dist(s.tcp[:3], target[:3]) <= _POSITION_TOLERANCE,
-        )  # fmt: skip
+        )
 
     def move_pose_joint_space(
         self, pose: Pose, speed: float = 1.05, accel: float = 1.4
@@ -250,9 +256,11 @@ class URArm:
             else:
                 ok = control.endFreedriveMode() if new else control.endTeachMode()
             if not ok:
-                verb = ("freedriveMode" if on else "endFreedriveMode") if new else (
-                    "teachMode" if on else "endTeachMode"
-                )  # fmt: skip
+                verb = (
+                    ("freedriveMode" if on else "endFreedriveMode")
+                    if new
+                    else ("teachMode" if on else "endTeachMode")
+                )
                 raise URError(f"freedrive: {verb} refused: {fault_reason(self._conn.state)}")
             self._freedrive = on
 
@@ -283,9 +291,12 @@ class _Monitor:
     """Watches one asynchronous move on the I/O thread."""
 
     def __init__(
-        self, handle: CommandHandle, op_before: int, stop_name: str,
+        self,
+        handle: CommandHandle,
+        op_before: int,
+        stop_name: str,
         arrived: Callable[[URState], bool],
-    ) -> None:  # fmt: skip
+    ) -> None:
         self.handle = handle
         self.op_before = op_before
         self.stop_name = stop_name

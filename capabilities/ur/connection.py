@@ -88,9 +88,11 @@ def fault_reason(state: URState) -> str:
         return f"safety stop ({safety.name})"
     if state.robot_mode < RobotMode.RUNNING:
         mode = RobotMode(state.robot_mode).name
-        return "the arm is powered off" if state.robot_mode <= RobotMode.POWER_OFF else (
-            f"the arm is not running (robot mode {mode})"
-        )  # fmt: skip
+        return (
+            "the arm is powered off"
+            if state.robot_mode <= RobotMode.POWER_OFF
+            else (f"the arm is not running (robot mode {mode})")
+        )
     if not state.program_running:
         return NO_SCRIPT
     return ""

@@ -39,9 +39,12 @@ class RobotiqGripper:
     """
 
     def __init__(
-        self, connection: URConnection, port: int = ROBOTIQ_PORT, speed: int = 255,
+        self,
+        connection: URConnection,
+        port: int = ROBOTIQ_PORT,
+        speed: int = 255,
         force: int = 150,
-    ) -> None:  # fmt: skip
+    ) -> None:
         self._conn = connection
         self._port = port
         self._speed, self._force = speed, force

@@ -43,19 +43,30 @@ def run_command(emulator: UREmulator, line: str) -> dict[str, Any]:
             emulator.protective_stop(at=float(args[0][3:]))
         else:
             emulator.protective_stop()
-    elif name in ("emergency_stop", "release_emergency_stop", "power_off", "kill_script",
-                  "disconnect"):  # fmt: skip
+    elif name in (
+        "emergency_stop",
+        "release_emergency_stop",
+        "power_off",
+        "kill_script",
+        "disconnect",
+    ):
         getattr(emulator, name)()
     elif name == "state":
         snap = ctl.snapshot()
         return {
-            "ok": True, "robot_mode": snap["robot_mode"], "safety_mode": snap["safety_mode"],
-            "program_running": ctl.program_running(), "q": list(snap["actual_q"]),
-            "digital_outputs": ctl.digital_outputs(), "freedrive": ctl.freedrive_on,
-            "speed_fraction": ctl.speed_fraction, "sim_time": emulator.cell.time(),
+            "ok": True,
+            "robot_mode": snap["robot_mode"],
+            "safety_mode": snap["safety_mode"],
+            "program_running": ctl.program_running(),
+            "q": list(snap["actual_q"]),
+            "digital_outputs": ctl.digital_outputs(),
+            "freedrive": ctl.freedrive_on,
+            "speed_fraction": ctl.speed_fraction,
+            "sim_time": emulator.cell.time(),
             "gripper_closed": emulator.cell.gripper.is_closed(),
-            "moving": ctl.arm_moving(), "messages": ctl.messages[-5:],
-        }  # fmt: skip
+            "moving": ctl.arm_moving(),
+            "messages": ctl.messages[-5:],
+        }
     elif name == "input":  # input BANK INDEX 0|1: a digital input (a foot pedal)
         shift = {"standard": 0, "configurable": 8, "tool": 16}[args[0]]
         ctl.set_digital_input(shift + int(args[1]), args[2] == "1")
@@ -136,9 +147,13 @@ def _emulator(args: argparse.Namespace, stack: contextlib.ExitStack) -> UREmulat
     check_loopback(args.host)  # refuse a bad host before building a scene
     session = stack.enter_context(SimCellSession(args.scene, args.seed, args.speed))
     return UREmulator(
-        args.host, args.version, cell=session.sim, unlock_delay=args.unlock_delay,
-        cameras=session.cameras, truth=session.truth_pose,
-    )  # fmt: skip
+        args.host,
+        args.version,
+        cell=session.sim,
+        unlock_delay=args.unlock_delay,
+        cameras=session.cameras,
+        truth=session.truth_pose,
+    )
 
 
 def main(argv: list[str] | None = None, prog: str = "python -m capabilities.ur_emulator") -> int:
@@ -153,26 +168,34 @@ def main(argv: list[str] | None = None, prog: str = "python -m capabilities.ur_e
         "--speed", type=float, default=1.0, help="real-time factor of the simulation (1.0)"
     )
     parser.add_argument(
-        "--unlock-delay", type=float, default=5.0,
+        "--unlock-delay",
+        type=float,
+        default=5.0,
         help="seconds before a protective stop can be unlocked (default 5, as on a UR)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--protective-stop-at", type=float, default=None, metavar="SECONDS",
+        "--protective-stop-at",
+        type=float,
+        default=None,
+        metavar="SECONDS",
         help="inject a protective stop at this simulated time",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--protective-stop-on-contact", action="store_true",
+        "--protective-stop-on-contact",
+        action="store_true",
         help="a protective stop when the arm touches something",
-    )  # fmt: skip
+    )
     parser.add_argument("--scene", help="a scene of the simulated cell around the arm")
     parser.add_argument("--seed", type=int, default=0, help="scene seed (default 0)")
     parser.add_argument(
         "--write-cell", metavar="FILE", help="write a cell file whose robot is this emulator"
     )
     parser.add_argument(
-        "--control", choices=("none", "stdin"), default="none",
+        "--control",
+        choices=("none", "stdin"),
+        default="none",
         help="stdin: read fault commands from standard input (for tests)",
-    )  # fmt: skip
+    )
     args = parser.parse_args(argv)
     done = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: done.set())
@@ -181,9 +204,12 @@ def main(argv: list[str] | None = None, prog: str = "python -m capabilities.ur_e
             emulator = stack.enter_context(_emulator(args, stack))
             if args.write_cell:
                 write_cell_file(
-                    args.write_cell, args.host, args.version, emulator.cell.config,
+                    args.write_cell,
+                    args.host,
+                    args.version,
+                    emulator.cell.config,
                     cameras=args.scene is not None,
-                )  # fmt: skip
+                )
             _serve(emulator, args, done)
     except EmulatorError as exc:
         print(f"error: {exc}", file=sys.stderr, flush=True)

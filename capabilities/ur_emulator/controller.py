@@ -41,10 +41,16 @@ VERSIONS: dict[str, tuple[int, int, int, int]] = {
 }
 _ZEROS6 = (0.0,) * 6
 _SAFETY_BIT = {
-    SafetyMode.NORMAL: 0, SafetyMode.REDUCED: 1, SafetyMode.PROTECTIVE_STOP: 2,
-    SafetyMode.RECOVERY: 3, SafetyMode.SAFEGUARD_STOP: 4, SafetyMode.SYSTEM_EMERGENCY_STOP: 5,
-    SafetyMode.ROBOT_EMERGENCY_STOP: 6, SafetyMode.VIOLATION: 8, SafetyMode.FAULT: 9,
-}  # fmt: skip
+    SafetyMode.NORMAL: 0,
+    SafetyMode.REDUCED: 1,
+    SafetyMode.PROTECTIVE_STOP: 2,
+    SafetyMode.RECOVERY: 3,
+    SafetyMode.SAFEGUARD_STOP: 4,
+    SafetyMode.SYSTEM_EMERGENCY_STOP: 5,
+    SafetyMode.ROBOT_EMERGENCY_STOP: 6,
+    SafetyMode.VIOLATION: 8,
+    SafetyMode.FAULT: 9,
+}
 _EMERGENCY = (SafetyMode.ROBOT_EMERGENCY_STOP, SafetyMode.SYSTEM_EMERGENCY_STOP)
 
 
@@ -154,19 +160,25 @@ class EmulatedController:
             safety_bits |= 1 << 10
         values: dict[str, Any] = {
             "timestamp": time.monotonic() - self._started,
-            "actual_q": q, "target_q": q, "actual_qd": qd, "target_qd": qd,
-            "actual_TCP_pose": tuple(tcp), "target_TCP_pose": tuple(tcp),
-            "robot_mode": int(self.robot_mode), "safety_mode": int(self.safety_mode),
+            "actual_q": q,
+            "target_q": q,
+            "actual_qd": qd,
+            "target_qd": qd,
+            "actual_TCP_pose": tuple(tcp),
+            "target_TCP_pose": tuple(tcp),
+            "robot_mode": int(self.robot_mode),
+            "safety_mode": int(self.safety_mode),
             "safety_status": int(self.safety_mode),
             "runtime_state": int(RuntimeState.PLAYING if running else RuntimeState.STOPPED),
-            "robot_status_bits": status, "safety_status_bits": safety_bits,
+            "robot_status_bits": status,
+            "safety_status_bits": safety_bits,
             "speed_scaling": 1.0 if running else 0.0,
             "target_speed_fraction": self.speed_fraction,
             "actual_digital_output_bits": self._digital_out,
             "actual_digital_input_bits": self._digital_in,
             "joint_mode": (253 if arm_on else 236,) * 6,
             "actual_main_voltage": 48.0 if arm_on else 0.0,
-        }  # fmt: skip
+        }
         for i, value in enumerate(self._out_int):
             values[f"output_int_register_{i}"] = value
         for i, fvalue in enumerate(self._out_double):
@@ -240,9 +252,9 @@ class EmulatedController:
     def set_digital_input(self, bit: int, level: bool) -> None:
         """Set one digital input (bit 0-7 standard, 8-15 configurable, 16-17 tool)."""
         with self._lock:
-            self._digital_in = (self._digital_in | (1 << bit)) if level else (
-                self._digital_in & ~(1 << bit)
-            )  # fmt: skip
+            self._digital_in = (
+                (self._digital_in | (1 << bit)) if level else (self._digital_in & ~(1 << bit))
+            )
 
     def press_teach_button(self, down: bool) -> None:
         """The pendant's teach button: held down, the arm is in freedrive, as on a UR."""

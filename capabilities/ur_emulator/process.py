@@ -56,7 +56,7 @@ class EmulatorProcess:
             sys.executable, "-m", "capabilities.ur_emulator", "--host", host,
             "--version", version, "--speed", str(speed), "--unlock-delay", str(unlock_delay),
             "--control", "stdin",
-        ]  # fmt: skip
+        ]  # fmt: skip  # a command line: each flag beside its value
         if scene is not None:
             self._args += ["--scene", scene, "--seed", str(seed)]
         if write_cell is not None:
@@ -69,9 +69,14 @@ class EmulatorProcess:
         env = dict(os.environ)
         env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(_ROOT), env.get("PYTHONPATH")]))
         self._proc = subprocess.Popen(
-            self._args, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-            text=True, cwd=str(_ROOT), env=env,
-        )  # fmt: skip
+            self._args,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            cwd=str(_ROOT),
+            env=env,
+        )
         first = self._read_line()
         if not first.get("ok"):
             self.kill()

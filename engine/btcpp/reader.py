@@ -54,15 +54,30 @@ class _Reader(ReaderBase):
         for child in root.children:
             groups.setdefault(child.tag, []).append(child)
         self.lines.root = root.line
-        for extra in groups.get("TreeNodesModel", [])[1:]:
-            self.problem(extra.line, "one <TreeNodesModel>", "a second one")
-        self.models = read_models(next(iter(groups.get("TreeNodesModel", [])), None), self.problem)
-        for extra in groups.get("CostarPlan", [])[1:]:
-            self.problem(extra.line, "one <CostarPlan>", "a second one")
-        data = next(iter(groups.get("CostarPlan", [])), None)
+        self.models = read_models(self._the_one(groups, "TreeNodesModel"), self.problem)
+        data = self._the_one(groups, "CostarPlan")
         self.foreign = data is None
+        trees = self._trees(groups.get("BehaviorTree", []))
+        main_id = self._main_id(root, data, trees)
+        plan = PlanSpec(name=main_id or "")
+        self._read_subtrees(trees, main_id)
+        if main_id is not None:
+            plan.tree = self._root_node(trees[main_id], plan.layout)
+        plan.subtrees = list(self.subtrees.values())
+        if data is not None:
+            self._plan_data(data, plan)
+        return plan
+
+    def _the_one(self, groups: dict[str, list[Element]], tag: str) -> Element | None:
+        """The first ``tag`` element under the root; a second one is a problem."""
+        for extra in groups.get(tag, [])[1:]:
+            self.problem(extra.line, f"one <{tag}>", "a second one")
+        return next(iter(groups.get(tag, [])), None)
+
+    def _trees(self, elements: list[Element]) -> dict[str, Element]:
+        """The BehaviorTree elements by ID (the first of each ID)."""
         trees: dict[str, Element] = {}
-        for index, tree in enumerate(groups.get("BehaviorTree", [])):
+        for index, tree in enumerate(elements):
             tree_id = tree.attrs.get("ID", f"BehaviorTree_{index}")
             if tree_id in trees and not self.foreign:
                 # BehaviorTree.CPP writes a loaded tree with one BehaviorTree per instance;
@@ -71,8 +86,11 @@ class _Reader(ReaderBase):
                     tree.line, "a BehaviorTree ID no other BehaviorTree has", repr(tree_id)
                 )
             trees.setdefault(tree_id, tree)
-        main_id = self._main_id(root, data, trees)
-        plan = PlanSpec(name=main_id or "")
+        return trees
+
+    def _read_subtrees(self, trees: dict[str, Element], main_id: str | None) -> None:
+        """Every tree but the main one into ``self.subtrees``: first their definitions and
+        ports, then their nodes (an instance is read once all trees are known)."""
         for tree_id, element in trees.items():
             if tree_id != main_id:
                 self.subtrees[tree_id] = sub = self._subtree(tree_id, element)
@@ -82,16 +100,10 @@ class _Reader(ReaderBase):
                     sub.inputs, sub.outputs = infer_subtree_ports(
                         element, instances, self._port_info
                     )
-        for tree_id, element in trees.items():  # instances are read once all trees are known
+        for tree_id, element in trees.items():
             if tree_id != main_id:
                 sub = self.subtrees[tree_id]
                 sub.tree = self._root_node(element, sub.layout) or sub.tree
-        if main_id is not None:
-            plan.tree = self._root_node(trees[main_id], plan.layout)
-        plan.subtrees = list(self.subtrees.values())
-        if data is not None:
-            self._plan_data(data, plan)
-        return plan
 
     def _check_subtree_ref(self, sub: SubtreeSpec, element: Element) -> None:
         """A plan holds each subtree version once (its file reader refuses a second)."""

@@ -391,10 +391,14 @@ class TreeNodeItem(NodeItem):
         look = self.look
         selected = self.isSelected()
         overview.paint(
-            painter, self._title(), QRectF(0.0, 0.0, self._width, self._height), scale,
-            _SELECTED if selected else fill, _WHITE if selected else _TEXT,
+            painter,
+            self._title(),
+            QRectF(0.0, 0.0, self._width, self._height),
+            scale,
+            _SELECTED if selected else fill,
+            _WHITE if selected else _TEXT,
             _BROKEN if look is not None and look.broken else None,
-        )  # fmt: skip
+        )
 
     def _paint_text(self, painter: QPainter, look: NodeLook) -> None:
         painter.setPen(_TEXT)

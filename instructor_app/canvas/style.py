@@ -142,9 +142,14 @@ def look_of(
     if node.kind is NodeKind.SUBTREE:
         version = f"version {node.subtree.version}" if node.subtree else "no subtree"
         return NodeLook(
-            title, "[ ]", f"subtree, {version}", _param_lines(node), _SUBTREE_FILL,
-            (200, 140, 60), True,
-        )  # fmt: skip
+            title,
+            "[ ]",
+            f"subtree, {version}",
+            _param_lines(node),
+            _SUBTREE_FILL,
+            (200, 140, 60),
+            True,
+        )
     fill = _OPERATION_FILL.get(
         op_kind or OperationKind.ACTION, _OPERATION_FILL[OperationKind.ACTION]
     )
@@ -152,7 +157,13 @@ def look_of(
     if unknown:
         broken = f"Unknown operation {node.op!r}: no capability of this cell provides it"
         return NodeLook(
-            title, "", f"⚠ unknown: {node.op}", _param_lines(node), _BROKEN_FILL, _BROKEN_FILL,
-            True, broken,
-        )  # fmt: skip
+            title,
+            "",
+            f"⚠ unknown: {node.op}",
+            _param_lines(node),
+            _BROKEN_FILL,
+            _BROKEN_FILL,
+            True,
+            broken,
+        )
     return NodeLook(title, "", subtitle, _param_lines(node), fill, fill, True)

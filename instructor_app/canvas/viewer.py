@@ -66,13 +66,18 @@ class CanvasViewer(NodeViewer):
     # ------------------------------------------------------------------ drops
 
     def dragEnterEvent(self, event: QDragEnterEvent) -> None:
+        self._accept_palette_drag(event)
+
+    def dragMoveEvent(self, event: QDragMoveEvent) -> None:
+        self._accept_palette_drag(event)
+
+    @staticmethod
+    def _accept_palette_drag(event: QDragMoveEvent) -> None:
+        """An enter event is a move event: both take a palette entry and refuse anything else."""
         if event.mimeData().hasFormat(PALETTE_MIME):
             event.acceptProposedAction()
         else:
             event.ignore()
-
-    def dragMoveEvent(self, event: QDragMoveEvent) -> None:
-        self.dragEnterEvent(event)  # type: ignore[arg-type]  # a move event is handled like an enter event: only mimeData is read
 
     def dropEvent(self, event: QDropEvent) -> None:
         if not event.mimeData().hasFormat(PALETTE_MIME):

@@ -90,10 +90,11 @@ class PlanModel(QObject):
         node = self.node(node_id)
         ids = set(tree_ops.subtree_ids(node))
         fragment = PlanSpec(
-            tree=node, name=SUBTREE_FORMAT,
+            tree=node,
+            name=SUBTREE_FORMAT,
             layout={k: v for k, v in self.plan.layout.items() if k in ids},
             subtrees=subtrees_in_use(node, self.plan.subtrees),  # what its instances run
-        )  # fmt: skip
+        )
         return dump_plan(fragment)
 
     # ------------------------------------------------------------------ mutators (no undo)

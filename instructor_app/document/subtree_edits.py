@@ -97,9 +97,13 @@ class SubtreeEditor:
         doc = self.document
         try:
             return make_subtree(
-                doc.node(node_id), name, ports_of(doc.plan, source), open_ports, outputs,
+                doc.node(node_id),
+                name,
+                ports_of(doc.plan, source),
+                open_ports,
+                outputs,
                 description,
-            )  # fmt: skip
+            )
         except ValueError as exc:
             raise DocumentError(str(exc)) from exc
 

@@ -49,9 +49,13 @@ class InstanceInsidePanel(QWidget):
             self._colour(runtime_id, status)
 
     def _add(
-        self, plan: PlanSpec, node: NodeSpec, prefix: str, parent: QTreeWidgetItem | None,
+        self,
+        plan: PlanSpec,
+        node: NodeSpec,
+        prefix: str,
+        parent: QTreeWidgetItem | None,
         stack: tuple[object, ...],
-    ) -> None:  # fmt: skip
+    ) -> None:
         what = node.op or node.kind.value.replace("_", " ")
         label = f"{node.name} ({what})" if node.name else what
         row = QTreeWidgetItem(parent if parent is not None else self.tree, [label, ""])

@@ -326,11 +326,17 @@ class Scene3DPanel(PointingMixin, QWidget):
     ) -> list[Any]:
         library = (self._cell.interfaces() if self._cell else {}).get("objects")
         try:
-            data = mesh_data(str(library.get(name).mesh_file))  # type: ignore[union-attr]
+            if library is None:
+                raise LookupError("no object library")
+            data = mesh_data(str(library.get(name).mesh_file))
         except Exception:  # no library or an unknown class: a ball marks where it was seen
             data = gl.MeshData.sphere(rows=6, cols=8, radius=0.03)
-        mesh = gl.GLMeshItem(meshdata=data, color=colour, shader="shaded",
-                             glOptions="translucent" if colour[3] < 1 else "opaque")  # fmt: skip
+        mesh = gl.GLMeshItem(
+            meshdata=data,
+            color=colour,
+            shader="shaded",
+            glOptions="translucent" if colour[3] < 1 else "opaque",
+        )
         set_pose(mesh, pose_to_matrix(pose))
         text = gl.GLTextItem(
             pos=np.add(pose.position, (0, 0, 0.12)), text=label, color=(230, 230, 230, 255)
@@ -375,8 +381,14 @@ class Scene3DPanel(PointingMixin, QWidget):
         for name, region in self._regions:
             sphere = sphere_item(region.radius, REGION_RGBA)
             sphere.translate(*region.center)
-            items += [sphere, gl.GLTextItem(pos=np.add(region.center, (0, 0, region.radius + 0.02)),
-                                            text=name, color=(255, 120, 220, 255))]  # fmt: skip
+            items += [
+                sphere,
+                gl.GLTextItem(
+                    pos=np.add(region.center, (0, 0, region.radius + 0.02)),
+                    text=name,
+                    color=(255, 120, 220, 255),
+                ),
+            ]
         self._replace("regions", items)
 
     def _waypoint_pose(self, waypoint: Waypoint) -> Pose | None:
@@ -400,8 +412,14 @@ class Scene3DPanel(PointingMixin, QWidget):
                 continue
             axes = axes_item()
             set_pose(axes, pose_to_matrix(pose))
-            items += [axes, gl.GLTextItem(pos=np.add(pose.position, (0, 0, 0.03)), text=waypoint.name,
-                                          color=(200, 230, 255, 255))]  # fmt: skip
+            items += [
+                axes,
+                gl.GLTextItem(
+                    pos=np.add(pose.position, (0, 0, 0.03)),
+                    text=waypoint.name,
+                    color=(200, 230, 255, 255),
+                ),
+            ]
         self._replace("waypoints", items)
 
 

@@ -36,10 +36,14 @@ __all__ = [
 
 # example-robot-data mesh of each UR5 link (the tool0 frame has none).
 _LINK_MESHES = {
-    "base_link": "base", "shoulder_link": "shoulder", "upper_arm_link": "upperarm",
-    "forearm_link": "forearm", "wrist_1_link": "wrist1", "wrist_2_link": "wrist2",
+    "base_link": "base",
+    "shoulder_link": "shoulder",
+    "upper_arm_link": "upperarm",
+    "forearm_link": "forearm",
+    "wrist_1_link": "wrist1",
+    "wrist_2_link": "wrist2",
     "wrist_3_link": "wrist3",
-}  # fmt: skip
+}
 
 
 def _ur5_mesh_dir() -> Path:
@@ -86,16 +90,20 @@ class RobotItems:
         folder = _ur5_mesh_dir()
         for link, stem in _LINK_MESHES.items():
             item = gl.GLMeshItem(
-                meshdata=mesh_data(str(folder / f"{stem}.stl")), color=colour, smooth=False,
-                shader="shaded", glOptions="translucent" if translucent else "opaque",
-            )  # fmt: skip
+                meshdata=mesh_data(str(folder / f"{stem}.stl")),
+                color=colour,
+                smooth=False,
+                shader="shaded",
+                glOptions="translucent" if translucent else "opaque",
+            )
             view.addItem(item)
             self.items[link] = item
         self.tool = gl.GLMeshItem(
             meshdata=gl.MeshData.cylinder(rows=1, cols=16, radius=[0.035, 0.035], length=0.12),
-            color=(0.3, 0.3, 0.35, colour[3]), shader="shaded",
+            color=(0.3, 0.3, 0.35, colour[3]),
+            shader="shaded",
             glOptions="translucent" if translucent else "opaque",
-        )  # fmt: skip
+        )
         view.addItem(self.tool)
 
     def set_joints(self, q: Sequence[float]) -> np.ndarray:
@@ -122,7 +130,7 @@ def box_item(size: Sequence[float], colour: tuple[float, ...]) -> gl.GLMeshItem:
     faces = np.array([
         [0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
         [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3],
-    ], dtype=np.int32)  # fmt: skip
+    ], dtype=np.int32)  # fmt: skip  # a table: two triangles per side of the box
     return gl.GLMeshItem(vertexes=corners, faces=faces, color=colour, shader="shaded", smooth=False)
 
 

@@ -60,7 +60,7 @@ def opengl_problem() -> str | None:
 _LIVE: set[SceneView] = set()
 
 
-class SceneView(GLViewMixin, QOpenGLWindow):  # type: ignore[misc]  # pyqtgraph is untyped
+class SceneView(GLViewMixin, QOpenGLWindow):
     """pyqtgraph's GL view as a window (see the module's text) that turns clicks into rays
     and counts the frames it draws.
 

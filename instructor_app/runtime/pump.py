@@ -66,9 +66,8 @@ class Batch:
     @property
     def empty(self) -> bool:
         return not (
-            self.statuses or self.writes or self.logs or self.finished or self.started
-            or self.holds
-        )  # fmt: skip
+            self.statuses or self.writes or self.logs or self.finished or self.started or self.holds
+        )
 
 
 class EventPump:

@@ -17,8 +17,13 @@ from tools.generators import (
 
 def main() -> int:
     status = make_objects.main([])
-    for generator in (make_clear_stop, make_examples, make_cell_examples, make_kitting,
-                      make_tending):  # fmt: skip
+    for generator in (
+        make_clear_stop,
+        make_examples,
+        make_cell_examples,
+        make_kitting,
+        make_tending,
+    ):
         generator.main()
     return status
 

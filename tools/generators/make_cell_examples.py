@@ -71,11 +71,19 @@ def tending_waypoints() -> list[Waypoint]:
         Waypoint("observe", WaypointFrame.JOINTS, joints=JointConfig(OBSERVE_JOINTS)),
         Waypoint("over exit", WaypointFrame.WORLD, Pose((*EXIT_XY, ABOVE_Z), EXIT_DOWN)),
         Waypoint("at exit", WaypointFrame.WORLD, Pose((*EXIT_XY, GRASP_Z), EXIT_DOWN)),
-        Waypoint("over rack", WaypointFrame.OBJECT, Pose((*TOTE, OVER_RACK_Z), DOWN),
-                 reference="tending_rack"),
-        Waypoint("into rack", WaypointFrame.OBJECT, Pose((*TOTE, RACK_DROP_Z), DOWN),
-                 reference="tending_rack"),
-    ]  # fmt: skip
+        Waypoint(
+            "over rack",
+            WaypointFrame.OBJECT,
+            Pose((*TOTE, OVER_RACK_Z), DOWN),
+            reference="tending_rack",
+        ),
+        Waypoint(
+            "into rack",
+            WaypointFrame.OBJECT,
+            Pose((*TOTE, RACK_DROP_Z), DOWN),
+            reference="tending_rack",
+        ),
+    ]
 
 
 class _Cell(PlanBuilder):
@@ -96,41 +104,45 @@ def _figure3_tree(m: _Cell, finder: str, detect: str, title: str) -> NodeSpec:
     """The Figure 3 tree; ``finder`` is the capability that finds objects (markers or
     perception) and ``detect`` its operation that looks."""
     transfer = m.node(
-        NodeKind.SEQUENCE, "transfer",
+        NodeKind.SEQUENCE,
+        "transfer",
         m.op(f"{finder}.object_found", "CUP found", object=obj("cup")),
         m.op(f"{finder}.object_pose", "pose of CUP", object=obj("cup"), pose="CUP_POSE"),
-        m.op(f"{finder}.object_pose", "pose of BIN", object=obj("waste_bin"),
-             pose="BIN_POSE"),
-        m.op("gripper.grasp", "grasp CUP at CUP_POSE", object=obj("cup"),
-             pose="CUP_POSE"),
+        m.op(f"{finder}.object_pose", "pose of BIN", object=obj("waste_bin"), pose="BIN_POSE"),
+        m.op("gripper.grasp", "grasp CUP at CUP_POSE", object=obj("cup"), pose="CUP_POSE"),
         m.move_to("move to BIN_POSE", "over bin", "BIN_POSE"),
         m.op("gripper.open", "release"),
-    )  # fmt: skip
+    )
     wait = m.node(
-        NodeKind.FORCE_FAILURE, "then look again",
+        NodeKind.FORCE_FAILURE,
+        "then look again",
         m.node(NodeKind.WAIT, "WAIT", seconds=1.0),
-    )  # fmt: skip
+    )
     return m.node(
-        NodeKind.SEQUENCE, title,
+        NodeKind.SEQUENCE,
+        title,
         m.move_to("step out of view", "observe"),
         m.op(f"{finder}.{detect}", "detect CUP and BIN"),  # the shoulder camera, by default
         m.node(NodeKind.SELECTOR, "transfer or wait", transfer, wait),
-    )  # fmt: skip
+    )
 
 
 def cup_to_bin() -> PlanSpec:
     tree = _figure3_tree(_Cell("cup_to_bin"), "markers", "detect_markers", "cup to bin")
     return PlanSpec(
-        tree, "Cup to bin (Figure 3, simulated cell)",
+        tree,
+        "Cup to bin (Figure 3, simulated cell)",
         "The paper's Figure 3 on the simulated cell: find the cup and the waste bin through their "
         "markers, check the cup was found, query both poses, grasp the cup at its pose with the "
         "grasp of its object model and drop it over the bin. When the cup is not visible the selector falls "
         "back to WAIT (forced to fail) and the root, which runs until success, looks again. "
         "Run it with: costar run cup_to_bin.costar.json --cell sim --seed N. Runs to SUCCESS.",
-        RunPolicy.UNTIL_SUCCESS, waypoints=waypoints(), objects=["cup", "waste_bin"],
+        RunPolicy.UNTIL_SUCCESS,
+        waypoints=waypoints(),
+        objects=["cup", "waste_bin"],
         reset_cell=True,  # each run in the Instructor starts from the scene's seed
         id=stable_id(CELL_EXAMPLES, "cup_to_bin"),
-    )  # fmt: skip
+    )
 
 
 def cup_to_bin_vision() -> PlanSpec:
@@ -138,16 +150,19 @@ def cup_to_bin_vision() -> PlanSpec:
     m = _Cell("cup_to_bin_vision")
     tree = _figure3_tree(m, "perception", "detect_objects", "cup to bin (vision)")
     return PlanSpec(
-        tree, "Cup to bin, by vision (Figure 3, simulated cell)",
+        tree,
+        "Cup to bin, by vision (Figure 3, simulated cell)",
         "The paper's Figure 3 with model-based recognition instead of markers: the shoulder "
         "camera's point cloud is matched to the cup and waste-bin models, the plan checks the "
         "cup was found, queries both poses, grasps the cup at its pose with the grasp of its "
         "object model and drops it over the bin; when the cup is not recognised it waits and looks "
         "again. Run it with: costar run cup_to_bin_vision.costar.json --cell sim --seed N.",
-        RunPolicy.UNTIL_SUCCESS, waypoints=waypoints(), objects=["cup", "waste_bin"],
+        RunPolicy.UNTIL_SUCCESS,
+        waypoints=waypoints(),
+        objects=["cup", "waste_bin"],
         reset_cell=True,  # each run in the Instructor starts from the scene's seed
         id=stable_id(CELL_EXAMPLES, "cup_to_bin_vision"),
-    )  # fmt: skip
+    )
 
 
 def _tending_cycle(m: _Cell) -> NodeSpec:
@@ -158,11 +173,21 @@ def _tending_cycle(m: _Cell) -> NodeSpec:
     # Four looks a second see the arm, which stays over the exit for more than a second.
     period = fixed(0.25, ParamType.DURATION)
     return m.node(
-        NodeKind.SEQUENCE, "one part",
-        m.op("occupancy.wait_until_occupied", "wait for the welding arm", region=region,
-             timeout=long, period=period),
-        m.op("occupancy.wait_until_empty", "wait until the arm is back up", region=region,
-             period=period),
+        NodeKind.SEQUENCE,
+        "one part",
+        m.op(
+            "occupancy.wait_until_occupied",
+            "wait for the welding arm",
+            region=region,
+            timeout=long,
+            period=period,
+        ),
+        m.op(
+            "occupancy.wait_until_empty",
+            "wait until the arm is back up",
+            region=region,
+            period=period,
+        ),
         m.move_to("over the exit", "over exit"),
         m.move_to("down to the part", "at exit", linear=True),
         m.op("gripper.close", "close on the part"),
@@ -178,29 +203,34 @@ def _tending_cycle(m: _Cell) -> NodeSpec:
         m.op("gripper.open", "let go into the tote"),
         m.move_to("up from the rack", "over rack", "RACK_POSE", linear=True),
         m.move_to("step out of view", "observe"),
-    )  # fmt: skip
+    )
 
 
 def tending_paper() -> PlanSpec:
     """The paper's wire-bender tending plan: no error handling but the operator's reset."""
     m = _Cell("tending_paper", tending_waypoints())
     operator = m.node(
-        NodeKind.SEQUENCE, "stop and wait for the operator",
+        NodeKind.SEQUENCE,
+        "stop and wait for the operator",
         m.op("gripper.open", "drop what is held"),
         m.move_to("step back", "observe"),
         m.op("collaboration.wait_for_button", "operator resets the cell, presses Continue"),
-    )  # fmt: skip
+    )
     tree = m.node(
-        NodeKind.SEQUENCE, "tend the wire bender",
+        NodeKind.SEQUENCE,
+        "tend the wire bender",
         m.move_to("step out of view", "observe"),
         m.op("markers.detect_markers", "find the rack"),
-        m.op("markers.object_pose", "pose of RACK", object=obj("tending_rack"),
-             pose="RACK_POSE"),
-        m.node(NodeKind.ITERATOR, "every part",
-               m.node(NodeKind.SELECTOR, "part or operator", _tending_cycle(m), operator)),
-    )  # fmt: skip
+        m.op("markers.object_pose", "pose of RACK", object=obj("tending_rack"), pose="RACK_POSE"),
+        m.node(
+            NodeKind.ITERATOR,
+            "every part",
+            m.node(NodeKind.SELECTOR, "part or operator", _tending_cycle(m), operator),
+        ),
+    )
     return PlanSpec(
-        tree, "Wire-bender tending, the paper's plan (section V-B, simulated cell)",
+        tree,
+        "Wire-bender tending, the paper's plan (section V-B, simulated cell)",
         "The paper's deployment at Marlin Steel on the 'tending' scene: the rack is found by "
         "its marker once; for each part the robot waits until the bender's welding arm swings "
         "into an occupancy region and back out, picks the wireform at the exit with one taught "
@@ -210,11 +240,13 @@ def tending_paper() -> PlanSpec:
         "back and waits for the operator's Continue while the bender keeps producing. Runs until "
         "stopped. It is taught on the simulated scene tending, which the simulated cell opens "
         "for it. Run it with: costar run example:tending_paper.",
-        RunPolicy.ONCE, waypoints=tending_waypoints(), objects=["tending_rack"],
+        RunPolicy.ONCE,
+        waypoints=tending_waypoints(),
+        objects=["tending_rack"],
         reset_cell=True,  # each run in the Instructor starts from the scene's seed
         scene="tending",
         id=stable_id(CELL_EXAMPLES, "tending_paper"),
-    )  # fmt: skip
+    )
 
 
 def main() -> None:

@@ -35,25 +35,30 @@ def clear_stop_and_back_off() -> SubtreeSpec:
     m = PlanBuilder(CLEAR_STOP, "clear_stop")
     root = m.id()  # this tree is numbered from its root down
     tree = m.node(
-        NodeKind.SEQUENCE, "ClearStopAndBackOff",
+        NodeKind.SEQUENCE,
+        "ClearStopAndBackOff",
         m.op("motion.clear_protective_stop", "clear the stop"),
-        m.op("motion.move_relative", "back off", dz="BACK_OFF",
-             speed=fixed(0.5, ParamType.NUMBER)),
+        m.op("motion.move_relative", "back off", dz="BACK_OFF", speed=fixed(0.5, ParamType.NUMBER)),
         m.op("motion.move_to", "to the safe pose", target="SAFE"),
         node_id=root,
-    )  # fmt: skip
+    )
     return subtree(
-        "recovery.clear_stop_and_back_off", "ClearStopAndBackOff",
+        "recovery.clear_stop_and_back_off",
+        "ClearStopAndBackOff",
         "After a collision: clears the protective stop (once the robot allows it), backs the "
         "tool off straight up and goes to a safe pose. Put it as the handler of a Catch of "
         "protective_stop around the moves.",
         tree,
         inputs=[
-            port("BACK_OFF", ParamType.NUMBER,
-                 "m the tool backs off straight up (half speed)", BACK_OFF),
+            port(
+                "BACK_OFF",
+                ParamType.NUMBER,
+                "m the tool backs off straight up (half speed)",
+                BACK_OFF,
+            ),
             port("SAFE", ParamType.WAYPOINT, "where the arm waits after backing off", safe),
         ],
-    )  # fmt: skip
+    )
 
 
 def main() -> None:

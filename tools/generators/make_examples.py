@@ -133,32 +133,48 @@ def _subtree_example() -> PlanSpec:
     """Two instances of one subtree, each with its own target, each keeping its own GOAL."""
     inner = _Debug("subtree/inside")
     go_to = subtree(
-        "examples.go_to", "Go to",
+        "examples.go_to",
+        "Go to",
         "Finds where to go (a private GOAL) and goes there.",
         inner.node(
-            NodeKind.SEQUENCE, "Go to",
-            inner.debug("query", "find", value=Binding.reference("TARGET"), result=Binding.reference("GOAL")),
+            NodeKind.SEQUENCE,
+            "Go to",
+            inner.debug(
+                "query", "find", value=Binding.reference("TARGET"), result=Binding.reference("GOAL")
+            ),
             inner.debug("pretend_move", "go", target=Binding.reference("GOAL")),
-            inner.debug("set_param", "report", value=Binding.reference("GOAL"), name=Binding.reference("REACHED")),
+            inner.debug(
+                "set_param",
+                "report",
+                value=Binding.reference("GOAL"),
+                name=Binding.reference("REACHED"),
+            ),
         ),
         inputs=[port("TARGET", ParamType.POSE, "where to go")],
         outputs=[port("REACHED", ParamType.ANY, "where it went")],
-    )  # fmt: skip
+    )
     m = _Debug("subtree")
 
     def visit(name: str, x: float, out: str) -> NodeSpec:
-        return m.instance(go_to, name, TARGET=fixed(Pose((x, 0.1, 0.2)), ParamType.POSE),
-                          REACHED=Binding.reference(out))  # fmt: skip
+        return m.instance(
+            go_to,
+            name,
+            TARGET=fixed(Pose((x, 0.1, 0.2)), ParamType.POSE),
+            REACHED=Binding.reference(out),
+        )
 
     tree = m.node(
         NodeKind.SEQUENCE, "two visits", visit("left", 0.3, "LEFT"), visit("right", 0.5, "RIGHT")
     )
     return PlanSpec(
-        tree, "Subtree instances",
+        tree,
+        "Subtree instances",
         "One subtree used twice with different targets: each instance keeps its own GOAL and "
         "passes out where it went. Runs to SUCCESS.",
-        RunPolicy.ONCE, id=stable_id(EXAMPLES, "subtree"), subtrees=[go_to],
-    )  # fmt: skip
+        RunPolicy.ONCE,
+        id=stable_id(EXAMPLES, "subtree"),
+        subtrees=[go_to],
+    )
 
 
 def _composites() -> dict[str, PlanSpec]:

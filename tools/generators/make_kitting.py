@@ -107,30 +107,41 @@ def _subtree(key: str, name: str, description: str, tree: NodeSpec, **ports: Any
 def handoff() -> SubtreeSpec:
     m = _Maker("handoff")
     tree = m.node(
-        NodeKind.SEQUENCE, "Handoff",
+        NodeKind.SEQUENCE,
+        "Handoff",
         m.move("step out of view", observe()),
-        m.op("collaboration.wait_for_handoff", "wait for the bin", object="OBJECT", region="AREA",
-             timeout=fixed(300.0, ParamType.DURATION), settle=fixed(0.5, ParamType.DURATION),
-             pose="POSE"),
-    )  # fmt: skip
+        m.op(
+            "collaboration.wait_for_handoff",
+            "wait for the bin",
+            object="OBJECT",
+            region="AREA",
+            timeout=fixed(300.0, ParamType.DURATION),
+            settle=fixed(0.5, ParamType.DURATION),
+            pose="POSE",
+        ),
+    )
     return _subtree(
-        "handoff", "Handoff",
+        "handoff",
+        "Handoff",
         "Waits for the worker to put an object (the kit bin) down in an area, seen by its "
         "markers in the shoulder camera, and tells where it is.",
         tree,
-        inputs=[port("OBJECT", ParamType.OBJECT, "what the worker hands in", ObjectModel("kit_bin")),
-                port("AREA", ParamType.REGION, "where the worker puts it")],
+        inputs=[
+            port("OBJECT", ParamType.OBJECT, "what the worker hands in", ObjectModel("kit_bin")),
+            port("AREA", ParamType.REGION, "where the worker puts it"),
+        ],
         outputs=[port("POSE", ParamType.POSE, "where it was put")],
-    )  # fmt: skip
+    )
 
 
 def unholster() -> SubtreeSpec:
     m = _Maker("unholster")
     tree = m.node(
-        NodeKind.SEQUENCE, "Unholster",
+        NodeKind.SEQUENCE,
+        "Unholster",
         m.op("motion.go_home", "home"),  # the holster's approach is taught from home
         m.op("tool.unholster", "take the suction tool"),
-    )  # fmt: skip
+    )
     return _subtree(
         "unholster",
         "Unholster",
@@ -142,10 +153,11 @@ def unholster() -> SubtreeSpec:
 def holster() -> SubtreeSpec:
     m = _Maker("holster")
     tree = m.node(
-        NodeKind.SEQUENCE, "Holster",
+        NodeKind.SEQUENCE,
+        "Holster",
         m.op("motion.go_home", "home"),
         m.op("tool.holster", "put the suction tool back"),
-    )  # fmt: skip
+    )
     return _subtree(
         "holster",
         "Holster",
@@ -157,14 +169,22 @@ def holster() -> SubtreeSpec:
 def transfer() -> SubtreeSpec:
     m = _Maker("transfer")
     tree = m.node(
-        NodeKind.SEQUENCE, "Transfer",
+        NodeKind.SEQUENCE,
+        "Transfer",
         m.move("step out of view", observe()),
         m.op("perception.detect_objects", "look", camera=fixed("shoulder", ParamType.TEXT)),
         m.op("perception.object_found", "OBJECT on the table", object="OBJECT"),
         m.op("perception.object_pose", "pose of OBJECT", object="OBJECT", pose="PART_POSE"),
-        m.node(NodeKind.INVERTER, "not in the bin yet",
-               m.op("predicates.touching", "OBJECT in the bin", object_a="OBJECT",
-                    object_b=obj("kit_bin"))),
+        m.node(
+            NodeKind.INVERTER,
+            "not in the bin yet",
+            m.op(
+                "predicates.touching",
+                "OBJECT in the bin",
+                object_a="OBJECT",
+                object_b=obj("kit_bin"),
+            ),
+        ),
         m.op("motion.go_home", "clear of the table"),  # from the camera pose, over the bin
         m.move("above OBJECT", "PICK", "PART_POSE"),
         m.vertical("down to OBJECT", -HOVER),
@@ -175,24 +195,32 @@ def transfer() -> SubtreeSpec:
         m.vertical("down into the bin", -PLACE_DROP),
         m.op("tool.suction_off", "release"),
         m.vertical("up", PLACE_DROP),
-    )  # fmt: skip
+    )
     return _subtree(
-        "transfer", "Transfer",
+        "transfer",
+        "Transfer",
         "Finds a part by its shape, sucks it up with a waypoint taught relative to it and puts "
         "it down with a waypoint taught relative to the bin. Fails at once when the part is not "
         "on the table (not seen, or already in the bin).",
         tree,
-        inputs=[port("OBJECT", ParamType.OBJECT, "the part to move"),
-                port("PICK", ParamType.WAYPOINT, "the tool 10 cm above the part, relative to it"),
-                port("PLACE", ParamType.WAYPOINT, "the tool above where the part goes, relative to the bin"),
-                port("BIN", ParamType.POSE, "where the bin is")],
-    )  # fmt: skip
+        inputs=[
+            port("OBJECT", ParamType.OBJECT, "the part to move"),
+            port("PICK", ParamType.WAYPOINT, "the tool 10 cm above the part, relative to it"),
+            port(
+                "PLACE",
+                ParamType.WAYPOINT,
+                "the tool above where the part goes, relative to the bin",
+            ),
+            port("BIN", ParamType.POSE, "where the bin is"),
+        ],
+    )
 
 
 def return_bin() -> SubtreeSpec:
     m = _Maker("return")
     tree = m.node(
-        NodeKind.SEQUENCE, "Return",
+        NodeKind.SEQUENCE,
+        "Return",
         m.op("gripper.open", "open"),
         m.move("above the wall", "GRASP", "BIN"),
         m.vertical("down to the wall", -HOVER),
@@ -204,15 +232,20 @@ def return_bin() -> SubtreeSpec:
         m.op("gripper.open", "let go"),
         m.vertical("up", HOVER),
         m.move("step out of view", observe()),
-    )  # fmt: skip
+    )
     return _subtree(
-        "return", "Return",
+        "return",
+        "Return",
         "Takes the bin by its wall with the gripper and puts it down at a new place.",
         tree,
-        inputs=[port("BIN", ParamType.POSE, "where the bin is"),
-                port("GRASP", ParamType.WAYPOINT, "the gripper 10 cm above the wall, relative to the bin"),
-                port("DEST", ParamType.WAYPOINT, "the gripper 10 cm above where it lets go (world)")],
-    )  # fmt: skip
+        inputs=[
+            port("BIN", ParamType.POSE, "where the bin is"),
+            port(
+                "GRASP", ParamType.WAYPOINT, "the gripper 10 cm above the wall, relative to the bin"
+            ),
+            port("DEST", ParamType.WAYPOINT, "the gripper 10 cm above where it lets go (world)"),
+        ],
+    )
 
 
 def library() -> list[SubtreeSpec]:
@@ -221,9 +254,11 @@ def library() -> list[SubtreeSpec]:
 
 def wall_grasp() -> Waypoint:
     return Waypoint(
-        "above the bin's wall", WaypointFrame.OBJECT,
-        Pose((0.0, WALL_Y, WALL_GRASP_Z + HOVER), DOWN), reference="kit_bin",
-    )  # fmt: skip
+        "above the bin's wall",
+        WaypointFrame.OBJECT,
+        Pose((0.0, WALL_Y, WALL_GRASP_Z + HOVER), DOWN),
+        reference="kit_bin",
+    )
 
 
 def return_place() -> Waypoint:
@@ -238,41 +273,58 @@ def kitting() -> PlanSpec:
 
     def transfer_of(plate: str, label: str) -> NodeSpec:
         return m.instance(
-            subs["transfer"], f"Transfer {label}", OBJECT=obj(plate),
+            subs["transfer"],
+            f"Transfer {label}",
+            OBJECT=obj(plate),
             PICK=fixed(pick_waypoint(plate), ParamType.WAYPOINT),
-            PLACE=fixed(place_waypoint(plate), ParamType.WAYPOINT), BIN="BIN_POSE",
-        )  # fmt: skip
+            PLACE=fixed(place_waypoint(plate), ParamType.WAYPOINT),
+            BIN="BIN_POSE",
+        )
 
     plates = m.node(
-        NodeKind.REPEAT, "one of each plate",
-        m.node(NodeKind.SELECTOR, "whichever plate is on the table",
-               transfer_of("plate_3_holes", "3-hole plate"),
-               transfer_of("plate_4_holes", "4-hole plate"),
-               transfer_of("plate_8_holes", "8-hole plate")),
+        NodeKind.REPEAT,
+        "one of each plate",
+        m.node(
+            NodeKind.SELECTOR,
+            "whichever plate is on the table",
+            transfer_of("plate_3_holes", "3-hole plate"),
+            transfer_of("plate_4_holes", "4-hole plate"),
+            transfer_of("plate_8_holes", "8-hole plate"),
+        ),
         count=3,
-    )  # fmt: skip
+    )
     tree = m.node(
-        NodeKind.SEQUENCE, "Kitting",
-        m.instance(subs["handoff"], "Handoff", AREA=fixed(HANDOFF_AREA, ParamType.REGION),
-                   POSE="BIN_POSE"),
+        NodeKind.SEQUENCE,
+        "Kitting",
+        m.instance(
+            subs["handoff"], "Handoff", AREA=fixed(HANDOFF_AREA, ParamType.REGION), POSE="BIN_POSE"
+        ),
         m.instance(subs["unholster"], "Unholster"),
         plates,
         m.instance(subs["holster"], "Holster"),
-        m.instance(subs["return"], "Return", BIN="BIN_POSE",
-                   GRASP=fixed(wall_grasp(), ParamType.WAYPOINT),
-                   DEST=fixed(return_place(), ParamType.WAYPOINT)),
-    )  # fmt: skip
+        m.instance(
+            subs["return"],
+            "Return",
+            BIN="BIN_POSE",
+            GRASP=fixed(wall_grasp(), ParamType.WAYPOINT),
+            DEST=fixed(return_place(), ParamType.WAYPOINT),
+        ),
+    )
     return PlanSpec(
-        tree, "Kitting (Figure 7, simulated cell)",
+        tree,
+        "Kitting (Figure 7, simulated cell)",
         "The paper's kitting task composed from the shipped library: wait for the worker to hand "
         "the kit bin in, take the suction tool, put one each of the 3-, 4- and 8-hole plates into "
         "the bin (whichever is on the table), holster the tool and return the bin. It is taught "
         "on the simulated scene kitting_handoff (a worker hands the bin in), which the simulated "
         "cell opens for it. Run it with: costar run example:kitting --seed N.",
-        RunPolicy.ONCE, objects=["kit_bin", *PLATE_THICKNESS], reset_cell=True,
+        RunPolicy.ONCE,
+        objects=["kit_bin", *PLATE_THICKNESS],
+        reset_cell=True,
         scene="kitting_handoff",
-        id=stable_id(KITTING, "kitting"), subtrees=list(subs.values()),
-    )  # fmt: skip
+        id=stable_id(KITTING, "kitting"),
+        subtrees=list(subs.values()),
+    )
 
 
 def main() -> None:

@@ -460,23 +460,37 @@ def make_wireforms() -> dict[str, tuple[dict, Mesh]]:
     """The two wireforms the bender makes: a U and a step (both welded in the middle)."""
     w, h = WIRE, WELD / 2
     u = [
-        _bar(-0.08, -h, -0.045, -0.045 + w), _bar(-h, h, -0.045, -0.045 + w),
+        _bar(-0.08, -h, -0.045, -0.045 + w),
+        _bar(-h, h, -0.045, -0.045 + w),
         _bar(h, 0.08, -0.045, -0.045 + w),
-        _bar(-0.08, -0.08 + w, -0.045 + w, 0.045), _bar(0.08 - w, 0.08, -0.045 + w, 0.045),
-    ]  # fmt: skip
+        _bar(-0.08, -0.08 + w, -0.045 + w, 0.045),
+        _bar(0.08 - w, 0.08, -0.045 + w, 0.045),
+    ]
     step = [
-        _bar(-0.075, w / 2, 0.034, 0.034 + w), _bar(-w / 2, w / 2, h, 0.034),
-        _bar(-w / 2, w / 2, -h, h), _bar(-w / 2, w / 2, -0.034, -h),
+        _bar(-0.075, w / 2, 0.034, 0.034 + w),
+        _bar(-w / 2, w / 2, h, 0.034),
+        _bar(-w / 2, w / 2, -h, h),
+        _bar(-w / 2, w / 2, -0.034, -h),
         _bar(-w / 2, 0.075, -0.034 - w, -0.034),
-    ]  # fmt: skip
+    ]
     return {
         "wireform_u": make_wireform(
-            "wireform_u", "A U-shaped 2D wireform, 160 x 90 mm of 8 mm wire, welded in the "
-            "middle of its base; no markers.", u, (1, [[0, 3], [2, 4]]), 0.0),
+            "wireform_u",
+            "A U-shaped 2D wireform, 160 x 90 mm of 8 mm wire, welded in the "
+            "middle of its base; no markers.",
+            u,
+            (1, [[0, 3], [2, 4]]),
+            0.0,
+        ),
         "wireform_step": make_wireform(
-            "wireform_step", "A step-shaped 2D wireform, 150 x 84 mm of 8 mm wire, welded in "
-            "the middle of its riser; no markers.", step, (2, [[0, 1], [3, 4]]), math.pi / 2),
-    }  # fmt: skip
+            "wireform_step",
+            "A step-shaped 2D wireform, 150 x 84 mm of 8 mm wire, welded in "
+            "the middle of its riser; no markers.",
+            step,
+            (2, [[0, 1], [3, 4]]),
+            math.pi / 2,
+        ),
+    }
 
 
 def make_bender() -> tuple[dict, Mesh]:
@@ -545,9 +559,11 @@ def make_rack() -> tuple[dict, Mesh]:
             {"size": [_r(v) for v in p["size"]], "position": [_r(x + ledge / 2), _r(y), _r(z)]}
         )
     parts.append(
-        {"size": [ledge, width, ledge_height],
-         "position": [_r((ledge - length) / 2), 0.0, ledge_height / 2]}
-    )  # fmt: skip
+        {
+            "size": [ledge, width, ledge_height],
+            "position": [_r((ledge - length) / 2), 0.0, ledge_height / 2],
+        }
+    )
     mesh = Mesh()
     for part in parts:
         mesh.box(part["position"], part["size"])
@@ -598,9 +614,13 @@ def make_scrap_bin() -> tuple[dict, Mesh]:
         dimensions=[length, width, height],
         symmetry={"kind": "discrete", "axis": [0.0, 0.0, 1.0], "order": 2},
         color=[0.45, 0.2, 0.16, 1.0],
-        tote={"center": [0.0, 0.0], "inner": [_r(length - 0.008), _r(width - 0.008)],
-              "floor": 0.012, "rim": height},
-    )  # fmt: skip
+        tote={
+            "center": [0.0, 0.0],
+            "inner": [_r(length - 0.008), _r(width - 0.008)],
+            "floor": 0.012,
+            "rim": height,
+        },
+    )
     return model, mesh
 
 

@@ -44,10 +44,16 @@ PICK_ERRORS = "failed, grasp_failed, object_lost, timeout"
 PLACE_ERRORS = "protective_stop"  # the rack moved into the way: a collision
 
 
-def _wait_for_part(m: TendingMaker, subs: dict[str, SubtreeSpec], wps: dict[str, Waypoint],
-                   name: str) -> NodeSpec:  # fmt: skip
-    return m.instance(subs["WaitForPart"], name, REGION=fixed(ARM_REGION, ParamType.REGION),
-                      ABOVE=bound(wps["over exit"]), AT=bound(wps["at exit"]))  # fmt: skip
+def _wait_for_part(
+    m: TendingMaker, subs: dict[str, SubtreeSpec], wps: dict[str, Waypoint], name: str
+) -> NodeSpec:
+    return m.instance(
+        subs["WaitForPart"],
+        name,
+        REGION=fixed(ARM_REGION, ParamType.REGION),
+        ABOVE=bound(wps["over exit"]),
+        AT=bound(wps["at exit"]),
+    )
 
 
 def _part_cycle(
@@ -59,54 +65,86 @@ def _part_cycle(
     is done, and a part left at the exit unseen would be buried under the one after it."""
     exit_wps = {"ABOVE": bound(wps["over exit"]), "AT": bound(wps["at exit"])}
     scrap = m.instance(
-        subs["DiscardToScrap"], "DiscardToScrap", ABOVE=bound(wps["over exit"]),
+        subs["DiscardToScrap"],
+        "DiscardToScrap",
+        ABOVE=bound(wps["over exit"]),
         SCRAP=bound(wps["over scrap"]),
         **{f"PIECE_{i}": bound(wps[f"over piece {i}"]) for i in range(1, len(PIECES) + 1)},
-    )  # fmt: skip
+    )
     pick = m.node(
-        NodeKind.CATCH, "pick, with recovery",
+        NodeKind.CATCH,
+        "pick, with recovery",
         m.instance(subs["PickAtExit"], "PickAtExit", **exit_wps),
-        m.node(NodeKind.SELECTOR, "regrasp, else scrap it",
-               m.instance(subs["Regrasp"], "Regrasp", **exit_wps),
-               m.node(NodeKind.FORCE_FAILURE, "scrapped: nothing to place",
-                      m.node(NodeKind.SEQUENCE, "scrap it",
-                             m.node(NodeKind.PARALLEL, "scrap it until the next part comes",
-                                    scrap,
-                                    arm_comes(m, fixed(ARM_REGION, ParamType.REGION)),
-                                    success="any"),
-                             # A piece on its way to the bin when the next part came: on
-                             # into the bin (carried on through the back-off that follows,
-                             # it fell off: 1 of the 3 parts lost in 2 x 50).
-                             m.held_into_scrap(wps["over scrap"])))),
-        errors=PICK_ERRORS, error="PICK_ERROR",
-    )  # fmt: skip
+        m.node(
+            NodeKind.SELECTOR,
+            "regrasp, else scrap it",
+            m.instance(subs["Regrasp"], "Regrasp", **exit_wps),
+            m.node(
+                NodeKind.FORCE_FAILURE,
+                "scrapped: nothing to place",
+                m.node(
+                    NodeKind.SEQUENCE,
+                    "scrap it",
+                    m.node(
+                        NodeKind.PARALLEL,
+                        "scrap it until the next part comes",
+                        scrap,
+                        arm_comes(m, fixed(ARM_REGION, ParamType.REGION)),
+                        success="any",
+                    ),
+                    # A piece on its way to the bin when the next part came: on
+                    # into the bin (carried on through the back-off that follows,
+                    # it fell off: 1 of the 3 parts lost in 2 x 50).
+                    m.held_into_scrap(wps["over scrap"]),
+                ),
+            ),
+        ),
+        errors=PICK_ERRORS,
+        error="PICK_ERROR",
+    )
     rack: dict[str, Binding | str] = {
         "RACK": "RACK_POSE",
         "OVER": bound(wps["over rack"]),
         "INTO": bound(wps["into rack"]),
     }
     place = m.node(
-        NodeKind.CATCH, "place, with recovery",
+        NodeKind.CATCH,
+        "place, with recovery",
         m.instance(subs["PlaceOnRack"], "PlaceOnRack", **rack),
-        m.node(NodeKind.SEQUENCE, "clear the stop, find the rack, place again",
-               m.instance(subs["ClearStopAndBackOff"], "ClearStopAndBackOff",
-                          SAFE=bound(observe())),
-               m.instance(subs["ReRegisterRack"], "ReRegisterRack", RACK_POSE="RACK_POSE"),
-               m.instance(subs["PlaceOnRack"], "PlaceOnRack again", **rack)),
-        errors=PLACE_ERRORS, error="PLACE_ERROR",
-    )  # fmt: skip
+        m.node(
+            NodeKind.SEQUENCE,
+            "clear the stop, find the rack, place again",
+            m.instance(subs["ClearStopAndBackOff"], "ClearStopAndBackOff", SAFE=bound(observe())),
+            m.instance(subs["ReRegisterRack"], "ReRegisterRack", RACK_POSE="RACK_POSE"),
+            m.instance(subs["PlaceOnRack"], "PlaceOnRack again", **rack),
+        ),
+        errors=PLACE_ERRORS,
+        error="PLACE_ERROR",
+    )
     # The watch starts once the arm is out of view with the part (ReRegisterRack): the part
     # carried past the welding arm's region would look like the arm.
     return m.node(
-        NodeKind.SEQUENCE, "one part",
-        m.node(NodeKind.SELECTOR, "a part in the gripper",
-               m.op("gripper.is_holding", "holding it already"), pick),
+        NodeKind.SEQUENCE,
+        "one part",
+        m.node(
+            NodeKind.SELECTOR,
+            "a part in the gripper",
+            m.op("gripper.is_holding", "holding it already"),
+            pick,
+        ),
         m.instance(subs["ReRegisterRack"], "where is the rack now", RACK_POSE="RACK_POSE"),
-        m.node(NodeKind.PARALLEL, "place it, watching for the next part",
-               m.node(NodeKind.SEQUENCE, "place it and step out of view",
-                      place, m.move("step out of view", observe())),
-               _wait_for_part(m, subs, wps, "the next part comes")),
-    )  # fmt: skip
+        m.node(
+            NodeKind.PARALLEL,
+            "place it, watching for the next part",
+            m.node(
+                NodeKind.SEQUENCE,
+                "place it and step out of view",
+                place,
+                m.move("step out of view", observe()),
+            ),
+            _wait_for_part(m, subs, wps, "the next part comes"),
+        ),
+    )
 
 
 def tending() -> PlanSpec:
@@ -126,41 +164,71 @@ def tending() -> PlanSpec:
     # of the welding arm's way (a robot left over the exit waited there for the arm to come
     # down on it), wait for the next part, as a part's cycle ends.
     go_on = m.node(
-        NodeKind.SEQUENCE, "recover and go on",
+        NodeKind.SEQUENCE,
+        "recover and go on",
         m.instance(subs["ClearStopAndBackOff"], "ClearStopAndBackOff", SAFE=bound(observe())),
         m.held_into_scrap(wps["over scrap"]),
         m.op("gripper.open", "let go"),
-        m.node(NodeKind.SELECTOR, "a part at the exit already, else the next one",
-               m.instance(subs["PartThenLeftPiece"], "PartThenLeftPiece",
-                          ABOVE=bound(wps["over exit"]), AT=bound(wps["at exit"]),
-                          OVER=bound(wps["over rack"]), INTO=bound(wps["into rack"]),
-                          SCRAP=bound(wps["over scrap"]),
-                          **{f"PIECE_{i}": bound(wps[f"over piece {i}"]) for i in range(1, len(PIECES) + 1)},
-                          REGION=fixed(ARM_REGION, ParamType.REGION), RACK_POSE="RACK_POSE"),
-               m.node(NodeKind.SEQUENCE, "none: the next one",
-                      m.move("step out of view", observe()),
-                      _wait_for_part(m, subs, wps, "then the next part comes"))),
-    )  # fmt: skip
+        m.node(
+            NodeKind.SELECTOR,
+            "a part at the exit already, else the next one",
+            m.instance(
+                subs["PartThenLeftPiece"],
+                "PartThenLeftPiece",
+                ABOVE=bound(wps["over exit"]),
+                AT=bound(wps["at exit"]),
+                OVER=bound(wps["over rack"]),
+                INTO=bound(wps["into rack"]),
+                SCRAP=bound(wps["over scrap"]),
+                **{f"PIECE_{i}": bound(wps[f"over piece {i}"]) for i in range(1, len(PIECES) + 1)},
+                REGION=fixed(ARM_REGION, ParamType.REGION),
+                RACK_POSE="RACK_POSE",
+            ),
+            m.node(
+                NodeKind.SEQUENCE,
+                "none: the next one",
+                m.move("step out of view", observe()),
+                _wait_for_part(m, subs, wps, "then the next part comes"),
+            ),
+        ),
+    )
     # Each part's cycle begins once its part has come (the first one's here) and ends when
     # the next one has; after a collision while recovering, it begins at once (the arm
     # came down on the robot at the exit: its part has come).
     tree = m.node(
-        NodeKind.SEQUENCE, "tend the wire bender",
+        NodeKind.SEQUENCE,
+        "tend the wire bender",
         m.instance(subs["ReRegisterRack"], "find the rack", RACK_POSE="RACK_POSE"),
         _wait_for_part(m, subs, wps, "the first part comes"),
-        m.node(NodeKind.ITERATOR, "every part",
-               m.node(NodeKind.FORCE_SUCCESS, "never stop",
-                      m.node(NodeKind.CATCH, "a collision while recovering",
-                             m.node(NodeKind.CATCH, "part, whatever happens",
-                                    _part_cycle(m, subs, wps), go_on, errors="any",
-                                    error="LAST_ERROR"),
-                             # The welding arm may come down on the robot feeling at the exit.
-                             m.instance(subs["ClearStopAndBackOff"], "clear it, back off",
-                                        SAFE=bound(observe())),
-                             errors="protective_stop"))),
-    )  # fmt: skip
+        m.node(
+            NodeKind.ITERATOR,
+            "every part",
+            m.node(
+                NodeKind.FORCE_SUCCESS,
+                "never stop",
+                m.node(
+                    NodeKind.CATCH,
+                    "a collision while recovering",
+                    m.node(
+                        NodeKind.CATCH,
+                        "part, whatever happens",
+                        _part_cycle(m, subs, wps),
+                        go_on,
+                        errors="any",
+                        error="LAST_ERROR",
+                    ),
+                    # The welding arm may come down on the robot feeling at the exit.
+                    m.instance(
+                        subs["ClearStopAndBackOff"], "clear it, back off", SAFE=bound(observe())
+                    ),
+                    errors="protective_stop",
+                ),
+            ),
+        ),
+    )
     return PlanSpec(
-        tree, "Wire-bender tending with recovery (section V-B, simulated cell)",
+        tree,
+        "Wire-bender tending with recovery (section V-B, simulated cell)",
         "The paper's wire-bender task composed from the shipped library, with recovery instead "
         "of the operator: the rack is found by its marker; for each part the robot waits until "
         "the bender's welding arm swings into an occupancy region and back out (WaitForPart), "
@@ -176,9 +244,14 @@ def tending() -> PlanSpec:
         "the rack, then the left piece of a scrap it cut short into the scrap bin); it "
         "never waits for the operator. Runs until stopped, on the simulated scene tending. "
         "Run it with: costar run example:tending.",
-        RunPolicy.ONCE, waypoints=waypoints(), objects=["tending_rack"], reset_cell=True,
-        scene="tending", id=stable_id(TENDING, "tending"), subtrees=list(subs.values()),
-    )  # fmt: skip
+        RunPolicy.ONCE,
+        waypoints=waypoints(),
+        objects=["tending_rack"],
+        reset_cell=True,
+        scene="tending",
+        id=stable_id(TENDING, "tending"),
+        subtrees=list(subs.values()),
+    )
 
 
 def main() -> None:

@@ -100,8 +100,10 @@ class PlanBuilder:
         if linear:
             params["mode"] = fixed("linear", ParamType.TEXT)
         if speed != 1.0:
-            params |= {"speed": fixed(speed, ParamType.NUMBER),
-                       "accel": fixed(speed, ParamType.NUMBER)}  # fmt: skip
+            params |= {
+                "speed": fixed(speed, ParamType.NUMBER),
+                "accel": fixed(speed, ParamType.NUMBER),
+            }
         return self.op("motion.move_to", name, **params)
 
     def instance(self, subtree: SubtreeSpec, name: str, /, **params: Binding | str) -> NodeSpec:
@@ -131,9 +133,15 @@ def port(name: str, ptype: ParamType, doc: str, default: Any = None) -> SubtreeP
 def subtree(key: str, name: str, description: str, tree: NodeSpec, **ports: Any) -> SubtreeSpec:
     """Version 1 of a shipped subtree; ``inputs`` and ``outputs`` are lists of ports."""
     return SubtreeSpec(
-        key, name, tree, 1, DATE, description,
-        inputs=ports.get("inputs", []), outputs=ports.get("outputs", []),
-    )  # fmt: skip
+        key,
+        name,
+        tree,
+        1,
+        DATE,
+        description,
+        inputs=ports.get("inputs", []),
+        outputs=ports.get("outputs", []),
+    )
 
 
 def write_library(folder: Path, subtrees: list[SubtreeSpec], root: Path) -> None:

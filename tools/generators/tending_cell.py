@@ -25,8 +25,11 @@ GRASP_Z, ABOVE_Z = 0.017, 0.12  # TCP: fingertips 2 mm above the table; clear of
 # it lay in the part), all bars along y, so the fingers close across them along x: the left
 # piece between the U's side bar and the step's end bar (the 85 mm stroke spans both), the
 # U's right side bar, the step's right end bar.
-PIECES = (((-0.058, -0.045), ACROSS_DOWN), ((0.076, -0.05), ACROSS_DOWN),
-          ((0.038, 0.036), ACROSS_DOWN))  # fmt: skip
+PIECES = (
+    ((-0.058, -0.045), ACROSS_DOWN),
+    ((0.076, -0.05), ACROSS_DOWN),
+    ((0.038, 0.036), ACROSS_DOWN),
+)
 ARM_REGION = Region((0.6, 0.28, 0.235), 0.05)  # the welding arm over the exit when it drops
 TOTE = (0.04, 0.0)  # the middle of the rack's tote (rack frame)
 OVER_RACK_Z, RACK_DROP_Z = 0.32, 0.235  # TCP, rack frame: the fingertips 2 cm over its rim
@@ -50,8 +53,10 @@ def observe() -> Waypoint:
     return Waypoint("observe", WaypointFrame.JOINTS, joints=JointConfig(OBSERVE_JOINTS))
 
 
-def _world(name: str, x: float, y: float, z: float, turn: tuple[float, ...]) -> Waypoint:
-    return Waypoint(name, WaypointFrame.WORLD, Pose((x, y, z), turn))  # type: ignore[arg-type]  # four values
+def _world(
+    name: str, x: float, y: float, z: float, turn: tuple[float, float, float, float]
+) -> Waypoint:
+    return Waypoint(name, WaypointFrame.WORLD, Pose((x, y, z), turn))
 
 
 def _on_rack(name: str, z: float) -> Waypoint:
@@ -86,17 +91,21 @@ class TendingMaker(PlanBuilder):
 
     def _take(self, above: str, at: str) -> NodeSpec:
         return self.node(
-            NodeKind.SEQUENCE, "take it",
+            NodeKind.SEQUENCE,
+            "take it",
             *self.feel(above, at),
             self.move("lift it", above, linear=True),
             self.op("gripper.is_holding", "still held"),
-        )  # fmt: skip
+        )
 
     def feel(self, above: Waypoint | str, at: Waypoint | str) -> list[NodeSpec]:
         """Over it, straight down, close, feel it held: something lies there."""
-        return [self.move("over it", above), self.move("down to it", at, linear=True),
-                self.op("gripper.close", "close on it"),
-                self.op("gripper.is_holding", "in the gripper")]  # fmt: skip
+        return [
+            self.move("over it", above),
+            self.move("down to it", at, linear=True),
+            self.op("gripper.close", "close on it"),
+            self.op("gripper.is_holding", "in the gripper"),
+        ]
 
     def piece(self, over: Waypoint | str, scrap: Waypoint | str) -> NodeSpec:
         """A piece of a broken weld from where it lies (the tool ``over`` it) into the
@@ -108,32 +117,41 @@ class TendingMaker(PlanBuilder):
         key = over if isinstance(over, str) else over.name.replace("over ", "").replace(" ", "_")
 
         def vertical(name: str, dz: float) -> NodeSpec:
-            return self.op("motion.move_relative", name, dz=fixed(dz, ParamType.NUMBER),
-                           speed=fast, accel=fast)  # fmt: skip
+            return self.op(
+                "motion.move_relative", name, dz=fixed(dz, ParamType.NUMBER), speed=fast, accel=fast
+            )
 
         return self.node(
-            NodeKind.TIMEOUT, f"{key.lower()}, {PIECE_TIME:g} s at most",
-            self.node(NodeKind.SEQUENCE, f"{key.lower()} into the scrap bin",
-                      self.op("gripper.open", "open"),
-                      self.move("over it", over, speed=DISCARD_SPEED),
-                      vertical("down to it", down),
-                      self.op("gripper.close", "close on it"),
-                      vertical("lift it", -down),
-                      self.op("gripper.is_holding", "a piece held"),
-                      self.move("over the scrap bin", scrap),
-                      self.op("gripper.open", "drop it into the bin")),
+            NodeKind.TIMEOUT,
+            f"{key.lower()}, {PIECE_TIME:g} s at most",
+            self.node(
+                NodeKind.SEQUENCE,
+                f"{key.lower()} into the scrap bin",
+                self.op("gripper.open", "open"),
+                self.move("over it", over, speed=DISCARD_SPEED),
+                vertical("down to it", down),
+                self.op("gripper.close", "close on it"),
+                vertical("lift it", -down),
+                self.op("gripper.is_holding", "a piece held"),
+                self.move("over the scrap bin", scrap),
+                self.op("gripper.open", "drop it into the bin"),
+            ),
             seconds=PIECE_TIME,
-        )  # fmt: skip
+        )
 
     def held_into_scrap(self, scrap: Waypoint | str) -> NodeSpec:
         """Whatever the gripper holds goes into the scrap bin (nothing to do if nothing)."""
         return self.node(
-            NodeKind.FORCE_SUCCESS, "what is held, into the scrap bin",
-            self.node(NodeKind.SEQUENCE, "drop it over the bin",
-                      self.op("gripper.is_holding", "something held"),
-                      self.move("over the scrap bin", scrap),
-                      self.op("gripper.open", "drop it into the bin")),
-        )  # fmt: skip
+            NodeKind.FORCE_SUCCESS,
+            "what is held, into the scrap bin",
+            self.node(
+                NodeKind.SEQUENCE,
+                "drop it over the bin",
+                self.op("gripper.is_holding", "something held"),
+                self.move("over the scrap bin", scrap),
+                self.op("gripper.open", "drop it into the bin"),
+            ),
+        )
 
 
 def bound(waypoint: Waypoint) -> Binding:
