@@ -60,6 +60,7 @@ _LET_UR_RTDE_TRY = 5.0  # s of a lost connection before ours (see _Recovery)
 # s after this program resumed from a stall longer than the watchdog's period in which a
 # script seen stopped is the watchdog's doing (it is seen at the first refresh after it).
 _STALL_WINDOW = 0.25
+_REARM_AFTER = 1.0  # s of a robot that can move before an unarmed watchdog is set again
 WATCHDOG_STOP = (
     "the arm stopped: this program did not answer the controller in time (its watchdog); "
     "the control script is started again"
@@ -249,6 +250,7 @@ class _Recovery:
     def __init__(self) -> None:
         self._next_try = 0.0
         self._lost_since: float | None = None
+        self._well_since: float | None = None  # the robot can move, the watchdog unarmed
         self.clearing = ""  # the stop or power loss being cleared ("" when none)
 
     def __call__(self, conn: URConnection) -> bool:
@@ -268,6 +270,7 @@ class _Recovery:
             # it answers again, so it is not dead: start the script again, as after a stop.
             self.clearing = WATCHDOG_STOP
             _log.warning("UR: %s", WATCHDOG_STOP)
+        self._rearm_watchdog(conn, now, problem)
         if now < self._next_try:
             return False
         try:
@@ -287,3 +290,18 @@ class _Recovery:
         except Exception as exc:  # the controller is not back yet: try again later
             _log.debug("UR recovery: %s", exc)
         return False
+
+    def _rearm_watchdog(self, conn: URConnection, now: float, problem: str) -> None:
+        """A connection that came back by ur_rtde's own reconnect, with its script running
+        on, has no watchdog kicked (kicks stop while it is away): set it again once all has
+        been well for a moment (ur_rtde's reconnect has then finished)."""
+        if problem or conn.watchdog_armed:
+            self._well_since = None
+        elif self._well_since is None:
+            self._well_since = now
+        elif now - self._well_since > _REARM_AFTER:
+            self._well_since = None
+            try:
+                conn.arm_watchdog()
+            except Exception as exc:  # gone again: the next quiet moment tries again
+                _log.debug("UR recovery: arming the watchdog: %s", exc)

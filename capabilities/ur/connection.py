@@ -345,9 +345,22 @@ class URConnection:
         while not self.state.program_running and time.monotonic() < deadline:
             time.sleep(0.005)
             self.refresh()
-        # Every new run of the script needs its own watchdog (a program stop removes it).
-        self._watchdog = bool(self.control.isProgramRunning()) and bool(
-            self.control.setWatchdog(WATCHDOG_HZ)
+        self.arm_watchdog()
+
+    @property
+    def watchdog_armed(self) -> bool:
+        """The control script's watchdog is set and this thread kicks it."""
+        return self._watchdog
+
+    def arm_watchdog(self) -> None:
+        """(I/O thread) Set the running script's watchdog and start kicking it. Every run of
+        the script needs its own (a program stop removes it), and so does a script that ran
+        on through a lost connection (kicks stop while the connection is away)."""
+        control = self.control
+        self._watchdog = (
+            control is not None
+            and bool(control.isProgramRunning())
+            and bool(control.setWatchdog(WATCHDOG_HZ))
         )
         self._last_kick = time.monotonic()
 
@@ -399,6 +412,12 @@ class URConnection:
             self.state = URState(connected=False, problem=ur_words(exc))
         if self.state.connected:
             self.last_heard = self.state
+        else:
+            # No more kicks until this connection is made afresh (start_control arms the
+            # watchdog again): a command sent while ur_rtde reconnects by itself makes it
+            # reconnect a second time, on this thread, and the two crash the process later.
+            # The controller's watchdog stops the script meanwhile, as a lost link should.
+            self._watchdog = False
 
     def _read_state(self) -> URState:
         receive, control = self.receive, self.control

@@ -311,6 +311,8 @@ def test_a_dropped_connection_holds_the_run_and_it_goes_on_once_reconnected(
         assert wait_for(lambda: executor.held.startswith("connection lost"), 20), executor.held
         result = executor.wait(60)  # the cell reconnects by itself, the run goes on
         assert result is not None and result.status is SUCCESS, (result, executor.held)
+        # No kicks while the link was away; the script's watchdog is kicked again after it.
+        assert wait_for(lambda: cell.connection.watchdog_armed, 20)
     reasons = [e.reason for e in events if isinstance(e, RunHeld)]
     assert reasons[-1] == "" and any(r.startswith("connection lost") for r in reasons)
     assert emulator.state()["q"] == pytest.approx(list(_joints(-0.6)), abs=0.01)
