@@ -130,7 +130,8 @@ class URConnection:
         self._closing = threading.Event()
         self._thread = threading.Thread(target=self._run, name="costar-ur-io", daemon=True)
         self._watchdog = False  # set on the running control script
-        self._last_kick = 0.0
+        self._last_kick = 0.0  # when the last kick began (kicks are rate-limited by it)
+        self._kicked = 0.0  # when the last kick ended
         self._halted = False  # close() halted the arm: no more work runs
         # Counts the control scripts this connection started: a move's monitor never stops
         # the arm through a script other than the one that ran its move.
@@ -267,9 +268,12 @@ class URConnection:
             or (not force and now - self._last_kick < _KICK_PERIOD)
         ):
             return
-        if now - self._last_kick > 1.0 / WATCHDOG_HZ:
+        # A stall is time this thread could not run since its last kick ended, not time
+        # spent inside a kick: ur_rtde waits in one for a script that just died (then the
+        # script's end is not the watchdog's doing).
+        if now - self._kicked > 1.0 / WATCHDOG_HZ:
             self.stalled_at = now
-            _log.info("the UR I/O thread stalled for %.2f s", now - self._last_kick)
+            _log.info("the UR I/O thread stalled for %.2f s", now - self._kicked)
         self._last_kick = now
         try:
             # A script that is not running would make ur_rtde print and wait: kick only one
@@ -278,6 +282,8 @@ class URConnection:
                 control.kickWatchdog()
         except Exception:  # a dead controller: the recovery monitor says so
             _log.debug("kicking the watchdog failed", exc_info=True)
+        finally:
+            self._kicked = time.monotonic()
 
     def halt(self) -> None:
         """(I/O thread) Stop the arm with a controlled deceleration, wait (bounded) until it
@@ -362,7 +368,7 @@ class URConnection:
             and bool(control.isProgramRunning())
             and bool(control.setWatchdog(WATCHDOG_HZ))
         )
-        self._last_kick = time.monotonic()
+        self._last_kick = self._kicked = time.monotonic()
 
     def reconnect(self) -> None:
         """(I/O thread) Drop the interfaces and connect afresh (the socket is really gone).
