@@ -42,7 +42,8 @@ PERCEPTION_S = 0.1  # simulated s a perception job takes in lockstep (a frame an
 @contextmanager
 def c_output_to_stderr() -> Iterator[None]:
     """Send what C code prints to stdout (pybullet's warnings) to stderr meanwhile, so that
-    stdout keeps the one JSON object of ``--json`` (cells of a pool started inside too)."""
+    stdout keeps the one JSON object of ``--json`` (cells of a pool started inside too).
+    """
     sys.stdout.flush()
     saved = os.dup(1)
     os.dup2(2, 1)
@@ -67,7 +68,8 @@ class TendingJob:
 
 def run_trial(job: TendingJob) -> dict[str, Any]:
     """One trial's counters (as JSON values), the failures that called the operator, the wall
-    time; a crash is reported as ``error`` (a bench goes on)."""
+    time; a crash is reported as ``error`` (a bench goes on).
+    """
     started = time.perf_counter()
     try:
         with SimCellSession(
@@ -105,7 +107,8 @@ def measure_tending(
 ) -> dict[str, Any]:  # fmt: skip
     """{"paper": {...}, "ours": {...}}: each plan's counters over ``trials`` trials
     (ours: {"skipped": why} while resources/examples/tending.costar.json does not exist;
-    a plan left out of ``only``: {"skipped": "not asked for"})."""
+    a plan left out of ``only``: {"skipped": "not asked for"}).
+    """
     asked = [name for name in PLANS if only is None or name in only]
     plans = [name for name in asked if PLANS[name].is_file()]
     work = [TendingJob(p, seed + i, parts, reset_s, speed) for p in plans for i in range(trials)]

@@ -79,7 +79,8 @@ def _renderers(cell: Any) -> dict[str, int]:
 
 def _first_pictures(window: Any, timeout: float = 60.0) -> float:
     """Seconds until the camera panel shows a picture of every camera: the live view's
-    renderers start once (a fresh process each), before either phase is measured."""
+    renderers start once (a fresh process each), before either phase is measured.
+    """
     cameras, started = window.cell_views.cameras, time.perf_counter()
     while len(cameras.shown) < len(cameras._pictures):
         _wait(0.1)
@@ -90,7 +91,8 @@ def _first_pictures(window: Any, timeout: float = 60.0) -> float:
 
 def _on_screen(window: Any) -> dict[str, list[int]]:
     """Sizes of the camera panel and the 3D view; raises unless both lie inside the window
-    (tabbed away or squeezed off it, they would be drawn where nobody sees them)."""
+    (tabbed away or squeezed off it, they would be drawn where nobody sees them).
+    """
     inside = window.rect()
     sizes: dict[str, list[int]] = {}
     for name, widget in (

@@ -57,7 +57,8 @@ _OPS = ("motion.move_to", "perception.detect_object", "gripper.close", "predicat
 
 def build_plan(count: int = 1000, seed: int = 1) -> PlanSpec:
     """A plan of ``count`` nodes: composites (about 30 %) and operation leaves with two
-    parameters each (a reference and a fixed value), attached at random composites."""
+    parameters each (a reference and a fixed value), attached at random composites.
+    """
     rnd = random.Random(seed)
     root = NodeSpec(NodeKind.SEQUENCE, name="bench root")
     composites = [root]
@@ -189,7 +190,8 @@ def run_bench(frames: int) -> dict[str, Any]:
 
 def measure_cell_views_in_a_process() -> dict[str, Any]:
     """bench/cell_views.py's figures; its own process, so that it gets the display's GL
-    (this one is offscreen) and a fresh simulated cell."""
+    (this one is offscreen) and a fresh simulated cell.
+    """
     env = dict(os.environ)
     if env.get("DISPLAY"):
         env["QT_QPA_PLATFORM"] = "xcb"

@@ -123,7 +123,6 @@ def measure_python_beside_the_world(cell: SimCell) -> dict[str, Any]:
 
 def measure_cup_to_bin(seed: int = 0) -> dict[str, Any]:
     """Real-time factor of the cup-to-bin plan run by the engine on a fresh simulated cell."""
-
     from capabilities.base import CapabilityRegistry
     from capabilities.sim.session import SimCellSession
     from engine.build import build_tree

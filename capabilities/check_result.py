@@ -1,5 +1,6 @@
 """What one check of ``costar doctor`` found (its own module: the computer's checks and a
-real cell's checks (:mod:`capabilities.ur.doctor`) both return it)."""
+real cell's checks (:mod:`capabilities.ur.doctor`) both return it).
+"""
 
 from __future__ import annotations
 

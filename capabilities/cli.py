@@ -67,7 +67,8 @@ def _load(path: str, registry: CapabilityRegistry, err: TextIO) -> PlanSpec | No
 
 def _open(args: argparse.Namespace, err: TextIO, start: bool) -> ClosableCell | None:
     """The cell the command asked for, or None after saying why it could not be opened.
-    The simulated cell opens ``--scene``, else the scene the plan was taught on."""
+    The simulated cell opens ``--scene``, else the scene the plan was taught on.
+    """
     plan = getattr(args, "plan", None)
     scene = args.scene or (plan_scene(plan) if plan else None)
     try:
@@ -136,7 +137,8 @@ _STOP_SIGNALS = ("SIGINT", "SIGTERM", "SIGHUP")  # Ctrl-C, kill, a closed termin
 
 def _install_interrupt(executor: Executor) -> Callable[[], None]:
     """Ctrl-C, SIGTERM and a closed terminal (SIGHUP) stop the run cleanly, halting what runs;
-    returns a function to undo it."""
+    returns a function to undo it.
+    """
     if threading.current_thread() is not threading.main_thread():
         return lambda: None
     signals = [getattr(signal, name) for name in _STOP_SIGNALS if hasattr(signal, name)]

@@ -163,7 +163,8 @@ def checks(extra: Sequence[Check] = ()) -> list[Check]:
 
 def cell_checks(args: argparse.Namespace) -> list[Check]:
     """The checks of the cell file ``--cell`` names: the file, the robot answering, each camera
-    giving a frame (:mod:`capabilities.ur.doctor`, imported only when a cell is named)."""
+    giving a frame (:mod:`capabilities.ur.doctor`, imported only when a cell is named).
+    """
     path = getattr(args, "cell", None)
     if not path:
         return []

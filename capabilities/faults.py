@@ -53,7 +53,8 @@ LOOKING = frozenset({"occupancy", "markers", "perception"})
 
 def hold_check(cell: object) -> HoldCheck | None:
     """The executor's hold check of a cell that holds runs (None for one that does not);
-    its stops spare the operations of the capabilities that only look."""
+    its stops spare the operations of the capabilities that only look.
+    """
     if not isinstance(cell, HoldsRuns):
         return None
     ask = cell.hold_reason

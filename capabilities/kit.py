@@ -77,7 +77,8 @@ def manifest(
 def stateful(cls: Callable[..., Any], *extra: Any) -> Callable[[CapabilityEnv], Any]:
     """The factory of an operation class whose first argument is the per-cell state:
     ``cap.add(IS_EMPTY, stateful(RegionCondition, False))`` makes
-    ``RegionCondition(env.state, False)`` for each leaf."""
+    ``RegionCondition(env.state, False)`` for each leaf.
+    """
     return lambda env: cls(env.state, *extra)
 
 

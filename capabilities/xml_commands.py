@@ -44,7 +44,8 @@ def _cmd_export(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 def _cmd_import(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Read the XML, check the plan as ``costar validate --cell none`` would (every operation
     counted as available: there is no cell) and only then write it: a file import writes
-    always loads and validates."""
+    always loads and validates.
+    """
     ok, invalid = args.exit_codes
     registry = CapabilityRegistry()
     try:

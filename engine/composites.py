@@ -82,7 +82,8 @@ class Selector(Node):
 
 class ParallelPolicy:
     """When a Parallel finishes: ``success`` is "all", "any" or a count M; ``failure`` is
-    "any" (= 1) or a count N."""
+    "any" (= 1) or a count N.
+    """
 
     __slots__ = ("failure", "success")
 
@@ -110,7 +111,8 @@ class ParallelPolicy:
 
 class Parallel(Node):
     """Ticks every unfinished child each tick; finishes by its policy and then halts the
-    children still running."""
+    children still running.
+    """
 
     kind = "parallel"
 
@@ -190,7 +192,8 @@ class ReactiveSequence(Node):
 
 class ReactiveSelector(Node):
     """A Selector whose condition children are re-checked every tick; when a higher
-    priority condition succeeds, the running lower-priority sibling is halted."""
+    priority condition succeeds, the running lower-priority sibling is halted.
+    """
 
     kind = "reactive_selector"
 

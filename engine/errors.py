@@ -1,5 +1,6 @@
 """The engine's exception base: catch :class:`EngineError` to catch anything the engine raises
-on purpose (a bad plan file, a plan that does not validate)."""
+on purpose (a bad plan file, a plan that does not validate).
+"""
 
 from __future__ import annotations
 

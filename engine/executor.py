@@ -175,7 +175,8 @@ class Executor:
 
     def step(self) -> None:
         """One tick while paused; ignored otherwise (a step asked for while running must not
-        turn into a surprise tick after a later pause)."""
+        turn into a surprise tick after a later pause).
+        """
         with self._cond:
             if self._state is not ExecutorState.PAUSED:
                 return
@@ -279,7 +280,8 @@ class Executor:
 
     def _held_now(self) -> bool:
         """Ask the hold check; throw a stop into the plan, or halt the running leaves when a
-        hold begins (engine thread)."""
+        hold begins (engine thread).
+        """
         if self._hold is None:
             return False
         try:

@@ -44,7 +44,8 @@ def stopped_leaves(leaves: list[Node], hold: Hold) -> list[Node]:
     """The running ``leaves`` the stop concerns: all but the operations of spared capabilities,
     unless nothing else runs. A robot stopped while the plan only watches was hit where it
     stood (a machine's arm came down on it): the watch is what the plan is doing then, so a
-    Catch around it must hear of the stop, or the run stays held with the robot in the way."""
+    Catch around it must hear of the stop, or the run stays held with the robot in the way.
+    """
     if not hold.spares:
         return leaves
     concerned = [leaf for leaf in leaves if getattr(leaf, "capability", "") not in hold.spares]

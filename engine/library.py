@@ -444,7 +444,8 @@ def _owner_text(lock: Path) -> str:
 
 def _is_stale(owner: dict[str, object] | None, age: float) -> bool:
     """A lock nobody holds: its process is gone from this host, it names no owner (and is not
-    being written), or it is older than any save takes."""
+    being written), or it is older than any save takes.
+    """
     if age > STALE_LOCK_SECONDS:
         return True
     if owner is None:
@@ -487,7 +488,8 @@ def _break_if_stale(lock: Path) -> bool:
 
 def _remove_temps_of(target: Path) -> None:
     """Remove the temporary files of ``target`` (called holding its lock: their writer held
-    it too, so it is gone)."""
+    it too, so it is gone).
+    """
     with contextlib.suppress(OSError):
         for path in target.parent.iterdir():
             match = _TEMP.fullmatch(path.name)
@@ -498,7 +500,8 @@ def _remove_temps_of(target: Path) -> None:
 
 def _remove_dead_temps(root: Path) -> None:
     """Remove the library's temporary files whose writer is gone: its lock is stale (a killed
-    save leaves both), or the file is older than any save takes."""
+    save leaves both), or the file is older than any save takes.
+    """
     if not root.is_dir():
         return
     now = time.time()

@@ -102,7 +102,8 @@ class Node:
     def abort(self, message: str, error: ErrorType) -> None:
         """Fail a RUNNING node from outside a tick (the executor throws a cell's stop into
         it): its work is halted and it latches FAILURE, which its parents see on the next
-        tick. Nothing happens to a node that is not running. Never raises."""
+        tick. Nothing happens to a node that is not running. Never raises.
+        """
         status = self.status
         if status is not RUNNING:
             return

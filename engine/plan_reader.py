@@ -407,7 +407,8 @@ def load_plan(path: str | os.PathLike[str], aliases: Mapping[str, str] | None = 
 def plan_scene(path: str | os.PathLike[str]) -> str | None:
     """The simulated scene a plan file names (its ``scene``), or None: what a cell must open
     before the plan is loaded. A file that cannot be read is left to :func:`load_plan`,
-    which says what is wrong with it."""
+    which says what is wrong with it.
+    """
     try:
         scene = read_json_file(path).get("scene")
     except (JsonFileError, AttributeError):

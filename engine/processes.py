@@ -1,5 +1,6 @@
 """Whether a process of this host still runs: the one check behind every stale lock and
-recovery file (a library save's lock, the Instructor's recovery sidecar)."""
+recovery file (a library save's lock, the Instructor's recovery sidecar).
+"""
 
 from __future__ import annotations
 

@@ -312,7 +312,8 @@ def _catch_reads(check: Check, node: NodeSpec, available: frozenset[str]) -> fro
 
 def _parallel_guarantee(node: NodeSpec, results: list[frozenset[str]]) -> frozenset[str]:
     """A name is guaranteed when any set of children that meets the success policy has a
-    child that writes it, i.e. fewer children than the policy needs leave it unwritten."""
+    child that writes it, i.e. fewer children than the policy needs leave it unwritten.
+    """
     policy = _setting(node, "success")
     need = len(results) if policy == "all" else 1 if policy == "any" else policy
     if not isinstance(need, (int, float)) or isinstance(need, bool):

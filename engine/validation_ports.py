@@ -227,7 +227,8 @@ def check_fixed(
 
 def check_named_operation(check: Check, node: NodeSpec, port: PortSpec, binding: Binding) -> None:
     """A port whose value is an operation id (``names_kind``): that operation must exist,
-    be of the kind the port names, be available and need no inputs."""
+    be of the kind the port names, be available and need no inputs.
+    """
     kind = port.names_kind
     assert kind is not None
     op_id = binding.value.strip() if isinstance(binding.value, str) else ""

@@ -155,7 +155,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _start_session(args: argparse.Namespace, speed: float | None) -> CellSession:
     """A session on the cell without a robot (opens at once), so that the window can show
-    before the cell asked for is open; the window then opens that one in the background."""
+    before the cell asked for is open; the window then opens that one in the background.
+    """
     session = CellSession(args.cell, seed=args.seed, scene=args.scene, speed=speed)
     session.open("none")
     return session
@@ -216,7 +217,8 @@ def _wait_for_cell(session: CellSession) -> None:
 
 def _wait_for_camera_pictures(window: MainWindow, timeout_s: float = 5.0) -> None:
     """Run the event loop until every camera of the cell shows a picture (bounded: a camera
-    that never sends one leaves its pane empty in the picture, as it would on screen)."""
+    that never sends one leaves its pane empty in the picture, as it would on screen).
+    """
     panel = window.cell_views.cameras
     cameras = set(camera_interfaces(window.session.cell))
     loop = QEventLoop()

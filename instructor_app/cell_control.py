@@ -122,7 +122,8 @@ class CellControl(QObject):
     def switch_cell(self, name: str) -> None:
         """Open another cell: a name, a cell file, or "" to ask for one (not while running,
         not while another opens). It opens in the background (see CellSession): the window
-        answers meanwhile, and the cell that was open stays in use until the new one is."""
+        answers meanwhile, and the cell that was open stays in use until the new one is.
+        """
         if self.session.opening:
             self._show_cell(self.session.opening)
             self.show_message(

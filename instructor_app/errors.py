@@ -1,5 +1,6 @@
 """The Instructor's exception root: catch :class:`InstructorError` to catch anything the
-application raises on purpose (a refused edit, an autosave that could not be written)."""
+application raises on purpose (a refused edit, an autosave that could not be written).
+"""
 
 from __future__ import annotations
 

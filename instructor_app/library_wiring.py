@@ -149,7 +149,8 @@ class LibraryController(QObject):
     def save_as_subtree(self, node_id: str, choices: SubtreeChoices) -> bool:
         """Save a node and those below it to the library, off the GUI thread; once saved, an
         instance takes their place and ``save_finished`` says so. False (and a message) when
-        the save is refused at once (a bad port, a save already under way)."""
+        the save is refused at once (a bad port, a save already under way).
+        """
         if self._saving:
             self.message.emit("Cannot save the subtree: another save is under way; try again")
             return False
@@ -214,7 +215,8 @@ class LibraryController(QObject):
 
     def shutdown(self) -> None:
         """Let a save under way finish on its thread (its file is written whole or not at
-        all); nothing new starts."""
+        all); nothing new starts.
+        """
         self._pool.shutdown(wait=False, cancel_futures=True)
 
     def detach(self, node_id: str) -> str | None:

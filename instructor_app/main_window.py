@@ -161,7 +161,8 @@ class MainWindow(QMainWindow):
     def arrange_cell_views(self) -> None:
         """Place the cameras and the 3D scene for the window's width (see
         window_layout.arrange_cell_views). Called when no saved layout is restored, and
-        after a resize for a picture."""
+        after a resize for a picture.
+        """
         arrange_cell_views(self, self.docks)
 
     def _action(self, name: str, text: str, slot: Any, shortcut: str = "") -> QAction:
@@ -476,7 +477,8 @@ class MainWindow(QMainWindow):
     def shutdown(self, keep_recovery: bool = False) -> None:
         """Stop the run, the robot's teaching commands, background drawing and autosave;
         with ``keep_recovery`` unsaved work stays in its recovery file (a signal ends the
-        program: nobody was asked to save)."""
+        program: nobody was asked to save).
+        """
         self.controller.shutdown()
         self.cell_views.stop()
         self.views.teacher.shutdown()

@@ -89,7 +89,8 @@ class PlanFiles(QObject):
 
     def save_plan(self) -> bool:
         """Save to the plan's file; asks for a new one (Save As) when it has none or when
-        it is a shipped example, which stays as shipped (also after a crash recovery)."""
+        it is a shipped example, which stays as shipped (also after a crash recovery).
+        """
         path = self.document.path
         if path is None or is_shipped_example(path):
             return self.save_plan_as()
@@ -118,7 +119,8 @@ class PlanFiles(QObject):
 
     def offer_recoveries(self) -> bool:
         """Offer the plans a crashed session left (newest first); True when one was restored.
-        Declined ones are deleted."""
+        Declined ones are deleted.
+        """
         restored = offer_recoveries(
             self.document,
             self.autosaver,

@@ -65,7 +65,8 @@ class Views:
 
 def offered_object_names(interfaces: Any) -> list[str]:
     """The object models a field offers: those the cell's scene has on the table first (what a
-    plan usually handles), then the rest of the library by name."""
+    plan usually handles), then the rest of the library by name.
+    """
     library = interfaces.get("objects")
     names = list(library.names()) if library is not None else []
     layout = interfaces.get("scene_layout") or {}
@@ -83,7 +84,8 @@ def make_views(
     document: PlanDocument, session: CellSession, parent: QWidget, data_folder: Path | None = None
 ) -> Views:
     """Create the canvas and the panels for ``document`` on the session's cell; caches (the
-    object thumbnails) go under ``data_folder`` (default: the user's cache folder)."""
+    object thumbnails) go under ``data_folder`` (default: the user's cache folder).
+    """
     from instructor_app.canvas import CanvasView
     from instructor_app.panels import (
         BlackboardPanel,

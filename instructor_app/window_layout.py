@@ -14,7 +14,8 @@ from instructor_app.views import Views
 
 class _Scrolled(QScrollArea):
     """A tall panel in a scroll area that asks for no more than a side column's width, so
-    that its tab squeezes neither the inspector nor the palette."""
+    that its tab squeezes neither the inspector nor the palette.
+    """
 
     def sizeHint(self) -> QSize:
         hint = super().sizeHint()
@@ -93,7 +94,8 @@ def place_docks(
 def arrange_cell_views(window: QMainWindow, docks: dict[str, QDockWidget]) -> None:
     """Cameras above the 3D scene in a column of their own right of the inspector when
     the window is wide enough for it (1700 px); tabs beside Plan, Waypoints and Operator
-    otherwise (the canvas and the inspector keep their room)."""
+    otherwise (the canvas and the inspector keep their room).
+    """
     if window.width() >= 1700:
         right, across = Qt.DockWidgetArea.RightDockWidgetArea, Qt.Orientation.Horizontal
         window.addDockWidget(right, docks["cameras"], across)  # a full-height column

@@ -1,5 +1,6 @@
 """File > Export / Import BehaviorTree.CPP XML: the plan as BehaviorTree.CPP v4 XML
-(engine.btcpp), for Groot2 and BehaviorTree.CPP, and such XML back as a new, unsaved plan."""
+(engine.btcpp), for Groot2 and BehaviorTree.CPP, and such XML back as a new, unsaved plan.
+"""
 
 from __future__ import annotations
 
@@ -44,7 +45,8 @@ def export_plan_xml(window: MainWindow) -> bool:
 
 def import_plan_xml(window: MainWindow) -> bool:
     """Ask for an XML file and open it as a new plan (unsaved, no file yet); on problems
-    show every one with its line and keep the open plan. False when nothing was imported."""
+    show every one with its line and keep the open plan. False when nothing was imported.
+    """
     if not window.maybe_save():
         return False
     chosen = window.dialogs.xml_open_path(window, window.settings.last_dir())

@@ -15,7 +15,8 @@ ROOT = Path(__file__).resolve().parents[1]
 def test_resources_holds_data_and_its_locator_only() -> None:
     """No generator in the shipped package: its only Python is resources/__init__.py (the
     generators of its files live in tools/generators, which nothing shipped imports: a
-    contract in pyproject.toml)."""
+    contract in pyproject.toml).
+    """
     code = sorted(str(p.relative_to(ROOT)) for p in (ROOT / "resources").rglob("*.py"))
     assert code == ["resources/__init__.py"]
 

@@ -39,7 +39,8 @@ def test_the_import_contracts_are_kept() -> None:
 
 def test_a_lazy_import_breaks_a_contract(tmp_path: Path) -> None:
     """The project's own layers contract, on a sample tree whose engine imports upward inside
-    a function."""
+    a function.
+    """
     settings = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
     layers = next(c for c in settings["tool"]["importlinter"]["contracts"] if c["type"] == "layers")
     for package in layers["layers"]:

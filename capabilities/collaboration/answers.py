@@ -82,7 +82,8 @@ class PromptAnswerer:
 
     def _match(self) -> None:
         """Give the lines read so far to the open prompts, oldest first; at the end of the
-        input, what is left open is answered no."""
+        input, what is left open is answered no.
+        """
         # Answered under the lock: two matches at once must not give one prompt two lines.
         unanswered: list[str] = []
         with self._lock:

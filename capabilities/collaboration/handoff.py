@@ -51,7 +51,8 @@ WAIT_SLICE_S = 0.002
 @dataclass(frozen=True)
 class ObjectMarkers:
     """An object model's markers: name, id -> (side in m, pose in the object frame), reach
-    (m from the object frame's origin to its farthest point, to size the crop)."""
+    (m from the object frame's origin to its farthest point, to size the crop).
+    """
 
     name: str
     markers: Mapping[int, tuple[float, Pose]]
@@ -65,7 +66,8 @@ def in_region(pose: Pose, region: Region) -> bool:
 
 def region_crop(frame: FrameLike, region: Region, grow: float) -> tuple[int, int, int, int] | None:
     """(x0, y0, x1, y1) of the image part where a sphere of ``region.radius + grow`` around
-    the region's centre can appear; None when it may cover the whole image."""
+    the region's centre can appear; None when it may cover the whole image.
+    """
     height, width = frame.rgb.shape[:2]
     centre = frame.T_world_camera.inverse().compose(Pose(region.center)).position
     radius = region.radius + grow

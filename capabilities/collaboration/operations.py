@@ -120,7 +120,8 @@ class ButtonPressed:
 
 class _ButtonJob(Job):
     """RUNNING until the button is pressed: a press finishes it at once from the thread that
-    pressed (no wait for the next tick); a timeout is checked on the cell's clock."""
+    pressed (no wait for the next tick); a timeout is checked on the cell's clock.
+    """
 
     def __init__(
         self, console: OperatorConsole, button: str, call: OperationCall, timeout: float

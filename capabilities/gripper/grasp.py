@@ -147,7 +147,8 @@ class Grasp:
         self, grasp: GraspSpec, object_class: str
     ) -> tuple[list[tuple[str, Callable[[], Job]]], Callable[[], bool]]:
         """The take steps and the held sensor of the grasp's tool, after checking that
-        tool is the one in hand; raises OperationFailed saying what to do first."""
+        tool is the one in hand; raises OperationFailed saying what to do first.
+        """
         suction = self._suction
         in_hand = suction is not None and suction.in_hand()
         if grasp.tool == "suction":

@@ -1,5 +1,6 @@
 """Operations of the gripper capability: open, close, is_closed, is_holding, and grasp (an
-object at its pose with a grasp of its model, :mod:`capabilities.gripper.grasp`)."""
+object at its pose with a grasp of its model, :mod:`capabilities.gripper.grasp`).
+"""
 
 from __future__ import annotations
 
@@ -81,7 +82,8 @@ def _suction(env: CapabilityEnv) -> HeldSuctionTool | None:
 
 def capability(symmetries: SymmetryTable | None = None) -> Capability:
     """The gripper capability (requires ``gripper`` and ``arm``; grasp reads ``suction``
-    when the cell has one)."""
+    when the cell has one).
+    """
     table = symmetries if symmetries is not None else SymmetryTable()
     cap = Capability(
         CAP,

@@ -63,7 +63,7 @@ class _Env:
         return camera(self.env, name)
 
     def markers_on_objects(self) -> dict[int, tuple[str, Pose]]:
-        """marker id -> (object model name, marker pose in the object frame)."""
+        """Marker id -> (object model name, marker pose in the object frame)."""
         found: dict[int, tuple[str, Pose]] = {}
         for name in self.library.names():
             for marker in self.library.get(name).markers:

@@ -64,7 +64,8 @@ class ArmBackend(Protocol):
     def clear_protective_stop(self) -> CommandHandleLike:
         """Unlock a protective stop once the robot allows it; the handle finishes when the
         arm can move again (at once when it is not stopped) and fails, in the fault's
-        words, on a stop only the operator may clear (an emergency stop, power off)."""
+        words, on a stop only the operator may clear (an emergency stop, power off).
+        """
         ...
 
 

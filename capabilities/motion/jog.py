@@ -162,7 +162,8 @@ class Jogger:
 
     def follow(self, handle: CommandHandleLike, released: threading.Event) -> str:
         """Wait for ``handle`` or ``released``; on release stop the arm. Returns the failure
-        message ("" when it arrived or was released)."""
+        message ("" when it arrived or was released).
+        """
         while not handle.done():
             if released.wait(_POLL_S):
                 handle.cancel()

@@ -73,7 +73,8 @@ class SymmetryTable:
 
     def grasp_names(self) -> tuple[str, ...]:
         """Every grasp name of the library's models, in first-seen order (a broken or
-        missing model is left out: using it says what is wrong)."""
+        missing model is left out: using it says what is wrong).
+        """
         names: dict[str, None] = {}
         with self._lock:
             library = self._library_now()

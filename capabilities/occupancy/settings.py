@@ -1,5 +1,6 @@
 """The occupancy capability's settings: a module of their own, without numpy, so that the
-capability's manifests load (``costar ops``, validation) without the point-cloud code."""
+capability's manifests load (``costar ops``, validation) without the point-cloud code.
+"""
 
 from __future__ import annotations
 

@@ -77,7 +77,8 @@ def score_recognitions(
 
 def visible_fraction(frame: FrameLike, model: ModelCloud, pose: Pose) -> float:
     """Share of the model's camera-facing surface at ``pose`` (world) that the frame sees
-    (its depth within 1 cm of the surface): 0 hidden or out of view, ~1 in plain view."""
+    (its depth within 1 cm of the surface): 0 hidden or out of view, ~1 in plain view.
+    """
     t = pose_to_matrix(pose)
     pts = model.points @ t[:3, :3].T + t[:3, 3]
     nrm = model.normals @ t[:3, :3].T

@@ -1,5 +1,6 @@
 """Point models of the object library: points sampled on each mesh, with normals, a
-nearest-neighbour index and FPFH features, built once per model and shared by threads."""
+nearest-neighbour index and FPFH features, built once per model and shared by threads.
+"""
 
 from __future__ import annotations
 

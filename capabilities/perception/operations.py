@@ -45,7 +45,8 @@ SOURCE_PREFIX = "perception:"
 
 class _Shared:
     """What the operations of one capability instance share: recognisers by object library,
-    trackers by (world model, camera). Weak keys: a closed cell takes its state with it."""
+    trackers by (world model, camera). Weak keys: a closed cell takes its state with it.
+    """
 
     def __init__(self) -> None:
         self._lock = threading.Lock()

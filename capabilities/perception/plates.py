@@ -120,7 +120,8 @@ def _hole_mismatch(model: ModelCloud, x: float, y: float, yaw: float, seen: np.n
 
 def _place(view: TopView, model: ModelCloud) -> tuple[float, float, float, float]:
     """(x, y, yaw, hole mismatch) of the model on the blob: the rectangle's centre, its long
-    side along the model's long side, and of the turns the one whose holes match best."""
+    side along the model's long side, and of the turns the one whose holes match best.
+    """
     (cu, cv), (w, h), angle = cv2.minAreaRect(view.outline.astype(np.float32))
     x, y = view.to_table(cu, cv)
     yaw = math.radians(angle) + (0.0 if w >= h else math.pi / 2)
@@ -137,7 +138,8 @@ def _place(view: TopView, model: ModelCloud) -> tuple[float, float, float, float
 
 def classify_plate(view: TopView, plates: list[ModelCloud]) -> PlateView | None:
     """The plate model with as many holes as the view shows (size as the tie-breaker and
-    as the fallback when the count matches no model); None when nothing fits the outline."""
+    as the fallback when the count matches no model); None when nothing fits the outline.
+    """
     if not plates:
         return None
     count = len(view.holes)

@@ -106,7 +106,8 @@ def free_space_consistency(
     scene: SceneCloud, model: ModelCloud, pose: np.ndarray, tolerance: float
 ) -> float:
     """Share of the model's camera-facing surface (at ``pose``, table frame) not contradicted
-    by the depth image: where the camera saw farther than the model surface, it is wrong."""
+    by the depth image: where the camera saw farther than the model surface, it is wrong.
+    """
     step = max(1, len(model.points) // _CHECK_POINTS)
     pts = model.points[::step] @ pose[:3, :3].T + pose[:3, 3]
     nrm = model.normals[::step] @ pose[:3, :3].T

@@ -71,7 +71,8 @@ class CollisionWorld:
 
     def distance(self, a: tuple[str, Pose], b: tuple[str, Pose]) -> float:
         """Signed distance (m) between two models at poses: negative when they overlap,
-        ``inf`` when more than 1 m apart. A name of ``TOOL`` is the tool at a TCP pose."""
+        ``inf`` when more than 1 m apart. A name of ``TOOL`` is the tool at a TCP pose.
+        """
         with self._lock:
             if self._client < 0:
                 raise PredicateError("the collision world is closed")

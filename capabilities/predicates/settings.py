@@ -1,5 +1,6 @@
 """The predicates capability's settings and relations: a module without numpy, so that the
-capability's manifests load (``costar ops``, validation) without its geometry."""
+capability's manifests load (``costar ops``, validation) without its geometry.
+"""
 
 from __future__ import annotations
 

@@ -28,7 +28,8 @@ def _wrist_mount(
 ) -> Pose:
     """The wrist camera in tool0 (z along the tool axis): beside the gripper on tool0's +x,
     image down toward the tool axis, tilted by ``tilt`` toward it so that the fingertips show
-    at the bottom of the image and the optical axis meets the tool axis ~0.3 m out."""
+    at the bottom of the image and the optical axis meets the tool axis ~0.3 m out.
+    """
     c, s = math.cos(tilt), math.sin(tilt)
     rot = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])  # 90 deg about z
     rot = rot @ np.array([[1.0, 0.0, 0.0], [0.0, c, s], [0.0, -s, c]])  # -tilt about x

@@ -225,7 +225,8 @@ def _source_json(c: CameraSettings) -> dict[str, str]:
 
 def _source(entry: JsonReader, base: CameraSettings) -> tuple[str, str]:
     """A camera's ``source``: {"kind": "sim"}, {"kind": "recorded", "path": FOLDER},
-    {"kind": "stream", "address": "HOST:PORT"} or {"kind": "realsense", "serial": SERIAL}."""
+    {"kind": "stream", "address": "HOST:PORT"} or {"kind": "realsense", "serial": SERIAL}.
+    """
     if not entry.has("source"):
         return base.source, base.where
     block = entry.child("source", ("kind", "path", "serial", "address"), ("kind",))

@@ -52,7 +52,8 @@ class BenderEvent:
     """What happened at simulated time ``time`` (ground truth, for tests and scores).
 
     ``kind`` is released (a part dropped onto the exit at ``pose``), weld_broke (a bad
-    weld came apart while lifted) or slipped (a bad grasp let the part go)."""
+    weld came apart while lifted) or slipped (a bad grasp let the part go).
+    """
 
     time: float
     kind: str
@@ -239,7 +240,8 @@ class WireBender(ScheduledActor[PlannedPart, BenderEvent]):
 
     def _slip(self, name: str) -> None:
         """The grasp lets go: the tool's hold on the part is gone and the part slides
-        ``SLIP`` down, out of the fingers, and falls."""
+        ``SLIP`` down, out of the fingers, and falls.
+        """
         client, body, model = self._client, self._scene.body_id(name), self._scene.model(name)
         for uid in self._holds_on(body):
             p.removeConstraint(uid, physicsClientId=client)
@@ -294,7 +296,8 @@ def _weld_station(model: ObjectModelSpec) -> Pose:
     """Where the bender holds a part while it welds, as the part's frame in the exit's: its
     weld bead (where the gripper's grasp closes) lies on the exit point, turned so that the
     grasp's fingers close along the exit's y, whatever the shape (one pick waypoint takes
-    every shape)."""
+    every shape).
+    """
     grasp = next((g for g in model.grasps if g.tool == "gripper"), model.grasp())
     x, y, _ = grasp.pose.position
     tool_x = quaternion_to_matrix(grasp.pose.orientation)[:, 0]

@@ -163,14 +163,16 @@ class SimCell:
 
     def sharing(self) -> AbstractContextManager[None]:
         """A block in which another thread computes: the world shares the GIL with it every
-        step (see ``PhysicsThread.sharing``)."""
+        step (see ``PhysicsThread.sharing``).
+        """
         return self._physics.sharing()
 
     @contextmanager
     def perceiving(self, latency: float) -> Iterator[None]:
         """A perception job in lockstep (another thread): simulated time stands still while
         the block runs, then goes on until ``latency`` simulated seconds have passed since it
-        began (so that perception polled without pause still lets time pass)."""
+        began (so that perception polled without pause still lets time pass).
+        """
         started = self.time()
         with self._physics.standing_still():
             yield

@@ -51,7 +51,8 @@ def shaded_colour(
     rgba: tuple[float, float, float, float], light_direction: tuple[float, float, float]
 ) -> np.ndarray:
     """The RGB (uint8) TinyRenderer gives the top of a box of colour ``rgba`` under this light:
-    rendered once, looking straight down at such a box, in a pybullet client of its own."""
+    rendered once, looking straight down at such a box, in a pybullet client of its own.
+    """
     client = p.connect(p.DIRECT)
     try:
         visual = p.createVisualShape(

@@ -87,7 +87,8 @@ class GripperController:
         """Forget a hold that is gone; attach an object both closing fingers touch.
 
         A hold is gone when its constraint is (the part came apart or slipped out); the
-        fingers then close on, but grasp anew only during a close command."""
+        fingers then close on, but grasp anew only during a close command.
+        """
         if self._constraint is not None and not self._hold_exists():
             self._constraint, self.attached = None, None
             self._collide_again()

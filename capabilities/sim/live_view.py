@@ -154,7 +154,8 @@ class _Mirror:
         ahead: bool = False,
     ) -> tuple[Any, Any]:
         """(the mirror's reply, ``pose()`` taken with its snapshot); ``ahead``: ask for the
-        next frame before returning, so that the mirror renders it while this one is shown."""
+        next frame before returning, so that the mirror renders it while this one is shown.
+        """
         with self._lock:
             conn = self._connection()
             try:
@@ -173,7 +174,8 @@ class _Mirror:
         self, conn: Connection, size: tuple[int, int], ahead: bool
     ) -> tuple[Any, Any] | None:
         """The frame asked for ahead, if this call wants one (``ahead``: a call without it
-        wants the cell now) and it has this size and is not stale."""
+        wants the cell now) and it has this size and is not stale.
+        """
         pending, self._pending = self._pending, None
         if pending is None:
             return None
@@ -207,7 +209,8 @@ class _Mirror:
 
     def _start(self) -> Connection:
         """Start the mirror process: a fresh interpreter (the caller's ``__main__`` is never
-        imported again, unlike multiprocessing's spawn) talking over a socket pair."""
+        imported again, unlike multiprocessing's spawn) talking over a socket pair.
+        """
         ours, theirs = socket.socketpair()
         env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
         self.process = subprocess.Popen(

@@ -1,5 +1,6 @@
 """Spawning the object library's models in pybullet (the library itself is cell-neutral:
-:mod:`capabilities.object_library`)."""
+:mod:`capabilities.object_library`).
+"""
 
 from __future__ import annotations
 

@@ -160,7 +160,8 @@ class PhysicsThread:
         """Simulated time stands still inside this block (any thread; blocks may nest and
         overlap): the world is not stepped, calls are still served. Lockstep for work that
         takes wall time on another thread (perception), so that the world does not go on
-        without it, however loaded the machine."""
+        without it, however loaded the machine.
+        """
         if self.in_thread():
             raise SimError("standing_still is for other threads than the physics thread")
         with self._hold_lock:
@@ -182,7 +183,8 @@ class PhysicsThread:
         """Another thread computes in Python inside this block (perception): the loop hands
         it the GIL after every step meanwhile. Without it, a thread that dropped the GIL for a
         moment (a numpy call) waited for the interpreter's switch interval (5 ms) to get it
-        back: a look that takes 1 s alone took 25 s beside a cell stepping as fast as it can."""
+        back: a look that takes 1 s alone took 25 s beside a cell stepping as fast as it can.
+        """
         with self._hold_lock:
             self._sharers += 1
         try:
@@ -194,7 +196,8 @@ class PhysicsThread:
     def add_gate(self, may_step: Callable[[], bool]) -> None:
         """Step the world only while ``may_step()`` (any thread's state; keep it cheap) says
         True: lockstep with another loop, e.g. an engine that must not fall behind. Whoever
-        changes what the gate reads calls :meth:`nudge`."""
+        changes what the gate reads calls :meth:`nudge`.
+        """
         self._gates.append(may_step)
 
     def track(self, handle: CommandHandle) -> None:
@@ -211,7 +214,8 @@ class PhysicsThread:
     def waited_on(self) -> bool:
         """True while a command is in flight or a thread waits for simulated time: as a gate,
         the world steps only then (a driven cell: each command starts at the step after the
-        one the last ended in, however long its sender took to send it)."""
+        one the last ended in, however long its sender took to send it).
+        """
         return self._in_flight > 0 or bool(self._timers)
 
     def nudge(self) -> None:

@@ -111,7 +111,7 @@ class SimRobot:
     def move_joints(
         self, q: Sequence[float], speed: float = 1.05, accel: float = 1.4
     ) -> CommandHandle:
-        """moveJ to joints ``q`` (rad) with joint speed (rad/s) and acceleration (rad/s^2)."""
+        """MoveJ to joints ``q`` (rad) with joint speed (rad/s) and acceleration (rad/s^2)."""
         problem = self._check_joints(q) or _check_limits(speed, accel)
         if problem:
             return CommandHandle.failed("move_joints", problem)
@@ -168,7 +168,8 @@ class SimRobot:
 
     def clear_protective_stop(self) -> CommandHandle:
         """Unlock a protective stop as soon as the unlock delay allows; the handle finishes
-        when the arm can move again (at once when it is not stopped)."""
+        when the arm can move again (at once when it is not stopped).
+        """
         handle = CommandHandle("clear_protective_stop")
         delay = self.unlock_delay
         return self._post(handle, lambda: self._ctl.clear_when_allowed(handle, delay))

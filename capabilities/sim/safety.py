@@ -85,7 +85,8 @@ class CollisionWatch:
         """After an unlock: the arm still presses on what stopped it (it holds the pose it
         was stopped in, within a fraction of a millimetre of it, with hundreds of N). While
         it backs out, that contact stops it only if it presses harder than now; once the
-        bodies part, the limit holds again."""
+        bodies part, the limit holds again.
+        """
         self._leaving = {}
         for (body, _), force in self._forces().items():
             self._leaving[body] = max(self._leaving.get(body, 0.0), force)

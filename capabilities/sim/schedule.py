@@ -48,7 +48,8 @@ class ScheduledActor(Generic[P, E]):
 
     def install(self, cell: Any, start: bool = True) -> None:
         """Join ``cell`` (a SimCell) and, with ``start``, start acting: times count from now
-        (simulated). Without it the actor waits for :meth:`start`."""
+        (simulated). Without it the actor waits for :meth:`start`.
+        """
 
         def attach(client: int) -> None:
             self._client = client

@@ -92,7 +92,8 @@ class SimCameraDevice:
 
     def capture(self, size: tuple[int, int] | None = None) -> RGBDFrame:
         """Render a frame; ``size`` (width, height) renders a smaller view of the same
-        camera (a live preview: the CPU renderer's cost grows with the pixels)."""
+        camera (a live preview: the CPU renderer's cost grows with the pixels).
+        """
         camera = self.camera if size is None else self._resized(size)
 
         def render(client: int) -> RGBDFrame:
@@ -291,7 +292,8 @@ class SimCellSession:
         marker sizes, which object carries which marker, the poses of the markers that never
         move (on the table, and on fixtures the scene file puts at one pose: a machine bolted
         down, measured once; the paper calibrated its cameras on the bender's), and the fixed
-        furniture (table, holster) as boxes."""
+        furniture (table, holster) as boxes.
+        """
         # Every marker the object library knows, not only those on objects present now: an
         # object handed in later must be recognised by its marker too.
         sizes = {m.marker_id: m.size for m in self.scene.fixed_markers.values()}
@@ -347,7 +349,8 @@ class SimCellSession:
 
     def status(self) -> CellStatus | None:
         """The robot's state for the status bar while it is stopped (None while it can move:
-        the simulated arm has no controller state worth a permanent label)."""
+        the simulated arm has no controller state worth a permanent label).
+        """
         stop = self.sim.robot.protective_stop()
         if stop is None:
             return None
@@ -363,7 +366,8 @@ class SimCellSession:
 
     def clear(self) -> None:
         """The operator's clear from the status bar: unlock the protective stop as soon as
-        the unlock delay allows (returns at once; the physics thread does it)."""
+        the unlock delay allows (returns at once; the physics thread does it).
+        """
         self.sim.robot.clear_protective_stop()  # finishes by itself once allowed
 
     def _body_name(self, body: int) -> str:

@@ -77,7 +77,8 @@ def _in_tote(tote: Mapping[str, Any], frame: Pose, where: Pose) -> bool:
 
 def _totes(client: int, scene: SceneState) -> list[tuple[str, Mapping[str, Any], Pose]]:
     """(object name, tote block, its frame now) of every object with a tote (rack, bins);
-    a tote without a ``rim`` height has its object's highest collision box as rim."""
+    a tote without a ``rim`` height has its object's highest collision box as rim.
+    """
     found = []
     for name in scene.names():
         model = scene.model(name)
@@ -92,7 +93,8 @@ def _totes(client: int, scene: SceneState) -> list[tuple[str, Mapping[str, Any],
 
 def _body_pose(client: int, body: int) -> Pose:
     """Where a piece is: the middle of its bounding box (its base frame is the frame of the
-    part it broke off, which may lie outside the piece)."""
+    part it broke off, which may lie outside the piece).
+    """
     lo, hi = p.getAABB(body, physicsClientId=client)
     middle = tuple((a + b) / 2 for a, b in zip(lo, hi, strict=True))
     return Pose(middle, (0.0, 0.0, 0.0, 1.0))
@@ -198,7 +200,8 @@ def lost_parts(
     client: int, bender: WireBender, scene: SceneState, removed: set[int]
 ) -> list[dict[str, Any]]:
     """What became of each lost part, in words (physics thread; for the bench's report):
-    its release time, its fault, and where it (or each of its pieces) is now."""
+    its release time, its fault, and where it (or each of its pieces) is now.
+    """
     events = bender.events()
     pieces = _pieces_by_part(bender, scene)
     faults = {e.part: e.kind for e in events if e.kind in (WELD_BROKE, SLIPPED)}

@@ -172,7 +172,8 @@ class TendingTrial:
 
     def _call(self, why: str, press: bool) -> None:
         """The operator is called now (comes ``reset_s`` later if present); ``press``: the
-        plan waits for Continue (a held run does not: a press would wait for the next)."""
+        plan waits for Continue (a held run does not: a press would wait for the next).
+        """
         now = self.session.clock()
         with self._lock:
             self.calls.append(now)
@@ -296,7 +297,8 @@ class TendingTrial:
 
     def lost(self) -> list[dict[str, object]]:
         """Each lost part's fault and whereabouts, with the failures around it (ground truth,
-        for the bench's report): the failures from 5 s before its release to 40 s after."""
+        for the bench's report): the failures from 5 s before its release to 40 s after.
+        """
         session, bender = self.session, self.session.bender
         assert bender is not None
         report = session.sim.call(

@@ -40,7 +40,8 @@ _TABLE_RGBA = (0.78, 0.7, 0.58, 1.0)
 @dataclass(frozen=True)
 class World:
     """Body ids and link indices of the fixed world (in the light world ``floor`` is -1 and
-    ``table`` draws only the table's sides: see :func:`light_surfaces`)."""
+    ``table`` draws only the table's sides: see :func:`light_surfaces`).
+    """
 
     robot: int
     arm_joints: tuple[int, ...]
@@ -116,7 +117,8 @@ def _table_extent(config: CellConfig) -> tuple[tuple[float, float], tuple[float,
 def light_surfaces(config: CellConfig) -> tuple[FlatSurface, ...]:
     """The light world's surfaces that are drawn, not rendered: the floor (a finite slab's
     top reaching past everything the cameras see of the floor, coloured like the mean of the
-    white and blue squares the renderer draws on the plane) and the table's top."""
+    white and blue squares the renderer draws on the plane) and the table's top.
+    """
     t = config.table
     floor_x, floor_y = _LIGHT_FLOOR_HALF
     x, y = _table_extent(config)

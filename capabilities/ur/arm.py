@@ -161,7 +161,8 @@ class URArm:
         it (5 s after the stop on a UR), and finish when the arm runs again (the control
         script uploaded again). At once when the arm can move. It fails with the fault's
         words on what only the operator may clear (an emergency stop, power off, a lost
-        connection), and with "timed out" after ``timeout`` s."""
+        connection), and with "timed out" after ``timeout`` s.
+        """
         handle = CommandHandle("clear_protective_stop", lambda h: None)  # the monitor sees it
         unlock = _Unlock(handle, time.monotonic() + timeout)
         self._submit(handle, lambda: self._conn.add_monitor(unlock))
@@ -216,7 +217,8 @@ class URArm:
 
         def send_when_idle(c: URConnection) -> bool:
             """A halted move's asynchronous stop may still decelerate the arm: its end would
-            end this move too (and look like it), so this one waits for it (bounded)."""
+            end this move too (and look like it), so this one waits for it (bounded).
+            """
             if handle.done():
                 return True
             if handle.cancel_requested:
@@ -270,7 +272,7 @@ class URArm:
         return self._freedrive
 
     def freedrive_status(self) -> int:
-        """getFreedriveStatus (PolyScope 5.10 and later). Blocks for the answer.
+        """GetFreedriveStatus (PolyScope 5.10 and later). Blocks for the answer.
 
         Raises:
             URError: an older controller (the message names the version needed).

@@ -180,7 +180,8 @@ class URCellSession:
     def clear(self) -> None:
         """The operator's clear of a control script that ended on its own (stopped on the
         pendant, a script error): upload it again. Returns at once (the I/O thread does it);
-        the hold lifts when the script runs."""
+        the hold lifts when the script runs.
+        """
         self.connection.submit(self.connection.start_control)
 
     def clear_protective_stop(self) -> None:
@@ -294,7 +295,8 @@ class _Recovery:
     def _rearm_watchdog(self, conn: URConnection, now: float, problem: str) -> None:
         """A connection that came back by ur_rtde's own reconnect, with its script running
         on, has no watchdog kicked (kicks stop while it is away): set it again once all has
-        been well for a moment (ur_rtde's reconnect has then finished)."""
+        been well for a moment (ur_rtde's reconnect has then finished).
+        """
         if problem or conn.watchdog_armed:
             self._well_since = None
         elif self._well_since is None:

@@ -217,7 +217,8 @@ class URConnection:
     def fault(self) -> str:
         """Why the robot cannot move now ("" when it can): :func:`fault_reason` of the last
         state, or a lost connection when that state, with no fault in it, is older than
-        ``SILENCE_S`` (the I/O thread has not heard from the controller since). Any thread."""
+        ``SILENCE_S`` (the I/O thread has not heard from the controller since). Any thread.
+        """
         state = self.state
         reason = fault_reason(state)
         silent = time.monotonic() - state.stamp
@@ -260,7 +261,8 @@ class URConnection:
 
     def kick(self, force: bool = False) -> None:
         """(I/O thread) Kick the control script's watchdog (at most every ``_KICK_PERIOD``
-        s unless ``force``); a long wait on the I/O thread calls it to keep the arm going."""
+        s unless ``force``); a long wait on the I/O thread calls it to keep the arm going.
+        """
         control, now = self.control, time.monotonic()
         if (
             not self._watchdog
@@ -288,7 +290,8 @@ class URConnection:
     def halt(self) -> None:
         """(I/O thread) Stop the arm with a controlled deceleration, wait (bounded) until it
         stands, then end the control script. Later work queued on the thread is refused.
-        Never raises: a controller that is gone stops the arm by itself (the watchdog)."""
+        Never raises: a controller that is gone stops the arm by itself (the watchdog).
+        """
         self._halted = True
         self._monitors.clear()
         control = self.control
@@ -327,7 +330,8 @@ class URConnection:
     def start_control(self, reupload: bool = False) -> None:
         """(I/O thread) Connect the control interface, or upload its script again: when it
         does not run, or with ``reupload`` (a stop ended it, though the controller may not
-        have said so yet)."""
+        have said so yet).
+        """
         import rtde_control
 
         if self.control is None:
@@ -361,7 +365,8 @@ class URConnection:
     def arm_watchdog(self) -> None:
         """(I/O thread) Set the running script's watchdog and start kicking it. Every run of
         the script needs its own (a program stop removes it), and so does a script that ran
-        on through a lost connection (kicks stop while the connection is away)."""
+        on through a lost connection (kicks stop while the connection is away).
+        """
         control = self.control
         self._watchdog = (
             control is not None

@@ -60,7 +60,8 @@ _WORDS: tuple[tuple[str, str], ...] = (
 
 def ur_words(exc: BaseException) -> str:
     """What went wrong in a ur_rtde call, in words a user of the cell reads (never ur_rtde's
-    own text: that goes to the log). Errors of this package keep their words."""
+    own text: that goes to the log). Errors of this package keep their words.
+    """
     if isinstance(exc, URError):
         return str(exc)
     logging.getLogger(__name__).info("ur_rtde said: %s: %s", type(exc).__name__, exc)

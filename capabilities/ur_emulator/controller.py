@@ -218,7 +218,8 @@ class EmulatedController:
 
     def inputs_pending(self) -> bool:
         """True while an RTDE client has sent bytes the emulator has not read yet: then a
-        silence is the emulator's own delay (a loaded machine), not the client's."""
+        silence is the emulator's own delay (a loaded machine), not the client's.
+        """
         with self._lock:
             conns = [c for c in self._input_sockets if c.fileno() >= 0]
         try:
@@ -342,7 +343,8 @@ class EmulatedController:
 
     def _watch(self, handle: CommandHandle) -> CommandHandle:
         """A move that fails on its own (unreachable, path error) ends the script, as on a UR;
-        a collision is the arm's protective stop, which the next cycle raises instead."""
+        a collision is the arm's protective stop, which the next cycle raises instead.
+        """
 
         def finished(h: CommandHandle) -> None:
             collided = self.cell.robot.protective_stop() is not None

@@ -141,7 +141,8 @@ class ControlProgram:
 
     def _watchdog_expired(self) -> bool:
         """True when the watched register was not written for a watchdog period: the
-        program stops, as rtde_set_watchdog's "stop" does (the arm halts with it)."""
+        program stops, as rtde_set_watchdog's "stop" does (the arm halts with it).
+        """
         if self._watchdog is None:
             return False
         register = f"input_int_register_{self._off}"

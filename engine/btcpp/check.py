@@ -101,7 +101,8 @@ _CHILD = re.compile(r"\.children\[(\d+)\]")
 
 def _json_path_line(path: str, imported: XmlImport) -> int:
     """The XML line of the part a plan file's JSON path names (``$.parameters[1]``,
-    ``$.subtrees[0].tree.children[2]``...): its element, else the nearest one above."""
+    ``$.subtrees[0].tree.children[2]``...): its element, else the nearest one above.
+    """
     plan, lines = imported.plan, imported.lines
     match = _PART.match(path or "")
     if match is None:

@@ -27,7 +27,8 @@ class XmlExportError(EngineError):
 @dataclass(frozen=True)
 class XmlProblem:
     """One thing wrong in an XML file: its line (0: the file as a whole, not read), what was
-    expected and what was there."""
+    expected and what was there.
+    """
 
     line: int
     expected: str

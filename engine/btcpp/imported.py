@@ -1,5 +1,6 @@
 """An imported plan with the XML line of each of its parts, so that what is found wrong
-with the plan later (by plan validation) is reported at a line of the file."""
+with the plan later (by plan validation) is reported at a line of the file.
+"""
 
 from __future__ import annotations
 

@@ -1,6 +1,7 @@
 """The ports of a subtree whose file declares no model for it (XML that BehaviorTree.CPP or
 Groot2 wrote keeps no ``<SubTree>`` model): the names its instances remap, read or written
-by the operations inside."""
+by the operations inside.
+"""
 
 from __future__ import annotations
 
@@ -51,7 +52,8 @@ def infer_subtree_ports(
 ) -> tuple[list[SubtreePort], list[SubtreePort]]:
     """(inputs, outputs) of a subtree from its instances and the nodes inside: a name an
     operation inside writes is an output of that port's type, any other an input, typed by
-    the first port that reads it (Text when none says)."""
+    the first port that reads it (Text when none says).
+    """
     names = _remapped(instances)
     written: dict[str, ParamType] = {}
     read: dict[str, ParamType] = {}

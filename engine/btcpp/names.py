@@ -80,7 +80,8 @@ def decode_id(model: str) -> str:
 def encode_port(port: str) -> str:
     """The attribute name of one of our port names. BehaviorTree.CPP takes a port name that
     starts with a letter, has no forbidden character and is not ``name`` or ``ID``; any other
-    (and one that starts with ``p_``) is written ``p_`` + :func:`encode_id`."""
+    (and one that starts with ``p_``) is written ``p_`` + :func:`encode_id`.
+    """
     plain = port[:1].isascii() and port[:1].isalpha() and is_model_name(port)
     if plain and port not in ("name", "ID") and not port.startswith("p_"):
         return port
@@ -108,7 +109,8 @@ def is_model_name(name: str) -> bool:
 def readable_tree_id(name: str, taken: set[str]) -> str:
     """A BehaviorTree id for a plan or subtree name that reads like it: characters other than
     letters and digits become ``_``; a clash with ``taken`` gets ``_2``, ``_3``... The name itself
-    is kept elsewhere in the file, so this need not be reversible."""
+    is kept elsewhere in the file, so this need not be reversible.
+    """
     words = re.findall(r"[^\W_]+", name)  # letters and digits, any script
     base = "_".join(words)
     if not base or not (base[0].isalpha() or base[0] == "_") or base in _RESERVED:

@@ -1,5 +1,6 @@
 """What BehaviorTree.CPP XML import reads besides the nodes: the TreeNodesModel, the plan's
-own data (``<CostarPlan>``) and subtree definitions; and the problem list every part adds to."""
+own data (``<CostarPlan>``) and subtree definitions; and the problem list every part adds to.
+"""
 
 from __future__ import annotations
 
@@ -31,7 +32,8 @@ __all__ = ["Model", "ReaderBase", "read_models"]
 @dataclass
 class Model:
     """A node model of the TreeNodesModel: its element (Action, Condition, SubTree...) and
-    port name -> (input_port/output_port/inout_port, our type, default text, doc)."""
+    port name -> (input_port/output_port/inout_port, our type, default text, doc).
+    """
 
     element: str
     ports: dict[str, tuple[str, ParamType, str | None, str]] = field(default_factory=dict)

@@ -90,7 +90,8 @@ class _Reader(ReaderBase):
 
     def _read_subtrees(self, trees: dict[str, Element], main_id: str | None) -> None:
         """Every tree but the main one into ``self.subtrees``: first their definitions and
-        ports, then their nodes (an instance is read once all trees are known)."""
+        ports, then their nodes (an instance is read once all trees are known).
+        """
         for tree_id, element in trees.items():
             if tree_id != main_id:
                 self.subtrees[tree_id] = sub = self._subtree(tree_id, element)

@@ -68,7 +68,8 @@ _BOOLS |= {"TRUE": True, "FALSE": False}
 
 def param_type_of_model(type_name: str | None) -> ParamType:
     """Our type of a TreeNodesModel port type (ours, or a C++ one); Text when unknown or
-    absent (BehaviorTree.CPP hands untyped ports their text)."""
+    absent (BehaviorTree.CPP hands untyped ports their text).
+    """
     if not type_name:
         return ParamType.TEXT
     for ptype, name in MODEL_TYPE.items():

@@ -203,7 +203,8 @@ class _Writer:
 
     def _bindings(self, node: NodeSpec, model: _Model, attrs: dict[str, str], path: str) -> None:
         """Ports as attributes; ``_types`` names the type of a fixed value whose type is
-        not the port's declared one (a port that takes several types)."""
+        not the port's declared one (a port that takes several types).
+        """
         other_types: list[str] = []
         for port, binding in sorted(node.params.items()):
             if binding.ref is None and binding.type is None and binding.value is None:

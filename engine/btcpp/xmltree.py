@@ -39,7 +39,8 @@ _CHUNK = 1 << 16
 
 class XmlSyntaxError(ValueError):
     """The text is not well-formed XML (or declares a DTD, or is beyond a limit); ``line``
-    is where."""
+    is where.
+    """
 
     def __init__(self, line: int, message: str) -> None:
         self.line = line

@@ -99,7 +99,8 @@ class _Fonts:
 
 def _bounds(width: float, height: float) -> QRectF:
     """The item's bounding rect: badges around the body, room above and below for the
-    taller zoomed-out box."""
+    taller zoomed-out box.
+    """
     top = -max(12.0, overview.GROW)
     bottom = height + max(10.0, overview.GROW)
     return QRectF(-12.0, top, width + 14.0, bottom - top)
@@ -118,7 +119,8 @@ def paint_port(painter: QPainter, rect: QRectF, info: dict[str, Any]) -> None:
 
 class TreePort(CustomPortItem):
     """A port whose change hook costs one comparison unless the port moved (Qt calls it for
-    every change of every item: tens of times per node while a plan opens)."""
+    every change of every item: tens of times per node while a plan opens).
+    """
 
     def itemChange(self, change: QGraphicsItem.GraphicsItemChange, value: Any) -> Any:
         if change == _MOVED and self._pipes:
@@ -128,7 +130,8 @@ class TreePort(CustomPortItem):
 
 class _TitleEditor(NodeTextItem):
     """NodeGraphQt's title editor, shown only while renaming; it reports the new name
-    through ``NodeViewer.node_name_changed`` and then goes away."""
+    through ``NodeViewer.node_name_changed`` and then goes away.
+    """
 
     def keyPressEvent(self, event: QKeyEvent) -> None:
         super().keyPressEvent(event)

@@ -31,7 +31,8 @@ def _font(height: float, scale: float) -> QFont:
 
 def lines(title: str, width: float, height: float, scale: float) -> list[str]:
     """``title`` wrapped at word breaks onto at most LINES lines of a box ``width`` wide,
-    the last one elided."""
+    the last one elided.
+    """
     metrics = QFontMetricsF(_font(height, scale))
     room = width - 2 * _SIDE
     result: list[str] = []
@@ -70,7 +71,8 @@ def paint(
     broken: QColor | None,
 ) -> None:
     """Paint the zoomed-out look: the box in ``fill``, the title in ``ink``, and a dashed
-    border in ``broken`` for a node that cannot run."""
+    border in ``broken`` for a node that cannot run.
+    """
     rect = box(title, body.width(), body.height(), scale)
     painter.fillRect(rect, fill)
     painter.save()

@@ -124,7 +124,8 @@ def look_of(
     node: NodeSpec, op_kind: OperationKind | None = None, unknown: bool = False
 ) -> NodeLook:
     """The look of ``node``; ``op_kind`` is its operation's kind when known, ``unknown``
-    says that the cell's registry has no such operation (the node is drawn as broken)."""
+    says that the cell's registry has no such operation (the node is drawn as broken).
+    """
     title = node.name or default_title(node)
     category = node.category
     if category is Category.COMPOSITE:

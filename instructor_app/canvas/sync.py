@@ -158,7 +158,8 @@ class GraphMirror:
 
     def _add_subtree(self, root: NodeSpec, parent_id: str | None) -> None:
         """Create the items of ``root`` and below, place them, then draw their links (a
-        link drawn before its ends are placed would be drawn again when they move)."""
+        link drawn before its ends are placed would be drawn again when they move).
+        """
         created: list[tuple[TreeNode, str | None]] = []
         overview = self.graph.viewer().overview_mode
         stack: list[tuple[NodeSpec, str | None]] = [(root, parent_id)]

@@ -185,7 +185,8 @@ class CanvasView(QWidget):
     def fit_all(self) -> None:
         """Zoom so that the whole tree shows, but not below MIN_FIT_ZOOM, where titles would
         be too small to read: a tree too large for that shows its top, around the root (the
-        rest is a scroll away)."""
+        rest is a scroll away).
+        """
         rect = QRectF()
         for node in self.mirror.nodes.values():
             if node.item.isVisible():
@@ -216,7 +217,8 @@ class CanvasView(QWidget):
 
     def action(self, name: str) -> QAction:
         """One of the canvas's QActions by role: delete, cut, copy, paste, duplicate,
-        move_left, move_right, toggle_collapse, auto_layout (``actions()`` lists them)."""
+        move_left, move_right, toggle_collapse, auto_layout (``actions()`` lists them).
+        """
         return self.commands.actions[name]
 
     # ------------------------------------------------------------------ document -> view
@@ -264,7 +266,8 @@ class CanvasView(QWidget):
 
     def _reparent(self, node_id: str, parent_id: str) -> None:
         """Make ``node_id`` the last child of ``parent_id`` (a drag onto a node, a new link);
-        its hand-placed position goes with the same undo step."""
+        its hand-placed position goes with the same undo step.
+        """
         doc = self.document
         try:
             current_parent, _, _ = doc.locate(node_id)

@@ -151,7 +151,8 @@ class SetLayoutCommand(_Command):
 
 class SetPlanFieldCommand(_Command):
     """Change a plan-wide field: name, description, run_policy, reset_cell, parameters,
-    waypoints, objects."""
+    waypoints, objects.
+    """
 
     FIELDS = (
         "name",

@@ -80,7 +80,8 @@ class PlanDocument(PlanModel):
 
     def move_node(self, node_id: str, parent_id: str, index: int) -> None:
         """Reparent or reorder; ``index`` counts in the new parent's children as they are
-        after the node was taken out."""
+        after the node was taken out.
+        """
         node = self.node(node_id)
         target = self.node(parent_id)
         if parent_id in tree_ops.subtree_ids(node):
@@ -119,7 +120,8 @@ class PlanDocument(PlanModel):
     ) -> None:
         """Put ``new`` in place of the plan's waypoint ``old_name`` (appended when there is
         none) and into every fixed binding that holds that waypoint, and bind it to the
-        port ``bind`` = (node id, port) if given: one undo step."""
+        port ``bind`` = (node id, port) if given: one undo step.
+        """
         waypoints = list(self.plan.waypoints)
         names = [w.name for w in waypoints]
         if new.name != old_name and new.name in names:

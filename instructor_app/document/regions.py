@@ -22,7 +22,8 @@ __all__ = ["plan_regions", "region_port", "save_region"]
 
 def plan_regions(plan: PlanSpec) -> list[tuple[str, Region]]:
     """(name, region) of every region the plan holds: its Region parameters first, then
-    the fixed Region bindings of nodes (named by the node's label)."""
+    the fixed Region bindings of nodes (named by the node's label).
+    """
     found: list[tuple[str, Region]] = [
         (decl.name, decl.value)
         for decl in plan.parameters

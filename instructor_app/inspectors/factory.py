@@ -56,7 +56,8 @@ def concrete_types(port: PortSpec) -> list[ParamType]:
 
 def default_value(ptype: ParamType, port: PortSpec | None, context: EditorContext) -> Any:
     """What a fresh editor of ``ptype`` shows: the port's default if it fits, else a neutral
-    value (None where there is nothing to offer, e.g. no waypoints in the plan)."""
+    value (None where there is nothing to offer, e.g. no waypoints in the plan).
+    """
     if port is not None and port.default is not None and check_value(ptype, port.default):
         return port.default
     if ptype is ParamType.TEXT and port is not None and port.choices:
@@ -82,7 +83,8 @@ def editor_for(
     parent: QWidget | None = None,
 ) -> ParamEditor:
     """A new editor for a value of ``param_type`` (for ``port``, whose unit and choices it
-    uses), showing the default value. Unknown types get a text field."""
+    uses), showing the default value. Unknown types get a text field.
+    """
     ptype = ParamType(param_type)
     if ptype is ParamType.TEXT and port is not None and port.choices:
         cls: type[ParamEditor] = ChoiceEditor

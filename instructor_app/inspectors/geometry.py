@@ -36,7 +36,8 @@ def _grid(owner: ParamEditor) -> QGridLayout:
 
 def _kept(spins: list[UnitSpinBox], stored: tuple[float, ...]) -> list[float]:
     """The SI values of the spins; a field whose display still matches its stored value
-    keeps the stored value exactly (the display is rounded)."""
+    keeps the stored value exactly (the display is rounded).
+    """
     values = []
     for spin, value in zip(spins, stored, strict=False):
         untouched = math.isclose(

@@ -1,5 +1,6 @@
 """Side panels of the Instructor: palette, inspector, validation, blackboard, log, the plan's
-settings, its waypoints and the subtree library."""
+settings, its waypoints and the subtree library.
+"""
 
 from __future__ import annotations
 

@@ -53,7 +53,7 @@ LIVE_FPS = 16.0
 
 
 def camera_interfaces(cell: Any) -> dict[str, Any]:
-    """name -> camera interface of the cell's ``rgbd:<name>`` interfaces."""
+    """Name -> camera interface of the cell's ``rgbd:<name>`` interfaces."""
     if cell is None:
         return {}
     return {k.split(":", 1)[1]: v for k, v in cell.interfaces().items() if k.startswith("rgbd:")}
@@ -278,7 +278,8 @@ class CameraPanel(QWidget):
 
     def snapshot(self, path: str | Path | None = None) -> Path | None:
         """Save the pictures shown now (colour and depth of each camera, overlays drawn) as
-        one PNG; asks for the file when ``path`` is None. Returns the file, or None."""
+        one PNG; asks for the file when ``path`` is None. Returns the file, or None.
+        """
         if not self.shown:
             self.message.emit("No camera picture to save yet")
             return None
@@ -306,7 +307,8 @@ class CameraPanel(QWidget):
 
     def begin_region(self, camera: str, u: float, v: float) -> bool:
         """Start a region at pixel (u, v) of a camera's picture: its centre is the point seen
-        there (the depth at that pixel, or the nearest valid one within a few pixels)."""
+        there (the depth at that pixel, or the nearest valid one within a few pixels).
+        """
         shown = self.shown.get(camera)
         if shown is None:
             return False

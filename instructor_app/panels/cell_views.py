@@ -1,6 +1,7 @@
 """The two views of the cell, the camera panel and the 3D scene, and what they share: the
 cell in use, the plan's regions and waypoints, and regions drawn by pointing (saved in the
-plan through the document, one undo command each)."""
+plan through the document, one undo command each).
+"""
 
 from __future__ import annotations
 

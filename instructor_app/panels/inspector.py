@@ -150,7 +150,8 @@ class InspectorPanel(QWidget):
 
     def set_problems(self, problems: Sequence[Problem]) -> None:
         """Mark the fields of the shown node that validation complains about
-        (connect ``ValidationPanel.problems_changed`` here)."""
+        (connect ``ValidationPanel.problems_changed`` here).
+        """
         self._problems = list(problems)
         self._mark_problems()
 

@@ -188,7 +188,8 @@ class ObjectLibraryPanel(QWidget):
     def add_from_mesh(self, mesh: str | Path, model: NewModel) -> bool:
         """Add a model to the user's library off the GUI thread (reading and writing a mesh
         takes a moment): ``models_changed`` when it is in, a message either way. False (and
-        a message) when it is refused at once."""
+        a message) when it is refused at once.
+        """
         if model.name in self.names():
             self.message.emit(f"Cannot add {model.name!r}: there is already a model of that name")
             return False

@@ -222,7 +222,8 @@ class Scene3DPanel(PointingMixin, QWidget):
 
     def draw_view_into(self, picture: QPixmap, top: QWidget) -> None:
         """Draw the 3D view into ``picture``, a ``grab()`` of ``top`` (a widget's grab leaves
-        the view out: it is a native window of its own)."""
+        the view out: it is a native window of its own).
+        """
         if self.view is None or not self.view_box.isVisible():
             return
         painter = QPainter(picture)
@@ -393,7 +394,8 @@ class Scene3DPanel(PointingMixin, QWidget):
 
     def _waypoint_pose(self, waypoint: Waypoint) -> Pose | None:
         """Where a waypoint is now, resolved as motion.move_to resolves it (a relative one
-        against the object or marker last seen); None when that cannot be told."""
+        against the object or marker last seen); None when that cannot be told.
+        """
         if waypoint.frame is WaypointFrame.JOINTS:
             fk = getattr(self.arm, "forward_kinematics", None)
             return fk(waypoint.joints.positions) if fk and waypoint.joints else None

@@ -63,7 +63,8 @@ def find_examples(folder: Path) -> list[Example]:
 
 def plan_preview(plan: PlanSpec, size: QSize = PREVIEW_SIZE) -> QPixmap:
     """A picture of the plan's tree: its boxes in their canvas colours, linked parent to child,
-    laid out as the canvas lays it out, scaled to fit ``size``."""
+    laid out as the canvas lays it out, scaled to fit ``size``.
+    """
     pixmap = QPixmap(size)
     pixmap.fill(_BACKGROUND)
     positions = tidy_layout(plan.tree, metrics=LayoutMetrics())

@@ -167,7 +167,8 @@ class WaypointsPanel(QWidget):
 
     def set_scene(self, scene: Any) -> None:
         """The 3D scene whose ghost arm (``show_ghost(joints | None)``) previews the selected
-        waypoint; None or a scene without OpenGL: no preview."""
+        waypoint; None or a scene without OpenGL: no preview.
+        """
         self.scene = scene if scene is not None and getattr(scene, "available", True) else None
         self._update_enabled()
 

@@ -188,7 +188,8 @@ class RunController(QObject):
     def reset_cell(self, scene: str = "") -> bool:
         """Put the cell back to its start (see CellSession.reset); False while a plan runs
         or a cell opens. ``scene``: the simulated scene to start from instead (the plan's
-        own)."""
+        own).
+        """
         if self.is_running or self.session.opening:
             return False
         if scene and self.session.name == "sim":
@@ -385,7 +386,7 @@ class RunController(QObject):
 
 
 def _depth_order(plan: PlanSpec) -> dict[str, tuple[int, int]]:
-    """node id -> (depth, position in tick order): the deepest, latest failure sorts last."""
+    """Node id -> (depth, position in tick order): the deepest, latest failure sorts last."""
     order: dict[str, tuple[int, int]] = {}
     stack = [(plan.tree, 0)] if plan.tree is not None else []
     while stack:

@@ -106,7 +106,8 @@ class CellClearButton(QToolButton):
     """The operator's clear of the robot's problem, labelled as the cell names it ("Restart
     control script", "Unlock protective stop"). Shown only while the cell offers one; the
     cell does the work on its own thread, so the click returns at once and a held run goes on
-    when the robot is ready."""
+    when the robot is ready.
+    """
 
     def __init__(
         self, session: CellSession, status: RobotStatusLabel, parent: QWidget | None = None

@@ -1,5 +1,6 @@
 """The run's controls and small views: Run/Pause/Step/Stop actions, the running-nodes list
-and the failure button of the status bar. They show the RunController; none runs anything."""
+and the failure button of the status bar. They show the RunController; none runs anything.
+"""
 
 from __future__ import annotations
 

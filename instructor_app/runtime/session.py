@@ -227,7 +227,8 @@ class CellSession(QObject):
         registry: CapabilityRegistry | None = None,
     ) -> None:
         """Make ``cell`` the one in use with ``registry`` (made here when None), tell the
-        views, then release the one before."""
+        views, then release the one before.
+        """
         old, self.cell, self.name = self.cell, cell, name
         self.registry = registry if registry is not None else self._registry_factory(cell)
         self.cell_changed.emit(name)
@@ -243,7 +244,8 @@ class CellSession(QObject):
         state of an earlier run. The simulated cell is opened again with the same scene and
         seed (robot at home, objects where the seed places them); a cell with a real robot
         is not reconnected (nothing puts a real robot back): only its registry is new.
-        Returns as :meth:`open`; False while a cell opens in the background."""
+        Returns as :meth:`open`; False while a cell opens in the background.
+        """
         if self._opening:
             return False
         if self.cell is not None and self.cell.name != "sim":
@@ -260,7 +262,8 @@ class CellSession(QObject):
 
     def close(self) -> None:
         """Release the open cell (its threads) and forget an opening under way (the worker
-        closes what it opened); safe to call twice."""
+        closes what it opened); safe to call twice.
+        """
         self._generation = next(self._generations)
         self._opening = ""
         cell, self.cell = self.cell, None

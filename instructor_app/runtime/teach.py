@@ -224,7 +224,8 @@ class RobotTeacher(QObject):
 
     def drag_to(self, pose: Pose) -> bool:
         """The tool follows a dragged pose (the newest one wins): in freedrive where the cell
-        can pull its arm by the tool (the simulated cell), else by joint moves through IK."""
+        can pull its arm by the tool (the simulated cell), else by joint moves through IK.
+        """
         arm = self._ready("arm")
         if arm is None:
             return False

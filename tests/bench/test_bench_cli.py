@@ -1,5 +1,6 @@
 """bench/cli.py keeps its shape: one run of each command and the peer gives one JSON object
-with wall time, CPU time, peak memory, ratios and the goal's verdicts (figures not asserted)."""
+with wall time, CPU time, peak memory, ratios and the goal's verdicts (figures not asserted).
+"""
 
 from __future__ import annotations
 

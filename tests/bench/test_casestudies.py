@@ -1,6 +1,7 @@
 """bench/casestudies.py keeps its shape: one JSON object with tending (the paper's plan and
 ours, Table I's counters), kitting and cup_to_bin, and Table I printed side by side. Tiny
-runs (one part, one seed): the goals are the bench's to measure, not asserted here."""
+runs (one part, one seed): the goals are the bench's to measure, not asserted here.
+"""
 
 from __future__ import annotations
 
@@ -38,7 +39,8 @@ def test_a_tiny_run_prints_one_json_object_of_every_case(
     casestudies: ModuleType, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """One part of the paper's plan (ours is left out: its own tests run it), one seed of
-    cup_to_bin."""
+    cup_to_bin.
+    """
     argv = ["--only", "tending", "--only", "cup_to_bin", "--plan", "paper", "--parts", "1",
             "--trials", "1", "--runs", "1", "--first-seed", "20", "--seed", "900", "--json"]  # fmt: skip
     assert casestudies.main(argv) == 0

@@ -1,5 +1,6 @@
 """bench/soak.py keeps its shape: a very short soak prints one JSON object with memory
-samples and growth, stalls, tick figures and Table I's counters (figures not asserted)."""
+samples and growth, stalls, tick figures and Table I's counters (figures not asserted).
+"""
 
 from __future__ import annotations
 

@@ -1,5 +1,6 @@
 """Regressions found by an outside test of the engine (issue 8, item 7): deep values, file
-names as given, problem lines that name the file."""
+names as given, problem lines that name the file.
+"""
 
 from __future__ import annotations
 

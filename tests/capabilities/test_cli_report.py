@@ -1,5 +1,6 @@
 """``costar run`` reads like the GUI: values in mm and degrees, and a success that came through
-a fallback names the nodes that failed on the way."""
+a fallback names the nodes that failed on the way.
+"""
 
 from __future__ import annotations
 

@@ -1,5 +1,6 @@
 """The command line on the shipped plans: the simulated cell by default, ``example:NAME``,
-``costar examples``, and no library banner in the output."""
+``costar examples``, and no library banner in the output.
+"""
 
 from __future__ import annotations
 

@@ -78,7 +78,8 @@ def test_commands_without_a_cell_import_no_heavy_library(tmp_path: Path) -> None
 
 def test_every_capability_lists_its_operations_without_a_cell() -> None:
     """The manifests stay available with the heavy libraries left out: every capability
-    registered, each with its operations (the vision and geometry ones included)."""
+    registered, each with its operations (the vision and geometry ones included).
+    """
     from capabilities.base import CapabilityRegistry
 
     registry = CapabilityRegistry()

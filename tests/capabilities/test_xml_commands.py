@@ -1,5 +1,6 @@
 """``costar export-xml`` / ``import-xml`` with the installed capabilities, and XML that
-BehaviorTree.CPP 4.10 itself wrote (tests/engine/data/btcpp, see the README there)."""
+BehaviorTree.CPP 4.10 itself wrote (tests/engine/data/btcpp, see the README there).
+"""
 
 from __future__ import annotations
 
@@ -75,7 +76,8 @@ def test_export_errors_name_the_file(tmp_path: Path) -> None:
 
 def test_btcpp_tree_nodes_model_declares_our_operations_as_we_read_them() -> None:
     """tree_nodes_model.xml is BehaviorTree.CPP's writeTreeNodesModelXML of a factory that
-    registered our operations with their ports: each model is read back as the operation."""
+    registered our operations with their ports: each model is read back as the operation.
+    """
     root = parse((BTCPP_DATA / "tree_nodes_model.xml").read_text(encoding="utf-8"))
     models = root.children[0].children
     manifests = operation_manifests()
@@ -120,7 +122,8 @@ def _shape(
 ) -> Any:
     """Kind, operation (or subtree name), bindings and children; with ``defaults_of``
     (manifests), a fixed binding equal to its port's default counts as unbound
-    (BehaviorTree.CPP writes them)."""
+    (BehaviorTree.CPP writes them).
+    """
     params = dict(node.params)
     if plan is not None and node.subtree is not None:
         sub = plan.subtree(node.subtree)
@@ -135,7 +138,8 @@ def _shape(
 
 def test_a_tree_btcpp_wrote_after_loading_our_export_imports_as_the_plan() -> None:
     """cup_to_bin_written_by_btcpp.xml: our export of cup_to_bin loaded by BehaviorTree.CPP
-    4.10 and written back with its WriteTreeToXML (its names, no _uid, its own model)."""
+    4.10 and written back with its WriteTreeToXML (its names, no _uid, its own model).
+    """
     written = (BTCPP_DATA / "cup_to_bin_written_by_btcpp.xml").read_text(encoding="utf-8")
     assert "_uid" not in written
     manifests = operation_manifests()
@@ -149,7 +153,8 @@ def test_a_tree_btcpp_wrote_after_loading_our_export_imports_as_the_plan() -> No
 def test_a_plan_with_subtrees_btcpp_wrote_imports_with_the_remapping() -> None:
     """kitting_written_by_btcpp.xml: our export of the kitting plan loaded and written back by
     BehaviorTree.CPP 4.10, which keeps one BehaviorTree per instance and no SubTree models:
-    the subtrees' ports come from the remapping and the operations inside."""
+    the subtrees' ports come from the remapping and the operations inside.
+    """
     written = (BTCPP_DATA / "kitting_written_by_btcpp.xml").read_text(encoding="utf-8")
     manifests = operation_manifests()
     plan = import_xml(written, "kitting.xml", manifests)

@@ -1,5 +1,6 @@
 """``costar import-xml`` writes only plans the project accepts, reads big files in linear time
-and bounded memory, and answers any bytes with exit 0 or 2 (issue 23, items 3 and 4)."""
+and bounded memory, and answers any bytes with exit 0 or 2 (issue 23, items 3 and 4).
+"""
 
 from __future__ import annotations
 

@@ -1,5 +1,6 @@
 """Fixtures of the engine tests; the fakes themselves live in ``bt_fakes`` (a module with a
-unique name, so test modules can import them whatever other conftest files are loaded)."""
+unique name, so test modules can import them whatever other conftest files are loaded).
+"""
 
 from __future__ import annotations
 

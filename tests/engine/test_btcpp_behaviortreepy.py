@@ -2,7 +2,8 @@
 BehaviorTree.CPP 4.8.2): each logic node mapped to a built-in gives the outcome our engine
 gives for the same plan. behaviortreepy registers nodes without ports, so the leaves here are
 the port-less ``debug.succeed`` and ``debug.fail``; Iterator and Enforce (no built-in twin)
-and port checks are tested with BehaviorTree.CPP 4.10 in test_btcpp_real.py."""
+and port checks are tested with BehaviorTree.CPP 4.10 in test_btcpp_real.py.
+"""
 
 from __future__ import annotations
 

@@ -315,7 +315,8 @@ def test_a_bad_value_text_says_what_was_expected(
 
 def test_damaged_files_give_problems_never_other_exceptions() -> None:
     """Every attribute value of an exported plan replaced in turn with junk: the import
-    succeeds or raises XmlFileError (a broken file never crashes the app)."""
+    succeeds or raises XmlFileError (a broken file never crashes the app).
+    """
     text = export_xml(_kitting(), {})
     junk = ["", "{", "nan", "-1", "json:{", "1;2", "{=}", "x" * 3, "_5g_", "inf", "true"]
     rng = random.Random(3)
@@ -334,7 +335,8 @@ def test_damaged_files_give_problems_never_other_exceptions() -> None:
 
 def test_every_field_of_the_spec_is_carried() -> None:
     """A new field of the plan spec must be taught to engine.btcpp (writer and read_parts),
-    or the XML round trip silently drops it: this test names the fields it knows."""
+    or the XML round trip silently drops it: this test names the fields it knows.
+    """
     carried = {
         PlanSpec: {"tree", "name", "description", "run_policy", "reset_cell", "scene"}
         | {"parameters", "waypoints", "objects", "layout", "id", "subtrees"},
@@ -363,7 +365,8 @@ def test_text_xml_cannot_hold_is_refused_by_node(text: str) -> None:
 
 def _nested() -> PlanSpec:
     """A subtree holding instances of another, two versions of one subtree, and a plan named
-    like one of its subtrees."""
+    like one of its subtrees.
+    """
     msg = [SubtreePort("MSG", ParamType.TEXT)]
     log = NodeSpec(NodeKind.OPERATION, op="debug.log", params={"message": Binding.reference("MSG")})
     inner = SubtreeSpec(id="a.inner", name="Inner", tree=log, inputs=msg)

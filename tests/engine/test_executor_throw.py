@@ -96,7 +96,8 @@ def test_a_stop_is_held_when_one_running_leaf_has_no_catch() -> None:
 
 def test_a_stop_spares_the_leaves_of_the_capabilities_that_only_look() -> None:
     """A camera's watch beside a caught move (a Parallel): the stop is thrown into the move
-    only; the watch has no Catch of its own and goes on, and finishes the run."""
+    only; the watch has no Catch of its own and goes on, and finishes the run.
+    """
     ctx = TreeContext()
     catch, move, handler = caught_move(ctx, {ErrorType.PROTECTIVE_STOP})
     watch = JobOperation()
@@ -177,7 +178,8 @@ def test_a_node_that_failed_with_the_stop_first_is_not_held_while_its_handler_ru
 def test_a_stop_while_the_plan_only_watches_is_thrown_into_the_watch() -> None:
     """Nothing but a camera's watch runs when the robot is hit where it stands (a machine's
     arm came down on it): the Catch around the watch gets the stop and its handler moves the
-    robot away, instead of a run held with the robot in the way."""
+    robot away, instead of a run held with the robot in the way.
+    """
     ctx = TreeContext()
     watch, handler = JobOperation(), JobOperation()
     seeing = OperationLeaf(ctx, "watch", "watch", OperationKind.ACTION, watch,

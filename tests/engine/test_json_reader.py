@@ -1,5 +1,6 @@
 """The one reader of user JSON files: loading refusals and typed access, each error with the
-file as given, the JSON path and what was expected."""
+file as given, the JSON path and what was expected.
+"""
 
 from __future__ import annotations
 

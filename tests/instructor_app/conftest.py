@@ -1,5 +1,6 @@
 """Fixtures of the Instructor's tests: a cell session without a robot, temporary settings
-and recovery folders, and dialogs that answer without a person."""
+and recovery folders, and dialogs that answer without a person.
+"""
 
 from __future__ import annotations
 

@@ -156,7 +156,8 @@ class CountingBot:
 
 def _count(qtbot: Any, what: str, at: object = None) -> None:
     """Count an action done without qtbot (opening a list, a file dialog's choice);
-    ``at`` is where the user's hands are after it."""
+    ``at`` is where the user's hands are after it.
+    """
     if isinstance(qtbot, CountingBot):
         qtbot.count(what, at)
 
@@ -208,7 +209,8 @@ def add_from_palette(qtbot: Any, window: MainWindow, key: str) -> str:
 
 def search_insert(qtbot: Any, window: MainWindow, text: str, expect: str) -> str:
     """Type ``text`` into the palette's search field and press Enter (search-to-insert);
-    checks that the node added is ``expect`` (an operation id or a kind) and returns its id."""
+    checks that the node added is ``expect`` (an operation id or a kind) and returns its id.
+    """
     before = _ids(window)
     field = window.views.palette.search_field
     _replace_text(qtbot, field, text)
@@ -221,7 +223,8 @@ def search_insert(qtbot: Any, window: MainWindow, text: str, expect: str) -> str
 
 def search_down_insert(qtbot: Any, window: MainWindow, text: str, expect: str) -> str:
     """Type ``text`` into the palette's search field, press Down until the current hit is
-    ``expect`` (an operation id or a kind), then Enter; the added node's id."""
+    ``expect`` (an operation id or a kind), then Enter; the added node's id.
+    """
     before = _ids(window)
     palette = window.views.palette
     _replace_text(qtbot, palette.search_field, text)
@@ -253,7 +256,8 @@ def double_click_palette(qtbot: Any, window: MainWindow, key: str) -> str:
 
 def select(window: MainWindow, node_id: str, qtbot: Any = None) -> None:
     """Select a node on the canvas (as a click on it would; counted as one when ``qtbot``
-    counts and the node was not selected yet)."""
+    counts and the node was not selected yet).
+    """
     if window.views.canvas.selected_ids() != [node_id]:
         _count(qtbot, "click a node")
     window.views.canvas.select(node_id)
@@ -306,7 +310,8 @@ def set_value(
     ptype: ParamType | None = None,
 ) -> None:
     """Give a port a fixed value: choose "value" (and the type), then enter the value in
-    its editor as a user would (type it, or pick it from the combo)."""
+    its editor as a user would (type it, or pick it from the combo).
+    """
     select(window, node_id, qtbot)
     row: PortRow = window.views.inspector.port_row(port)
     choose_index(qtbot, row.mode_combo, MODE_VALUE)
@@ -377,7 +382,8 @@ def choose_index(qtbot: Any, combo: QComboBox, index: int) -> None:
 
 def plan_panels(window: MainWindow) -> tuple[PlanSettingsPanel, WaypointsPanel]:
     """The window's plan settings and waypoints panels; docked here if the window has none
-    yet (as the window does it: registry changes reach the waypoints panel)."""
+    yet (as the window does it: registry changes reach the waypoints panel).
+    """
     settings = window.findChild(PlanSettingsPanel)
     if settings is None:
         settings = PlanSettingsPanel(window.document, window)

@@ -1,5 +1,6 @@
 """costar-instructor --cell: the cell opens after the window shows, and --screenshot waits for
-it (a run for the picture needs the arm), also when it fails (a UR host that does not answer)."""
+it (a run for the picture needs the arm), also when it fails (a UR host that does not answer).
+"""
 
 from __future__ import annotations
 

@@ -1,5 +1,6 @@
 """A real crash: an Instructor process is killed (SIGKILL) after its autosave; the next start
-offers the recovery file and restores the edits."""
+offers the recovery file and restores the edits.
+"""
 
 from __future__ import annotations
 

@@ -73,7 +73,8 @@ def _node(window: MainWindow, name: str) -> NodeSpec:
 
 def _save_part_with_open_message(qtbot: Any, window: MainWindow) -> str:
     """Select "part", open Save as subtree, tick its message as the input MESSAGE and OUT as
-    an output, save; returns the instance's id once the save is over."""
+    an output, save; returns the instance's id once the save is over.
+    """
     with qtbot.waitSignal(window.library.save_finished, timeout=20000) as finished:
         _ask_to_save_part(window)
     assert finished.args[0] is not None, "the save failed"
@@ -82,7 +83,8 @@ def _save_part_with_open_message(qtbot: Any, window: MainWindow) -> str:
 
 def _ask_to_save_part(window: MainWindow, folder: str = "tests") -> None:
     """Select "part" and save it as a subtree (MESSAGE open, OUT an output) in ``folder``; the
-    save runs on."""
+    save runs on.
+    """
     shown: list[SaveSubtreeDialog] = []
 
     def dialog(*args: Any) -> SaveSubtreeDialog:

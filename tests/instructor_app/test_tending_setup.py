@@ -225,7 +225,8 @@ def _teach_by_drag(
 ) -> None:
     """Drag the tool in the 3D scene to ``to`` and let go (one action: the drag): up, across
     and down again, as a hand carries it over the cell; the arm follows the hand (the
-    simulated cell's freedrive) and comes to rest where it let go."""
+    simulated cell's freedrive) and comes to rest where it let go.
+    """
     hands.count("drag the tool")
     arm = window.session.cell.interfaces()["arm"]
     start = arm.tcp_pose()

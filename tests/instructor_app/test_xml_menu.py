@@ -1,5 +1,6 @@
 """File > Export / Import BehaviorTree.CPP XML, through the menu actions and a patched
-file dialog."""
+file dialog.
+"""
 
 from __future__ import annotations
 

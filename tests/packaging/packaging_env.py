@@ -1,6 +1,7 @@
 """Helpers of the packaging tests (a module with a unique name, so tests import it whatever
 other conftest files are loaded): the sources as a clone has them, offline pip, and fresh
-environments that reuse this environment's dependencies (no download of Open3D and the like)."""
+environments that reuse this environment's dependencies (no download of Open3D and the like).
+"""
 
 from __future__ import annotations
 
@@ -57,7 +58,8 @@ def clean_env(**extra: str) -> dict[str, str]:
 
 def build_wheel(source: Path, dist: Path) -> Path:
     """Copy the sources into ``source`` (so no build/ litters the repository), build the wheel
-    into ``dist`` and return it."""
+    into ``dist`` and return it.
+    """
     for name in source_files():
         (source / name).parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(REPO_ROOT / name, source / name)

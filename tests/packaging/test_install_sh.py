@@ -1,5 +1,6 @@
 """``packaging/install.sh`` in a temporary home: the environment, the two commands on the
-PATH, the menu entry with its icon; run again it upgrades; ``--uninstall`` removes it all."""
+PATH, the menu entry with its icon; run again it upgrades; ``--uninstall`` removes it all.
+"""
 
 from __future__ import annotations
 

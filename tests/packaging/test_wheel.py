@@ -1,5 +1,6 @@
 """The wheel carries every shipped file: installed into a fresh environment in another folder,
-``costar run example:cup_to_bin --seed 3`` succeeds there, away from the repository."""
+``costar run example:cup_to_bin --seed 3`` succeeds there, away from the repository.
+"""
 
 from __future__ import annotations
 
@@ -14,7 +15,8 @@ from packaging_env import clean_env, fresh_venv, lend_dependencies, pip, source_
 def test_the_wheel_carries_every_shipped_file(built_wheel: Path) -> None:
     """Every file of resources/ (data and its locator, resources/__init__.py; the generators
     live in tools/, which is not shipped): a new kind of file fails here until
-    pyproject.toml's package-data lists it."""
+    pyproject.toml's package-data lists it.
+    """
     names = set(zipfile.ZipFile(built_wheel).namelist())
     shipped = {name for name in source_files() if name.startswith("resources/")}
     assert {"resources/icons/costar-instructor.svg", "resources/objects/cup/cup.obj"} <= shipped

@@ -77,7 +77,8 @@ def test_costar_run_kitting_succeeds(seed: int) -> None:
 def _reparameterized_transfer_plan() -> PlanSpec:
     """Handoff, Unholster, the 8-hole plate's Transfer rebound to the 4-hole plate (Figure 6:
     a new object, a new pick waypoint relative to it, a new place waypoint relative to the
-    bin), Holster."""
+    bin), Holster.
+    """
     plan = load_plan(KITTING)
     assert plan.tree is not None
     by_name = {n.name: n for _, n in plan.walk()}

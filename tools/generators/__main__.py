@@ -1,5 +1,6 @@
 """Run every generator, in the order their files depend on (make_tending reads the
-ClearStopAndBackOff that make_clear_stop writes)."""
+ClearStopAndBackOff that make_clear_stop writes).
+"""
 
 from __future__ import annotations
 

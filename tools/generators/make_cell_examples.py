@@ -102,7 +102,8 @@ class _Cell(PlanBuilder):
 
 def _figure3_tree(m: _Cell, finder: str, detect: str, title: str) -> NodeSpec:
     """The Figure 3 tree; ``finder`` is the capability that finds objects (markers or
-    perception) and ``detect`` its operation that looks."""
+    perception) and ``detect`` its operation that looks.
+    """
     transfer = m.node(
         NodeKind.SEQUENCE,
         "transfer",
@@ -167,7 +168,8 @@ def cup_to_bin_vision() -> PlanSpec:
 
 def _tending_cycle(m: _Cell) -> NodeSpec:
     """One part: the arm swings down and back up, pick at the exit, out of the arm's swing,
-    onto the rack."""
+    onto the rack.
+    """
     region = fixed(ARM_REGION, ParamType.REGION)
     long = fixed(600.0, ParamType.DURATION)
     # Four looks a second see the arm, which stays over the exit for more than a second.

@@ -230,7 +230,8 @@ DOWN = [1.0, 0.0, 0.0, 0.0]  # the tool's z (its approach) pointing down, at the
 
 def grasp(name: str, tool: str, z: float, approach_z: float) -> dict:
     """A grasp from above: the TCP pointing down at height ``z`` of the object frame, reached
-    straight down from ``approach_z``. Symmetric objects get every equivalent at run time."""
+    straight down from ``approach_z``. Symmetric objects get every equivalent at run time.
+    """
     return {
         "name": name,
         "tool": tool,
@@ -283,7 +284,8 @@ def make_bin(
 ) -> tuple[dict, Mesh]:
     """An open box with a marker in the middle of each outer wall (ids first_id..first_id+3)
     and two handle tabs at the rim of its short ends, each with a marker on top (ids
-    first_id+4 on +x, first_id+5 on -x) that a camera above the table sees."""
+    first_id+4 on +x, first_id+5 on -x) that a camera above the table sees.
+    """
     length, width, height = dims
     parts = open_box_parts(length, width, height, wall, floor)
     tab = (0.06, 0.08, 0.006)  # handle tab: out from the wall, along it, thick
@@ -420,7 +422,8 @@ def make_wireform(
 ) -> tuple[dict, Mesh]:
     """A flat 2D wireform of straight wires. ``weld`` is (index of the weld bead among
     ``bars``, the bars of each piece a bad weld falls apart into); the gripper's grasp closes
-    on the bead, its fingers across the wire (turned by ``yaw`` about z)."""
+    on the bead, its fingers across the wire (turned by ``yaw`` about z).
+    """
     mesh = Mesh()
     for bar in bars:
         mesh.box(bar["position"], bar["size"])
@@ -497,7 +500,8 @@ def make_bender() -> tuple[dict, Mesh]:
     """The 2D wire bender: a cabinet whose front (+x) faces the exit where parts land, with a
     welding arm hinged on its front top edge (``welding_arm``: the pivot, the arm's pitch at
     rest and when it releases a part, rad about the bender's y) and the exit (``exit``: where
-    a released part lands, in the bender frame)."""
+    a released part lands, in the bender frame).
+    """
     size = (0.20, 0.28, 0.22)
     mesh = Mesh()
     mesh.box((0.0, 0.0, size[2] / 2), size)
@@ -549,7 +553,8 @@ def make_rack() -> tuple[dict, Mesh]:
     """The mobile rack's top: a ledge at -x carrying marker 32 on its top and 33 on its end,
     and an open tote the wireforms are dropped into (they pile up there, as on a cart). The
     tote is deep and wide enough for a trial of 50 parts dropped in its middle (their pile
-    stays under its rim)."""
+    stays under its rim).
+    """
     tote, width, height, ledge, ledge_height = 0.34, 0.34, 0.2, 0.08, 0.08
     length = tote + ledge
     parts = []
@@ -593,7 +598,8 @@ def make_rack() -> tuple[dict, Mesh]:
 
 def make_scrap_bin() -> tuple[dict, Mesh]:
     """The scrap bin beside the bender's exit: a low open steel box without markers (the
-    robot knows it by a taught place, as on site)."""
+    robot knows it by a taught place, as on site).
+    """
     length, width, height = 0.18, 0.16, 0.1
     parts = open_box_parts(length, width, height, 0.004, 0.012)  # thick floor: no tunnelling
     mesh = Mesh()

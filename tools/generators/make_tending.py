@@ -62,7 +62,8 @@ def _part_cycle(
     """One part, once the welding arm has dropped it: pick (with recovery), find the rack (a
     worker may have moved it; the arm steps out of the camera's view anyway), then place
     (with recovery) while watching for the next part: the arm may drop it before the place
-    is done, and a part left at the exit unseen would be buried under the one after it."""
+    is done, and a part left at the exit unseen would be buried under the one after it.
+    """
     exit_wps = {"ABOVE": bound(wps["over exit"]), "AT": bound(wps["at exit"])}
     scrap = m.instance(
         subs["DiscardToScrap"],

@@ -73,13 +73,15 @@ class PlanBuilder:
         **config: Any,
     ) -> NodeSpec:
         """A logic node; ``config`` are its settings (``engine.kinds.setting``). ``node_id``:
-        an id taken earlier with :meth:`id` (a tree numbered from its root down)."""
+        an id taken earlier with :meth:`id` (a tree numbered from its root down).
+        """
         params = {k: setting(kind, k, v) for k, v in config.items()}
         return NodeSpec(kind, name, node_id or self.id(), params=params, children=list(children))
 
     def op(self, op: str, name: str, /, **params: Binding | str) -> NodeSpec:
         """An operation; a text parameter is a blackboard reference (a parameter may be
-        called ``name``: the label is positional only)."""
+        called ``name``: the label is positional only).
+        """
         return NodeSpec(NodeKind.OPERATION, name, self.id(), op=op, params=_bound(params))
 
     def move(
@@ -91,7 +93,8 @@ class PlanBuilder:
         speed: float = 1.0,
     ) -> NodeSpec:
         """``motion.move_to`` a waypoint (or the one a blackboard entry names); ``speed``
-        scales the nominal speed and acceleration alike (default: left at the port's 1)."""
+        scales the nominal speed and acceleration alike (default: left at the port's 1).
+        """
         params: dict[str, Binding | str] = {
             "target": target if isinstance(target, str) else fixed(target, ParamType.WAYPOINT)
         }

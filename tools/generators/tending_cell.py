@@ -86,7 +86,8 @@ class TendingMaker(PlanBuilder):
 
     def take(self, name: str, above: str, at: str) -> NodeSpec:
         """Down from ``above`` to ``at``, close, feel it held, lift, feel it still held; in
-        ``TAKE_TIME`` (a finger that jams on a part lying askew must not hold the robot up)."""
+        ``TAKE_TIME`` (a finger that jams on a part lying askew must not hold the robot up).
+        """
         return self.node(NodeKind.TIMEOUT, name, self._take(above, at), seconds=TAKE_TIME)
 
     def _take(self, above: str, at: str) -> NodeSpec:
@@ -109,7 +110,8 @@ class TendingMaker(PlanBuilder):
 
     def piece(self, over: Waypoint | str, scrap: Waypoint | str) -> NodeSpec:
         """A piece of a broken weld from where it lies (the tool ``over`` it) into the
-        scrap bin, in ``PIECE_TIME`` (a piece must not hold the robot up)."""
+        scrap bin, in ``PIECE_TIME`` (a piece must not hold the robot up).
+        """
         # Lifted whether or not the fingers hold anything (the next spot is reached from
         # above), then into the scrap bin only when held: an empty spot costs a close and
         # two short moves.

@@ -255,7 +255,8 @@ def _feel_at_exit(m: TendingMaker, name: str) -> NodeSpec:
 
 def _unless_the_arm_comes(m: TendingMaker, name: str, work: NodeSpec) -> NodeSpec:
     """``work`` (whatever it finds), then out of view until the next part comes
-    (WaitForPart); fails as soon as the machine's arm comes into REGION before it is done."""
+    (WaitForPart); fails as soon as the machine's arm comes into REGION before it is done.
+    """
     return m.node(
         NodeKind.SEQUENCE,
         f"{name}, then the next part",
@@ -275,7 +276,8 @@ def _unless_the_arm_comes(m: TendingMaker, name: str, work: NodeSpec) -> NodeSpe
 
 def _clear_of_the_arm(m: TendingMaker) -> list[NodeSpec]:
     """The machine's arm came: what is held into the scrap bin, let go, up clear, out of
-    view until the arm is back up (its part lies at the exit)."""
+    view until the arm is back up (its part lies at the exit).
+    """
     return [
         m.held_into_scrap("SCRAP"),
         m.op("gripper.open", "let go"),
@@ -290,7 +292,8 @@ def _clear_of_the_arm(m: TendingMaker) -> list[NodeSpec]:
 def _to_the_rack_then_the_left_piece(m: TendingMaker) -> list[NodeSpec]:
     """The part felt at the exit: lift it, feel it still held, to the rack (found again by
     its marker), then the left piece into the scrap bin unless the next part comes first
-    (that part then lies at the exit: the caller's cycle picks it)."""
+    (that part then lies at the exit: the caller's cycle picks it).
+    """
     piece = m.node(
         NodeKind.RETRY, "twice if need be", m.piece("PIECE_1", "SCRAP"), count=PIECE_TRIES
     )

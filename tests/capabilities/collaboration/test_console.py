@@ -1,5 +1,6 @@
 """OperatorConsole: latched buttons, prompts answered or withdrawn, listeners, threads;
-digital inputs as buttons."""
+digital inputs as buttons.
+"""
 
 from __future__ import annotations
 

@@ -62,7 +62,8 @@ def in_region_node() -> NodeSpec:
 
 def close_to_truth(seen: Pose, placed: Pose | None) -> None:
     """Seen where the worker put it (GROUND TRUTH: its pose on the table); it may have been
-    seen while still dropping the last centimetre."""
+    seen while still dropping the last centimetre.
+    """
     assert placed is not None
     assert math.dist(seen.position[:2], placed.position[:2]) < 0.01
     assert abs(seen.position[2] - placed.position[2]) < 0.015

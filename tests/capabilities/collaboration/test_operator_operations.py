@@ -1,5 +1,6 @@
 """confirm, button_pressed and wait_for_button through the engine, with the console answered
-or pressed from another thread (the GUI's, a pedal's)."""
+or pressed from another thread (the GUI's, a pedal's).
+"""
 
 from __future__ import annotations
 
@@ -132,7 +133,6 @@ def test_button_pressed_reads_the_named_button() -> None:
 
 def _run_pressing_when_running(cell: ClockCell, root: NodeSpec, press: str) -> Any:
     """Run ``root``; press ``press`` from another thread once the leaf is RUNNING."""
-
     pressed: list[bool] = []
 
     def listen(event: Event) -> None:

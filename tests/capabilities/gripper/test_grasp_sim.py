@@ -1,6 +1,7 @@
 """gripper.grasp on the simulated cell: "grasp CUP at CUP_POSE" with the cup's pose from its
 markers in a rendered image, and a plate taken with the suction tool at its pose from
-model-based recognition. Ground truth is read only here, to check the object is lifted."""
+model-based recognition. Ground truth is read only here, to check the object is lifted.
+"""
 
 from __future__ import annotations
 
@@ -78,7 +79,8 @@ def test_a_gripper_grasp_with_the_suction_tool_in_hand_says_what_to_do() -> None
 
 def test_figure3_literal_move_to_cup_pose_with_a_grasp_reference_then_close() -> None:
     """The paper's "move to CUP_POSE", then "grasp" (close): the grasp reference makes the
-    move go through the grasp's approach to where the fingers close around the cup."""
+    move go through the grasp's approach to where the fingers close around the cup.
+    """
     with SimCellSession("cup_to_bin", seed=2) as session:
         before = session.truth_pose("cup")
         plan = seq(

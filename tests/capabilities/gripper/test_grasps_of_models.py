@@ -1,5 +1,6 @@
 """Grasps taught once in the object models: they load, and their equivalents honour the
-object's symmetry (a fake arm whose reach the test chooses; no simulator)."""
+object's symmetry (a fake arm whose reach the test chooses; no simulator).
+"""
 
 from __future__ import annotations
 

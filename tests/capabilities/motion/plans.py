@@ -44,7 +44,8 @@ def registry_for(
 
 def op(op_id: str, label: str = "", /, **params: Any) -> NodeSpec:
     """An operation node; a str value starting with '$' is a reference, others fixed
-    (with the type of the value; pass a Binding for another type)."""
+    (with the type of the value; pass a Binding for another type).
+    """
     bindings: dict[str, Binding] = {}
     for port, value in params.items():
         if isinstance(value, Binding):

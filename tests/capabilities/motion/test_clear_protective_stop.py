@@ -1,5 +1,6 @@
 """motion.clear_protective_stop: its failure types from what the arm's clear says (the runs on
-the simulated cell and the UR emulator are in tests/capabilities/sim and tests/capabilities/ur)."""
+the simulated cell and the UR emulator are in tests/capabilities/sim and tests/capabilities/ur).
+"""
 
 from __future__ import annotations
 

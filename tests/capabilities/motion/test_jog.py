@@ -1,6 +1,7 @@
 """Jogging on any arm backend (a fake one here): the target of a jog in the base and tool
 frames, the distance halved where the arm refuses, a held jog that ends on release and one
-that cannot start at all."""
+that cannot start at all.
+"""
 
 from __future__ import annotations
 
@@ -42,7 +43,8 @@ def test_tool_frame_moves_along_the_tools_own_axes() -> None:
 
 class FakeArm:
     """Refuses any linear target farther than ``reach`` m from its start, like an arm at the
-    edge of its reach; accepted moves stay running until stopped."""
+    edge of its reach; accepted moves stay running until stopped.
+    """
 
     def __init__(self, reach: float = 1.0) -> None:
         self.tool = Pose((0.4, 0.0, 0.3), DOWN)

@@ -35,7 +35,8 @@ def run_op(
     registry: CapabilityRegistry, op_id: str, deadline: float = 60.0, **args: Any
 ) -> Outcome:
     """Start an operation with its defaults and ``args``, poll its job to the end (woken by
-    the job, as the engine is; ``deadline`` is a generous real-time bound)."""
+    the job, as the engine is; ``deadline`` is a generous real-time bound).
+    """
     operation = registry.create(op_id)
     manifest = registry.manifest(op_id)
     woken = threading.Event()

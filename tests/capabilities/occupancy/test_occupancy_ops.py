@@ -1,5 +1,6 @@
 """The occupancy operations' contract: waits with timeouts, fresh and cached frames, errors,
-the table plane; on the simulated cell (shoulder camera 320x240) and on synthetic clouds."""
+the table plane; on the simulated cell (shoulder camera 320x240) and on synthetic clouds.
+"""
 
 from __future__ import annotations
 

@@ -1,5 +1,6 @@
 """The UR5 body model: its kinematics agree with ur_analytic_ik and the simulated robot's URDF,
-and its capsules enclose every surface point of the simulated arm and gripper."""
+and its capsules enclose every surface point of the simulated arm and gripper.
+"""
 
 from __future__ import annotations
 

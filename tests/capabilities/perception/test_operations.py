@@ -1,5 +1,6 @@
 """The perception capability's operations on the simulated cell (rendered frames only;
-ground truth is read here to score them)."""
+ground truth is read here to score them).
+"""
 
 from __future__ import annotations
 

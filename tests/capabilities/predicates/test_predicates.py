@@ -1,5 +1,6 @@
 """The Predicator's conditions on constructed geometry: detections put straight into a world
-model of a fake cell (world, arm, the real object library), no simulator."""
+model of a fake cell (world, arm, the real object library), no simulator.
+"""
 
 from __future__ import annotations
 

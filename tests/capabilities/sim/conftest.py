@@ -14,7 +14,8 @@ from capabilities.sim.testing import add_box
 def cell() -> Iterator[SimCell]:
     """A started simulated cell with the default config, driven by the test (it steps as fast
     as it can while a command runs or the test waits for simulated time, else stands still:
-    the outcome of contacts does not depend on the machine's load)."""
+    the outcome of contacts does not depend on the machine's load).
+    """
     sim = SimCell(speed=None, driven=True)
     sim.start()
     try:

@@ -1,7 +1,8 @@
 """The tending cell: the wire bender's scene, its seeded production and fault model, bad welds
 that come apart and bad grasps that slip when a part is lifted (found by the gripper's
 sensor), the bender's and the rack's markers, and occupancy watching the welding arm.
-Ground truth is read here, in the tests, never by the code under test."""
+Ground truth is read here, in the tests, never by the code under test.
+"""
 
 from __future__ import annotations
 

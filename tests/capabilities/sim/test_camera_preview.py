@@ -1,5 +1,6 @@
 """A camera's smaller live preview (the camera panel's 320x240) and the furniture in the scene
-layout (the 3D scene's table and holster)."""
+layout (the 3D scene's table and holster).
+"""
 
 from __future__ import annotations
 

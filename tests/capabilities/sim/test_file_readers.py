@@ -1,5 +1,6 @@
 """Scene files and the cell configuration, read through the one JSON reader: each error names
-the file as given, the JSON path and what was expected."""
+the file as given, the JSON path and what was expected.
+"""
 
 from __future__ import annotations
 

@@ -1,6 +1,7 @@
 """The live view's floor and table top, drawn by numpy into pictures rendered without them, are
 what pybullet's renderer draws for the same surfaces as boxes: the same colour on every pixel,
-the same depth, objects in front of them kept, nothing past their edges or beyond ``far``."""
+the same depth, objects in front of them kept, nothing past their edges or beyond ``far``.
+"""
 
 from __future__ import annotations
 
@@ -41,7 +42,8 @@ def _box(client: int, half: tuple[float, ...], centre: tuple[float, ...], rgba: 
 
 def _world(with_boxes: bool) -> int:
     """The light world with a cube on the table; ``with_boxes``: the floor and the table top
-    as pybullet boxes (the reference), else without them."""
+    as pybullet boxes (the reference), else without them.
+    """
     client = p.connect(p.DIRECT)
     build_world(client, CONFIG, light=True)
     _box(client, (0.03, 0.03, 0.03), (0.6, 0.0, 0.03), (0.8, 0.1, 0.1, 1.0))

@@ -5,7 +5,8 @@ cell and with the cell's process, and a mirror that crashed fails its pictures, 
 The mirror draws a light world (a finite floor and the table's top drawn by numpy, the arm with
 its collision meshes): its pictures match the physics thread's pixel for pixel everywhere but
 on the arm and the floor (the table top included), and the arm is where the physics thread
-draws it (its depth, within a mesh's coarseness)."""
+draws it (its depth, within a mesh's coarseness).
+"""
 
 from __future__ import annotations
 

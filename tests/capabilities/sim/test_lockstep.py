@@ -1,6 +1,7 @@
 """Lockstep: simulated time stands still while perception computes on another thread (a
 ``standing_still`` block of the physics thread; a lockstep session's worker pool runs every
-job in one), and goes on as before outside such blocks."""
+job in one), and goes on as before outside such blocks.
+"""
 
 from __future__ import annotations
 
@@ -103,7 +104,8 @@ def test_a_closed_gate_stops_the_world_until_it_opens_and_nudges(physics: Physic
 
 def test_a_lockstep_session_charges_each_perception_job_its_simulated_time() -> None:
     """Time stands still while the job computes, then goes on to its latency before the job
-    finishes: a plan polling perception without pause still sees time pass."""
+    finishes: a plan polling perception without pause still sees time pass.
+    """
     with SimCellSession("empty", 0, lockstep=0.5) as session:
         seen: list[float] = []
 

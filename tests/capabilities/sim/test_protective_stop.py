@@ -1,6 +1,7 @@
 """A collision in the simulated cell is a protective stop, reported as the UR cell reports one,
 and a plan handles it: thrown into a Catch that runs ClearStopAndBackOff, or held until the
-operator clears it (the run then goes on from the node that was running)."""
+operator clears it (the run then goes on from the node that was running).
+"""
 
 from __future__ import annotations
 

@@ -4,7 +4,8 @@ slipped grasp by Regrasp, a broken weld by DiscardToScrap, a moved rack by ReReg
 a collision while placing by ClearStopAndBackOff and ReRegisterRack). Each is also a short
 trial of ours (one or two parts). The cell runs in
 lockstep (its time stands while perception computes), as the benches run it. Ground truth
-is read here only, to set the faults up and to score."""
+is read here only, to set the faults up and to score.
+"""
 
 from __future__ import annotations
 
@@ -73,7 +74,8 @@ def _trial(session: SimCellSession) -> tuple[TrialCounters, _Watched]:
 
 def test_a_slipped_grasp_is_regrasped(tmp_path: Path) -> None:
     """Part 1 slips out of the first grasp: Regrasp takes it again and it ends on the rack;
-    part 2 is good and ends there too. The operator is never called."""
+    part 2 is good and ends there too. The operator is never called.
+    """
     scene = tending_scene(tmp_path, parts=2, interval=24.0)
     rates = FaultModel(bad_weld=0.0, bad_grasp=0.5, interval_spread=0.0)
     seed = _seed_with([(False, True), (False, False)], rates, scene)
@@ -94,7 +96,8 @@ def test_a_broken_weld_is_discarded_without_the_operator(tmp_path: Path, shape: 
     """Part 1's weld comes apart when lifted: Regrasp gives up and DiscardToScrap takes over
     (both pieces into the scrap bin, wherever each shape's lie) until the next part comes,
     which is caught. The run goes on: the operator is never called and no protective stop
-    holds it."""
+    holds it.
+    """
     scene = tending_scene(tmp_path, parts=2, interval=24.0)
     rates = FaultModel(bad_weld=0.5, bad_grasp=0.0, interval_spread=0.0)
     seed = _seed_with([(True, False), (False, False)], rates, scene, shape)
@@ -145,7 +148,8 @@ def _multiply(turn: Pose, pose: Pose) -> tuple[float, float, float, float]:
 def test_a_rack_moved_while_the_robot_picks_is_found_again(tmp_path: Path) -> None:
     """The rack is pushed 19 cm away from the robot and turned while the robot takes the part
     at the exit: a drop where the rack was would miss its tote; ReRegisterRack finds it again before the
-    place and the part ends in the tote."""
+    place and the part ends in the tote.
+    """
     scene = tending_scene(tmp_path, parts=1)
     rates = FaultModel(bad_weld=0.0, bad_grasp=0.0)
     with _session(scene, 4, rates) as session:
@@ -165,7 +169,8 @@ def test_a_collision_while_placing_is_cleared_and_the_part_placed_again(tmp_path
     """Once the robot holds the part over the rack, the rack is pushed sideways and lifted
     6 cm (its wall under the tool): the fingers hit the wall on the way down, a protective
     stop. ClearStopAndBackOff clears it and backs off, ReRegisterRack finds the rack again
-    and the second place puts the part into its tote."""
+    and the second place puts the part into its tote.
+    """
     scene = tending_scene(tmp_path, parts=1)
     rates = FaultModel(bad_weld=0.0, bad_grasp=0.0)
     with _session(scene, 4, rates) as session:

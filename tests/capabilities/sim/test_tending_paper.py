@@ -1,7 +1,8 @@
 """The paper's wire-bender tending plan (resources/examples/tending_paper.costar.json) in a
 short trial on the ``tending`` scene: a bad weld stops the robot until the operator presses
 Continue, while the bender goes on; the next, good part ends on the rack. Ground truth is
-read here only."""
+read here only.
+"""
 
 from __future__ import annotations
 
@@ -41,7 +42,8 @@ def _seed_with(bad_welds: list[bool], faults: FaultModel, scene: Path) -> int:
 
 def test_a_bad_weld_stops_the_robot_until_the_operator_resets_it(tmp_path: Path) -> None:
     """Part 1's weld comes apart when lifted: the robot drops it, steps back and waits for
-    the operator; after Continue it catches part 2 and puts it on the rack."""
+    the operator; after Continue it catches part 2 and puts it on the rack.
+    """
     scene = tending_scene(tmp_path, parts=2, interval=18.0)
     faults = FaultModel(bad_weld=0.5, bad_grasp=0.0, interval_spread=0.0)
     seed = _seed_with([True, False], faults, scene)

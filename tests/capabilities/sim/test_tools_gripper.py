@@ -53,7 +53,8 @@ def test_grasp_move_and_release_a_box_where_asked(
 
 def _wire_askew(cell: SimCell, yaw: float) -> int:
     """An 8 mm square wire, 12 cm long, on the table at (0.5, 0.1), turned ``yaw`` from
-    lying across the fingers (as a wireform's piece lies at the bender's exit)."""
+    lying across the fingers (as a wireform's piece lies at the bender's exit).
+    """
     wire = add_box(cell, (0.12, 0.008, 0.008), (0.5, 0.1), mass=0.05)
     at = (0.5, 0.1, cell.table_top_z + 0.0041)
     turn = (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2))
@@ -66,7 +67,8 @@ def _close_low_over(cell: SimCell, pad_clearance: float) -> float:
     """Go down over (0.5, 0.1) and close; returns the simulated seconds the close took.
 
     The gripper says how long its fingers moved: simulated time read around the wait would
-    add the test thread's own latency, which grows with the machine's load."""
+    add the test thread's own latency, which grows with the machine's load.
+    """
     robot, gripper = cell.robot, cell.gripper
     run(robot.move_pose_joint_space(down_at(0.5, 0.1, APPROACH)))
     run(robot.move_linear(down_at(0.5, 0.1, cell.table_top_z + PAD_BELOW_TCP + pad_clearance)))

@@ -1,5 +1,6 @@
 """The simulated worker: reads the scene file's worker block, hands the bin in and takes it
-back at its seeded times, shifts a resting object (checked on ground truth)."""
+back at its seeded times, shifts a resting object (checked on ground truth).
+"""
 
 from __future__ import annotations
 
@@ -67,7 +68,8 @@ def test_the_schedule_follows_the_seed() -> None:
 
 class TruthProbe:
     """GROUND TRUTH after every physics step (a step hook registered after the worker's):
-    the simulated time and the object's pose, or None while it is not in the cell."""
+    the simulated time and the object's pose, or None while it is not in the cell.
+    """
 
     def __init__(self, session: SimCellSession, name: str) -> None:
         self.samples: list[tuple[float, Pose | None]] = []
@@ -101,7 +103,8 @@ def start_worker(
 ) -> tuple[SimCellSession, SimWorker, TruthProbe]:
     """A session of the handoff scene whose worker starts after a probe of ``handoff``'s
     object is in place (the simulation runs as fast as it can: a worker made with the
-    session could act before the test's probe is there)."""
+    session could act before the test's probe is there).
+    """
     spec = read_worker(handoff_scene(tmp_path, nudges, **handoff))
     assert spec is not None
     session = SimCellSession(handoff_scene(tmp_path, worker=False), seed, speed=None)

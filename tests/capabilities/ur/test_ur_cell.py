@@ -236,7 +236,8 @@ def test_cup_to_bin_runs_on_the_emulated_ur_cell_through_ur_rtde(
     tmp_path: Path, start_emulator
 ) -> None:
     """The real-robot path end to end: ur_rtde moves, the Robotiq URCap grips, the cameras
-    are the emulator's frame streams; the cup ends in the bin (ground truth scores it)."""
+    are the emulator's frame streams; the cup ends in the bin (ground truth scores it).
+    """
     from tests.capabilities.sim.test_cup_to_bin import cup_in_bin
 
     cell_file = tmp_path / "emulated.cell.json"
@@ -253,7 +254,8 @@ def test_the_pedal_and_the_pendant_teach_button_drive_a_plan(
     tmp_path: Path, start_emulator
 ) -> None:
     """Pedal (a digital input) -> "continue"; the teach button, held to guide the arm by hand
-    and released -> "teach", after which the plan records the waypoint where the arm is."""
+    and released -> "teach", after which the plan records the waypoint where the arm is.
+    """
     emulator_file = tmp_path / "emulated.cell.json"
     emulator = start_emulator("5.12", write_cell=emulator_file)
     data = json.loads(emulator_file.read_text("utf-8"))
@@ -324,7 +326,8 @@ def test_a_controller_not_heard_from_holds_the_run_until_it_answers_again(
 ) -> None:
     """The I/O thread stuck in a ur_rtde call (as in a move's send when the controller dies
     under it): its last state says all is well, but it is old: the run holds, and goes on
-    once the thread reads the controller again."""
+    once the thread reads the controller again.
+    """
     cell_file = tmp_path / "emulated.cell.json"
     start_emulator("5.12", write_cell=cell_file)
     plan, _ = _plan(tmp_path, (0.3,), speed=0.5)

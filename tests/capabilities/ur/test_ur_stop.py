@@ -101,7 +101,8 @@ def test_a_signalled_costar_run_leaves_the_arm_standing(
     tmp_path: Path, start_emulator, name: str
 ) -> None:
     """SIGTERM (as Ctrl-C and a closed terminal) ends the run, which halts the arm before it
-    closes the connection; SIGKILL gives the program no say: the script's watchdog stops it."""
+    closes the connection; SIGKILL gives the program no say: the script's watchdog stops it.
+    """
     cell = tmp_path / "emulated.cell.json"
     emulator = start_emulator(write_cell=cell)
     run = _costar_run(_plan_file(tmp_path, (0.0, FAR), 0.6), cell)

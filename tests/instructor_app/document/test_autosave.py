@@ -1,5 +1,6 @@
 """Autosave: the dirty plan is written to the recovery folder and removed on save; what a
-killed session left is found and restored."""
+killed session left is found and restored.
+"""
 
 from __future__ import annotations
 
@@ -146,7 +147,8 @@ def test_a_sidecar_with_an_odd_pid_is_offered_not_a_crash(
     document: PlanDocument, recovery_dir: Path, pid: object
 ) -> None:
     """The sidecar is read with the one JSON reader: a pid that is no process id (null, a
-    text, ...) is nobody's, so its plan is offered; it used to raise a TypeError at start-up."""
+    text, ...) is nobody's, so its plan is offered; it used to raise a TypeError at start-up.
+    """
     saver = Autosaver(document, recovery_dir, interval_ms=60_000)
     rename_root(document)
     saver.write_now()

@@ -1,5 +1,6 @@
 """PlanDocument: every edit is one undo command; undo restores the serialized plan byte for
-byte and redo the later one, for each command kind and for random sequences."""
+byte and redo the later one, for each command kind and for random sequences.
+"""
 
 from __future__ import annotations
 

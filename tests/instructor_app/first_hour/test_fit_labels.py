@@ -1,7 +1,8 @@
 """Labels stay readable at the zoom Fit chooses: a 30-node plan fitted into a 1400x900 window
 shows every node's title as painted text (dark glyph pixels inside each box of the grabbed
 viewport), never a blank box; a plan too wide for a readable zoom shows its top around the
-root. Unknown operations are drawn as broken (a red dashed border) with a tooltip."""
+root. Unknown operations are drawn as broken (a red dashed border) with a tooltip.
+"""
 
 from __future__ import annotations
 
@@ -33,7 +34,8 @@ def _leaves(prefix: str, count: int) -> list[NodeSpec]:
 
 def thirty_node_plan() -> PlanSpec:
     """30 nodes in the shape of a tending plan: prepare, a transfer that falls back to a
-    wait, finish; pick and place nested under the transfer."""
+    wait, finish; pick and place nested under the transfer.
+    """
     transfer = NodeSpec(
         NodeKind.SELECTOR,
         name="transfer or wait",

@@ -1,5 +1,6 @@
 """Inserting from the palette: a leaf selected gets a sibling after it, the new node is
-selected so that the next insert lines up after it, and the view follows new nodes."""
+selected so that the next insert lines up after it, and the view follows new nodes.
+"""
 
 from __future__ import annotations
 

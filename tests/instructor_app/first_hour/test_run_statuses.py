@@ -1,5 +1,6 @@
 """Stop keeps the last statuses on the canvas until the next run; the status bar says
-"Running…", not "Run running"."""
+"Running…", not "Run running".
+"""
 
 from __future__ import annotations
 

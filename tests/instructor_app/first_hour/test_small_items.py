@@ -1,5 +1,6 @@
 """Small things of the first hour: the About box shows the version, a recovered shipped
-example is saved elsewhere (Save As), no stale modifier hint stays on the canvas."""
+example is saved elsewhere (Save As), no stale modifier hint stays on the canvas.
+"""
 
 from __future__ import annotations
 

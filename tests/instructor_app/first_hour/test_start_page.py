@@ -1,5 +1,6 @@
 """The start page: shown when the Instructor opens without a plan; New plan, the recent
-plans and the shipped examples (each with a picture of its tree) lead to the canvas."""
+plans and the shipped examples (each with a picture of its tree) lead to the canvas.
+"""
 
 from __future__ import annotations
 

@@ -14,7 +14,7 @@ from instructor_app.document import PlanDocument
 
 @pytest.fixture
 def registry() -> CapabilityRegistry:
-    """debug (always available) and template (needs a lamp the null cell lacks)."""
+    """Debug (always available) and template (needs a lamp the null cell lacks)."""
     return CapabilityRegistry([debug_capability(), template_capability()], cell=NullCell())
 
 

@@ -1,5 +1,6 @@
 """Run by test_scene3d.py in its own process on Xvfb's GL (QT_QPA_PLATFORM=xcb): drives the
-3D scene on the simulated cell and prints one JSON object of what it saw."""
+3D scene on the simulated cell and prints one JSON object of what it saw.
+"""
 
 from __future__ import annotations
 

@@ -1,6 +1,7 @@
 """The camera panel on the simulated cell: live pictures off the GUI thread, overlays from the
 world model, snapshots, and a region drawn on a depth picture that is saved in the plan and
-read by ``occupancy.is_occupied``."""
+read by ``occupancy.is_occupied``.
+"""
 
 from __future__ import annotations
 

@@ -1,6 +1,7 @@
 """The inspector lets a user pick a grasp of the object's model by name (gripper.grasp's
 ``grasp`` port lists the library's grasps; unset means the model's first), and validation
-refuses a name that is not one of them."""
+refuses a name that is not one of them.
+"""
 
 from __future__ import annotations
 

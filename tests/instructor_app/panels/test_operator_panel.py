@@ -1,5 +1,6 @@
 """OperatorPanel: questions from the plan appear with Yes/No; a click answers them; the
-Continue button presses the console's button; events from other threads arrive safely."""
+Continue button presses the console's button; events from other threads arrive safely.
+"""
 
 from __future__ import annotations
 

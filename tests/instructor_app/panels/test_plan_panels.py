@@ -1,5 +1,6 @@
 """The plan panels: waypoints (record from the arm, import a file, remove) and the plan's
-settings (name, run policy). Each change is one undo command that undoes byte for byte."""
+settings (name, run policy). Each change is one undo command that undoes byte for byte.
+"""
 
 from __future__ import annotations
 

@@ -1,6 +1,7 @@
 """The 3D scene: without OpenGL it says why and the window works; with Xvfb's GL (in a process
 of its own, as the Qt widget tests run offscreen) it draws the robot where its forward
-kinematics put it, picks points, draws regions, and the tool gizmo drags."""
+kinematics put it, picks points, draws regions, and the tool gizmo drags.
+"""
 
 from __future__ import annotations
 

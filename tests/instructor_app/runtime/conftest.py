@@ -1,5 +1,6 @@
 """Fixtures of the Instructor's runtime tests: a loopback UR controller (its own process) that
-wrote a cell file into the test's folder."""
+wrote a cell file into the test's folder.
+"""
 
 from __future__ import annotations
 

@@ -1,5 +1,6 @@
 """The camera feed without a cell: captures on its own thread, keeps only the newest frame,
-captures nothing while inactive, and survives a failing camera; projection helpers."""
+captures nothing while inactive, and survives a failing camera; projection helpers.
+"""
 
 from __future__ import annotations
 

@@ -1,6 +1,7 @@
 """The window opens cells in the background: it stays responsive while a real cell connects,
 says what it waits for, refuses a second choice and a run meanwhile, and keeps the cell that
-was open when the new one fails (a UR cell file whose host does not answer, through ur_rtde)."""
+was open when the new one fails (a UR cell file whose host does not answer, through ur_rtde).
+"""
 
 from __future__ import annotations
 
@@ -22,7 +23,8 @@ DEAD_HOST = "127.254.0.1"  # loopback, nothing listening (test emulators: 127.20
 
 class TickWaitingOpener:
     """The real opener, called only after the GUI thread's timer ticked a few more times:
-    when the opening ran on the GUI thread, those ticks could never come."""
+    when the opening ran on the GUI thread, those ticks could never come.
+    """
 
     def __init__(self, ticks: list[int]) -> None:
         self.ticks = ticks

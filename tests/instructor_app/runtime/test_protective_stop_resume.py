@@ -1,6 +1,7 @@
 """The Instructor on the simulated cell after a collision: the failed node shows protective_stop,
 the status bar shows the stop and offers its unlock once the delay has passed, and "Resume
-from this node" runs on after the operator cleared it and took the obstacle away."""
+from this node" runs on after the operator cleared it and took the obstacle away.
+"""
 
 from __future__ import annotations
 
@@ -38,7 +39,8 @@ def _move(name: str, target: Pose, mode: str) -> NodeSpec:
 
 def _plan() -> PlanSpec:
     """Above the table, then down in a Catch of protective_stop whose handler calls the
-    operator (it fails: the plan stops there)."""
+    operator (it fails: the plan stops there).
+    """
     down = _move("down", down_at(0.5, 0.0, 0.06), "linear")
     call = op("debug.fail", "call the operator", message=text("clear the cell, then resume"))
     catch = NodeSpec(NodeKind.CATCH, name="catch", children=[down, call], params={

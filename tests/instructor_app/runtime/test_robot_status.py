@@ -1,5 +1,6 @@
 """The Instructor on a UR cell (the loopback emulator through ur_rtde): the cell chooser opens a
-cell file, and the toolbar shows connection, robot mode, safety mode and program state live."""
+cell file, and the toolbar shows connection, robot mode, safety mode and program state live.
+"""
 
 from __future__ import annotations
 

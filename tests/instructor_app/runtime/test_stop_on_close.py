@@ -1,5 +1,6 @@
 """The Instructor on a UR cell (the loopback emulator through ur_rtde) halts the arm however it
-ends: its window closed during a run, or a signal (kill, Ctrl-C, a closed terminal)."""
+ends: its window closed during a run, or a signal (kill, Ctrl-C, a closed terminal).
+"""
 
 from __future__ import annotations
 

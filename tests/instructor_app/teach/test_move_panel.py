@@ -1,5 +1,6 @@
 """The Move panel without a robot, with an arm that cannot be hand guided, and while a plan
-runs: its buttons say why they are off; the readout follows the arm."""
+runs: its buttons say why they are off; the readout follows the arm.
+"""
 
 from __future__ import annotations
 

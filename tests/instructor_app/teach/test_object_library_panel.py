@@ -1,6 +1,7 @@
 """The Objects panel: every model with a thumbnail (drawn off the GUI thread, cached on disk),
 its symmetry, markers and grasps; Add model… from a mesh through its dialog, written whole
-into the user's library folder and read back like any model."""
+into the user's library folder and read back like any model.
+"""
 
 from __future__ import annotations
 

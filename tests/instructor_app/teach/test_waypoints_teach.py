@@ -1,7 +1,8 @@
 """Teaching waypoints without a robot (a fake arm and world model): Record relative to the
 nearest recognised object or marker, rename and edit numbers in the list, Teach again, and
 the inspector's Teach under Pose and Waypoint parameters. Every change is one undo step
-that undoes byte for byte, and nodes using a waypoint follow its changes."""
+that undoes byte for byte, and nodes using a waypoint follow its changes.
+"""
 
 from __future__ import annotations
 

@@ -1,5 +1,6 @@
 """Context menus fit the node: a leaf offers no "Add child" or "Paste as child"; the Add
-child menu of a composite offers the robot's operations too."""
+child menu of a composite offers the robot's operations too.
+"""
 
 from __future__ import annotations
 

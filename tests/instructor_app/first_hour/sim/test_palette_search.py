@@ -1,5 +1,6 @@
 """Palette search on the simulated cell: ranked by label and capability, Up/Down through the
-hits, the capability beside each hit, Enter inserts the current hit."""
+hits, the capability beside each hit, Enter inserts the current hit.
+"""
 
 from __future__ import annotations
 

@@ -1,5 +1,6 @@
 """The cell goes back to the scene's start: before each run when the plan asks for it
-(checkbox of the Plan panel), and on the Reset cell action."""
+(checkbox of the Plan panel), and on the Reset cell action.
+"""
 
 from __future__ import annotations
 

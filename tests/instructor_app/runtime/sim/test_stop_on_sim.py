@@ -1,5 +1,6 @@
 """Stop during a motion on the simulated cell: the run ends and the arm stands still short of
-its target (the leaf is halted and its capability stops the arm)."""
+its target (the leaf is halted and its capability stops the arm).
+"""
 
 from __future__ import annotations
 

@@ -1,7 +1,8 @@
 """Run by test_scene_drag.py in its own process on Xvfb's GL (QT_QPA_PLATFORM=xcb): in the
 Instructor's window on the simulated cell, Shift-drag the tool gizmo of the 3D scene with the
 mouse, let go, record the waypoint, preview it, and run a plan that goes there; prints one
-JSON object of what it saw."""
+JSON object of what it saw.
+"""
 
 from __future__ import annotations
 

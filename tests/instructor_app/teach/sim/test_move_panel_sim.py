@@ -1,5 +1,6 @@
 """The Move panel on the simulated cell: a jog by step moves the tool by that step, a held
-arrow moves until it is let go, joints jog one by one, the readout follows the arm."""
+arrow moves until it is let go, joints jog one by one, the readout follows the arm.
+"""
 
 from __future__ import annotations
 

@@ -1,6 +1,7 @@
 """The Move panel on the UR backend (ur_rtde against the loopback emulator): the same panel,
 through the backend Protocols only. Freedrive held maps to freedriveMode (PolyScope 5.10+)
-or teachMode (3.15), and a jog step moves the reported TCP by the step."""
+or teachMode (3.15), and a jog step moves the reported TCP by the step.
+"""
 
 from __future__ import annotations
 

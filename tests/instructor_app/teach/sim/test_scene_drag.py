@@ -1,7 +1,8 @@
 """Dragging the tool in the 3D scene on the simulated cell: the arm follows the gizmo, the
 pose where the hand let go is recorded and a plan that uses it runs; Preview shows the
 ghost arm at a waypoint. The scene here is a stand-in with the 3D panel's public API
-(COORD-scene3d.md): its signals are what a drag on the gizmo emits."""
+(COORD-scene3d.md): its signals are what a drag on the gizmo emits.
+"""
 
 from __future__ import annotations
 

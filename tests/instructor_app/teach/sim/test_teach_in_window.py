@@ -1,7 +1,8 @@
 """Teaching by hand in the Instructor on the simulated cell, through its widgets: waypoints
 taught by freedrive and by jogging are used by a plan that then runs; a waypoint taught
 relative to the cup follows the cup after it was moved (through detection at run time);
-Move here stops when its button is let go."""
+Move here stops when its button is let go.
+"""
 
 from __future__ import annotations
 
@@ -52,7 +53,8 @@ def record(qtbot: Any, window: MainWindow, name: str, frame: str, reference: str
 def click_and_wait(qtbot: Any, window: MainWindow, button: Any) -> None:
     """Click a jog button and wait until its jog ended. Only a jog's end counts: the end of
     what ran before (freedrive off) may still be on its way from the worker on a loaded
-    machine, and taken for the jog's, the test went on while the jog had not moved yet."""
+    machine, and taken for the jog's, the test went on while the jog had not moved yet.
+    """
     with qtbot.waitSignal(
         window.views.teacher.finished,
         timeout=30_000,
@@ -138,7 +140,8 @@ def _push_cup(client: int, cell: Any, dx: float, dy: float) -> None:
 
 def detect(qtbot: Any, window: MainWindow) -> str:
     """Run a plan that takes the arm out of the camera's view (to where it is now) and
-    looks (the shoulder camera's markers); the look node's id."""
+    looks (the shoulder camera's markers); the look node's id.
+    """
     search_insert(qtbot, window, "sequence", "sequence")
     out_of_view = record(qtbot, window, "out of view", "joints")
     node_id = search_insert(qtbot, window, "motion.move_to", "motion.move_to")
