@@ -6,7 +6,8 @@ runtime-checkable) rather than probing for a method, so a cell declares what it 
 methods' names and types, and mypy checks both sides.
 
 - :class:`ClosableCell`: a cell with a lifetime (what ``capabilities.cells.open_cell``
-  returns): ``close()``, and a context manager that closes it.
+  returns): ``close()``, and a context manager that closes it; :class:`ClosesOnExit` is
+  that context manager, for a class to inherit.
 - :class:`HoldsRuns`: a cell that can stop on its own says why it cannot act
   (``capabilities.faults.hold_check`` turns it into the executor's hold check).
 - :class:`ReportsStatus`: what the status bar shows of the robot (a :class:`CellStatus`).
@@ -20,7 +21,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from types import TracebackType
-from typing import Protocol, runtime_checkable
+from typing import Protocol, Self, runtime_checkable
 
 from capabilities.base import Cell
 from engine.types import Pose
@@ -29,6 +30,7 @@ __all__ = [
     "CellStatus",
     "ClearsStop",
     "ClosableCell",
+    "ClosesOnExit",
     "HoldsRuns",
     "ReportsStatus",
     "SceneObjects",
@@ -70,6 +72,29 @@ class ClosableCell(Cell, Protocol):
         exc: BaseException | None,
         tb: TracebackType | None,
     ) -> None: ...
+
+
+class ClosesOnExit:
+    """A context manager that gives itself on entry and calls ``close()`` on exit.
+
+    For a class with a lifetime (a cell, the UR emulator and its process): it defines
+    ``close()``, and overrides ``__enter__`` only when entering also starts it.
+    """
+
+    def close(self) -> None:
+        """Release what the object holds (threads, connections, processes)."""
+        raise NotImplementedError
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()
 
 
 @runtime_checkable

@@ -10,10 +10,9 @@ from __future__ import annotations
 import time
 from collections.abc import Mapping
 from pathlib import Path
-from types import TracebackType
 from typing import Any
 
-from capabilities.cell_features import ClosableCell
+from capabilities.cell_features import ClosableCell, ClosesOnExit
 from capabilities.collaboration.console import OperatorConsole
 from capabilities.errors import CapabilityError
 
@@ -26,7 +25,7 @@ class CellError(CapabilityError):
     """A cell could not be opened."""
 
 
-class ManagedCell:
+class ManagedCell(ClosesOnExit):
     """A cell with a lifetime: a context manager that closes it.
 
     The ``none`` cell has no robot: only cell-free capabilities (``debug``) and the
@@ -53,17 +52,6 @@ class ManagedCell:
 
     def close(self) -> None:
         """Release the cell (threads, connections)."""
-
-    def __enter__(self) -> ManagedCell:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        self.close()
 
 
 def open_cell(

@@ -16,11 +16,11 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator
 from contextlib import AbstractContextManager, contextmanager
 from pathlib import Path
-from types import TracebackType
-from typing import TypeVar
+from typing import Self, TypeVar
 
 import numpy as np
 
+from capabilities.cell_features import ClosesOnExit
 from capabilities.robot.cell_file import DEFAULT_CONFIG_PATH, CellConfig
 from capabilities.robot.kinematics import UR5Kinematics
 from capabilities.sim.arm_controller import ArmController
@@ -41,7 +41,7 @@ T = TypeVar("T")
 TIME_STEP = 1.0 / 240.0
 
 
-class SimCell:
+class SimCell(ClosesOnExit):
     """The simulated cell. Call ``start()`` (or use it as a context manager) before use.
 
     Attributes (after start):
@@ -121,17 +121,9 @@ class SimCell:
             if part is not None:
                 part.shutdown("the simulated cell was closed")
 
-    def __enter__(self) -> SimCell:
+    def __enter__(self) -> Self:
         self.start()
         return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        self.close()
 
     # ---------------------------------------------------------------- services
 

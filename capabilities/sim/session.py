@@ -22,14 +22,13 @@ import dataclasses
 import math
 from collections.abc import Mapping
 from pathlib import Path
-from types import TracebackType
 from typing import Any
 
 import numpy as np
 
 from capabilities.camera_source import CameraSource
 from capabilities.camera_sources import open_source
-from capabilities.cell_features import CellStatus
+from capabilities.cell_features import CellStatus, ClosesOnExit
 from capabilities.collaboration.console import OperatorConsole
 from capabilities.faults import PROTECTIVE_STOP
 from capabilities.jobs import WorkerPool
@@ -133,7 +132,7 @@ class SimCameraDevice:
         self.camera = SimCamera(self.camera.name, self.camera.config, FixedMount(true_pose))
 
 
-class SimCellSession:
+class SimCellSession(ClosesOnExit):
     """A running simulated cell with its scene; a context manager.
 
     Args:
@@ -387,14 +386,3 @@ class SimCellSession:
             self.live_view.close()
         self.workers.close()
         self.sim.close()
-
-    def __enter__(self) -> SimCellSession:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        self.close()

@@ -23,12 +23,11 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Mapping
-from types import TracebackType
 from typing import Any
 
 from capabilities.camera_source import CameraSource
 from capabilities.camera_sources import open_source
-from capabilities.cell_features import CellStatus
+from capabilities.cell_features import CellStatus, ClosesOnExit
 from capabilities.collaboration.console import OperatorConsole
 from capabilities.collaboration.inputs import DigitalInputButton
 from capabilities.faults import CONNECTION_LOST
@@ -68,7 +67,7 @@ WATCHDOG_STOP = (
 RESTART_SCRIPT = "Restart control script"  # the status bar's clear of a stopped script
 
 
-class URCellSession:
+class URCellSession(ClosesOnExit):
     """A UR controller at the cell file's host; a context manager.
 
     Args:
@@ -214,17 +213,6 @@ class URCellSession:
             button.stop()
         self.connection.close()
         self.workers.close()
-
-    def __enter__(self) -> URCellSession:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        self.close()
 
 
 def _last_heard(connection: URConnection) -> str:

@@ -14,9 +14,10 @@ command line. Example::
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from types import TracebackType
+from typing import Self
 
 from capabilities.camera_source import CameraSource
+from capabilities.cell_features import ClosesOnExit
 from capabilities.sim.cell import SimCell
 from capabilities.stream_camera import FRAME_PORT, serve_frames
 from capabilities.ur_emulator.controller import VERSIONS, EmulatedController
@@ -35,7 +36,7 @@ __all__ = ["UREmulator", "VERSIONS", "DASHBOARD_PORT", "SCRIPT_PORT", "RTDE_PORT
 DASHBOARD_PORT, SCRIPT_PORT, RTDE_PORT = 29999, 30003, 30004
 
 
-class UREmulator:
+class UREmulator(ClosesOnExit):
     """The loopback UR controller (with a Robotiq gripper's URCap); a context manager.
 
     Args:
@@ -109,16 +110,9 @@ class UREmulator:
 
     kill = close
 
-    def __enter__(self) -> UREmulator:
-        return self.start()
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        self.close()
+    def __enter__(self) -> Self:
+        self.start()
+        return self
 
     # ---------------------------------------------------------------- faults
 

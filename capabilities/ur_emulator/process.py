@@ -13,9 +13,9 @@ import subprocess
 import sys
 import threading
 from pathlib import Path
-from types import TracebackType
-from typing import Any
+from typing import Any, Self
 
+from capabilities.cell_features import ClosesOnExit
 from capabilities.ur_emulator.errors import EmulatorError
 from capabilities.ur_emulator.servers import check_loopback
 from engine.types import Pose
@@ -25,7 +25,7 @@ __all__ = ["EmulatorProcess"]
 _ROOT = Path(__file__).resolve().parents[3]
 
 
-class EmulatorProcess:
+class EmulatorProcess(ClosesOnExit):
     """``python -m capabilities.ur_emulator`` in a child process; a context manager.
 
     Args:
@@ -180,13 +180,6 @@ class EmulatorProcess:
                 pass
         self.kill()
 
-    def __enter__(self) -> EmulatorProcess:
-        return self.start()
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        self.close()
+    def __enter__(self) -> Self:
+        self.start()
+        return self
