@@ -22,10 +22,30 @@ __all__ = [
 ]
 
 
-class Sequence(Node):
-    """Children in order, the next only after SUCCESS; FAILURE at the first failure."""
+class _InOrder(Node):
+    """The walk of a Sequence or a Selector: children in order, the next after ``next_on``.
 
-    kind = "sequence"
+    It ends with the first child's result that is not ``next_on`` (halting nothing), or with
+    ``next_on`` when every child gave it.
+    """
+
+    next_on: Status = SUCCESS
+    # The message when every child gave ``next_on`` ("" leaves the message alone).
+    exhausted_message = ""
+
+    def _stopped(self, child: Node, status: Status) -> Status:
+        if status is FAILURE:
+            self.message = f"{child.name} failed"
+        return status
+
+    def _exhausted(self) -> Status:
+        if self.exhausted_message:
+            self.message = self.exhausted_message
+        return self.next_on
+
+
+class _Resuming(_InOrder):
+    """An in-order walk that keeps its place: a RUNNING child is resumed next tick."""
 
     def __init__(self, ctx: TreeContext, node_id: str, name: str = "") -> None:
         super().__init__(ctx, node_id, name)
@@ -33,51 +53,36 @@ class Sequence(Node):
 
     def update(self) -> Status:
         children = self.children
+        next_on = self.next_on
         index = self._index
         count = len(children)
         while index < count:
             child = children[index]
             status = child.tick()
-            if status is SUCCESS:
+            if status is next_on:
                 index += 1
                 continue
             self._index = index
-            if status is FAILURE:
-                self.message = f"{child.name} failed"
-            return status
+            return self._stopped(child, status)
         self._index = index
-        return SUCCESS
+        return self._exhausted()
 
     def on_reset(self) -> None:
         self._index = 0
 
 
-class Selector(Node):
+class Sequence(_Resuming):
+    """Children in order, the next only after SUCCESS; FAILURE at the first failure."""
+
+    kind = "sequence"
+
+
+class Selector(_Resuming):
     """Children in order until one succeeds; FAILURE when all failed (a fallback)."""
 
     kind = "selector"
-
-    def __init__(self, ctx: TreeContext, node_id: str, name: str = "") -> None:
-        super().__init__(ctx, node_id, name)
-        self._index = 0
-
-    def update(self) -> Status:
-        children = self.children
-        index = self._index
-        count = len(children)
-        while index < count:
-            status = children[index].tick()
-            if status is FAILURE:
-                index += 1
-                continue
-            self._index = index
-            return status
-        self._index = index
-        self.message = "every option failed"
-        return FAILURE
-
-    def on_reset(self) -> None:
-        self._index = 0
+    next_on = FAILURE
+    exhausted_message = "every option failed"
 
 
 class ParallelPolicy:
@@ -167,7 +172,25 @@ def _halt_after(children: tuple[Node, ...], index: int) -> None:
             child.reset()
 
 
-class ReactiveSequence(Node):
+class _Rechecking(_InOrder):
+    """An in-order walk from the first child every tick, conditions re-checked.
+
+    The child it stops at halts its running later siblings.
+    """
+
+    def update(self) -> Status:
+        children = self.children
+        next_on = self.next_on
+        for index, child in enumerate(children):
+            status = child.recheck() if child.is_condition else child.tick()
+            if status is next_on:
+                continue
+            _halt_after(children, index)
+            return self._stopped(child, status)
+        return self._exhausted()
+
+
+class ReactiveSequence(_Rechecking):
     """A Sequence whose condition children are re-checked every tick.
 
     When a condition that held turns false, the running sibling is halted and the node
@@ -177,33 +200,12 @@ class ReactiveSequence(Node):
 
     kind = "reactive_sequence"
 
-    def update(self) -> Status:
-        children = self.children
-        for index, child in enumerate(children):
-            status = child.recheck() if child.is_condition else child.tick()
-            if status is SUCCESS:
-                continue
-            _halt_after(children, index)
-            if status is FAILURE:
-                self.message = f"{child.name} failed"
-            return status
-        return SUCCESS
 
-
-class ReactiveSelector(Node):
+class ReactiveSelector(_Rechecking):
     """A Selector whose condition children are re-checked every tick; when a higher
     priority condition succeeds, the running lower-priority sibling is halted.
     """
 
     kind = "reactive_selector"
-
-    def update(self) -> Status:
-        children = self.children
-        for index, child in enumerate(children):
-            status = child.recheck() if child.is_condition else child.tick()
-            if status is FAILURE:
-                continue
-            _halt_after(children, index)
-            return status
-        self.message = "every option failed"
-        return FAILURE
+    next_on = FAILURE
+    exhausted_message = "every option failed"

@@ -48,14 +48,27 @@ class Decorator(Node):
     _passes_condition = False
 
 
-class Inverter(Decorator):
-    """SUCCESS <-> FAILURE; RUNNING passes through."""
+class _MapsResult(Decorator):
+    """A decorator that passes RUNNING through and maps the child's finished result."""
 
-    kind = "inverter"
     _passes_condition = True
 
     def update(self) -> Status:
         status = self.children[0].tick()
+        if status is RUNNING:
+            return RUNNING
+        return self._finished(status)
+
+    def _finished(self, status: Status) -> Status:
+        raise NotImplementedError
+
+
+class Inverter(_MapsResult):
+    """SUCCESS <-> FAILURE; RUNNING passes through."""
+
+    kind = "inverter"
+
+    def _finished(self, status: Status) -> Status:
         if status is SUCCESS:
             return FAILURE
         if status is FAILURE:
@@ -63,27 +76,21 @@ class Inverter(Decorator):
         return status
 
 
-class ForceSuccess(Decorator):
+class ForceSuccess(_MapsResult):
     """SUCCESS once the child finished, whatever its result."""
 
     kind = "force_success"
-    _passes_condition = True
 
-    def update(self) -> Status:
-        status = self.children[0].tick()
-        return RUNNING if status is RUNNING else SUCCESS
+    def _finished(self, status: Status) -> Status:
+        return SUCCESS
 
 
-class ForceFailure(Decorator):
+class ForceFailure(_MapsResult):
     """FAILURE once the child finished, whatever its result."""
 
     kind = "force_failure"
-    _passes_condition = True
 
-    def update(self) -> Status:
-        status = self.children[0].tick()
-        if status is RUNNING:
-            return RUNNING
+    def _finished(self, status: Status) -> Status:
         return self.fail("forced failure", ErrorType.FAILED)
 
 
