@@ -42,22 +42,15 @@ def _seconds(name: str, doc: str, default: float | None = None) -> PortSpec:
     return PortSpec(name, (_D,), default=default, unit="s", doc=doc)
 
 
+def _policy(name: str, default: str, doc: str) -> PortSpec:
+    """A Parallel's policy port: a word of ``POLICY_WORDS[name]`` or a count."""
+    return PortSpec(name, (_T, _N), default=default, doc=doc, choices=POLICY_WORDS[name])
+
+
 KIND_PORTS: dict[NodeKind, tuple[PortSpec, ...]] = {
     NodeKind.PARALLEL: (
-        PortSpec(
-            "success",
-            (_T, _N),
-            default="all",
-            doc="succeed when all, any, or this many children succeeded",
-            choices=POLICY_WORDS["success"],
-        ),
-        PortSpec(
-            "failure",
-            (_T, _N),
-            default="any",
-            doc="fail when any, or this many children failed",
-            choices=POLICY_WORDS["failure"],
-        ),
+        _policy("success", "all", "succeed when all, any, or this many children succeeded"),
+        _policy("failure", "any", "fail when any, or this many children failed"),
     ),
     NodeKind.CATCH: (
         PortSpec(
