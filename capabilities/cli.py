@@ -17,7 +17,7 @@ import sys
 import threading
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any, NamedTuple, TextIO
 
 from capabilities.base import CapabilityError, CapabilityRegistry
 from capabilities.cell_features import ClosableCell
@@ -86,16 +86,42 @@ def _library(args: argparse.Namespace, err: TextIO) -> Library:
     return library
 
 
-def _cmd_validate(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
-    cell = _open(args, err, start=False)
+class _OpenPlan(NamedTuple):
+    """A cell opened for a plan file: the cell, its capabilities, the plan and its problems."""
+
+    cell: ClosableCell
+    registry: CapabilityRegistry
+    plan: PlanSpec
+    problems: list[Problem]
+
+
+def _open_plan(args: argparse.Namespace, err: TextIO, start: bool) -> _OpenPlan | None:
+    """The cell ``args`` name opened, with ``args.plan`` loaded and validated on it.
+
+    None when the cell does not open or the plan cannot be read (said on ``err``); the cell
+    is closed then.
+    """
+    cell = _open(args, err, start=start)
     if cell is None:
-        return EXIT_INVALID
-    with cell:
+        return None
+    try:
         registry = CapabilityRegistry(cell=cell)
         plan = _load(args.plan, registry, err)
         if plan is None:
-            return EXIT_INVALID
-        problems = validate_plan(plan, registry, _library(args, err))
+            cell.close()
+            return None
+        return _OpenPlan(cell, registry, plan, validate_plan(plan, registry, _library(args, err)))
+    except BaseException:
+        cell.close()
+        raise
+
+
+def _cmd_validate(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    opened = _open_plan(args, err, start=False)
+    if opened is None:
+        return EXIT_INVALID
+    opened.cell.close()
+    problems = opened.problems
     _print_problems(args.plan, problems, out)
     if has_errors(problems):
         count = sum(p.severity == "error" for p in problems)
@@ -158,15 +184,11 @@ def _install_interrupt(executor: Executor) -> Callable[[], None]:
 
 
 def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
-    cell = _open(args, err, start=True)
-    if cell is None:
+    opened = _open_plan(args, err, start=True)
+    if opened is None:
         return EXIT_INVALID
+    cell, registry, plan, problems = opened
     with cell:
-        registry = CapabilityRegistry(cell=cell)
-        plan = _load(args.plan, registry, err)
-        if plan is None:
-            return EXIT_INVALID
-        problems = validate_plan(plan, registry, _library(args, err))
         if has_errors(problems):
             _print_problems(args.plan, problems, err)
             print(f"{args.plan}: invalid, not started", file=err)
