@@ -25,6 +25,7 @@ from capabilities.sim.cell import SimCell
 from capabilities.ur.frames import matrix_from_rotvec_pose, rotvec_pose_from_matrix
 from capabilities.ur.modes import RobotMode, RuntimeState, SafetyMode
 from capabilities.ur_emulator.faults import ContactWatch
+from capabilities.ur_emulator.loops import next_cycle
 from capabilities.ur_emulator.program import ControlProgram
 from capabilities.ur_emulator.robotiq import RobotiqURCap
 from capabilities.ur_emulator.wire import OUTPUT_TYPES, output_type
@@ -119,12 +120,7 @@ class EmulatedController:
                 self._cycle()
             except Exception:  # the emulator must keep answering; log and go on
                 _log.exception("emulated controller cycle failed")
-            next_time += period
-            delay = next_time - time.monotonic()
-            if delay > 0:
-                self._stop_event.wait(delay)
-            elif delay < -period:  # more than a period late: drop the backlog, keep the pace
-                next_time = time.monotonic()
+            next_time = next_cycle(next_time, period, self._stop_event)
 
     def _cycle(self) -> None:
         with self._lock:

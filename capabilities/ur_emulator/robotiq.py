@@ -15,6 +15,8 @@ import socket
 import threading
 from typing import TYPE_CHECKING
 
+from capabilities.ur_emulator.loops import received_lines
+
 if TYPE_CHECKING:
     from capabilities.robot.commands import CommandHandle
     from capabilities.ur_emulator.controller import EmulatedController
@@ -111,13 +113,5 @@ def robotiq_reply(urcap: RobotiqURCap, line: str) -> str:
 def robotiq_client(conn: socket.socket, ctl: EmulatedController, stop: threading.Event) -> None:
     """Serve one URCap client: a line in, a line out."""
     urcap = ctl.robotiq
-    buffer = b""
-    while not stop.is_set():
-        chunk = conn.recv(1024)
-        if not chunk:
-            return
-        buffer += chunk
-        while b"\n" in buffer:
-            raw, buffer = buffer.split(b"\n", 1)
-            reply = robotiq_reply(urcap, raw.decode("ascii", "replace").strip())
-            conn.sendall(reply.encode("ascii") + b"\n")
+    for line in received_lines(conn, stop, "ascii", 1024):
+        conn.sendall(robotiq_reply(urcap, line).encode("ascii") + b"\n")

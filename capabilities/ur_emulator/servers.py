@@ -20,6 +20,7 @@ from capabilities.ur_emulator import wire
 from capabilities.ur_emulator.controller import EmulatedController
 from capabilities.ur_emulator.dashboard import dashboard_reply
 from capabilities.ur_emulator.errors import EmulatorError
+from capabilities.ur_emulator.loops import next_cycle, received_lines
 
 __all__ = ["Server", "check_loopback", "rtde_client", "script_client", "dashboard_client"]
 
@@ -138,18 +139,11 @@ def _read_exact(conn: socket.socket, size: int) -> bytes:
 def dashboard_client(conn: socket.socket, ctl: EmulatedController, stop: threading.Event) -> None:
     """Serve one dashboard client: a line in, a line out."""
     conn.sendall(b"Connected: Universal Robots Dashboard Server\n")
-    pending = b""
-    while not stop.is_set():
-        chunk = conn.recv(4096)
-        if not chunk:
+    for line in received_lines(conn, stop, "utf-8", 4096):
+        reply, close = dashboard_reply(ctl, line)
+        conn.sendall(reply.encode() + b"\n")
+        if close:
             return
-        pending += chunk
-        while b"\n" in pending:
-            line, pending = pending.split(b"\n", 1)
-            reply, close = dashboard_reply(ctl, line.decode("utf-8", "replace").strip())
-            conn.sendall(reply.encode() + b"\n")
-            if close:
-                return
 
 
 _OFFSET = re.compile(rb"reg_offset_int\s*=\s*(\d+)")
@@ -264,12 +258,7 @@ class _RTDESession:
                     self.send(wire.DATA_PACKAGE, bytes([1]) + layout.pack(*flat))
                 except OSError:
                     return
-            next_time += period
-            delay = next_time - time.monotonic()
-            if delay > 0:
-                self.stop.wait(delay)
-            elif delay < -period:  # more than a period late: drop the backlog, keep the pace
-                next_time = time.monotonic()
+            next_time = next_cycle(next_time, period, self.stop)
 
 
 def rtde_client(conn: socket.socket, ctl: EmulatedController, stop: threading.Event) -> None:
