@@ -29,7 +29,7 @@ from capabilities.sim.trajectory import (
 )
 from capabilities.sim.transforms import rotation_angle
 
-__all__ = ["ArmController", "MOVING_SPEED"]
+__all__ = ["MOVING_SPEED", "ArmController"]
 
 Trajectory = JointTrajectory | CartesianTrajectory
 _FORCES = (330.0, 330.0, 150.0, 56.0, 56.0, 56.0)  # 2x the UR5's rated joint torques (N m)

@@ -33,9 +33,9 @@ from capabilities.sim.bender_spec import (
 )
 from capabilities.sim.objects import ObjectModelSpec, SceneError, set_object_frame_pose
 from capabilities.sim.scene import SceneState
-from capabilities.sim.scene_spec import SceneFileError
+from capabilities.sim.scene_spec import read_scene_json
 from capabilities.sim.schedule import ScheduledActor
-from engine.json_reader import JsonFileError, JsonReader, read_json_file
+from engine.json_reader import JsonFileError, JsonReader
 from engine.types import Pose
 
 __all__ = ["BenderEvent", "WireBender", "install_scene_bender", "read_bender"]
@@ -75,11 +75,7 @@ class _Live:
 
 def read_bender(path: Path | str) -> BenderSpec | None:
     """The bender block of a scene file (None if it has none); raises SceneFileError."""
-    try:
-        data = read_json_file(path, "scene")
-    except JsonFileError as exc:
-        raise SceneFileError(str(exc)) from exc
-    return parse_bender(data, str(path))
+    return parse_bender(read_scene_json(path), str(path))
 
 
 def _pitch_pose(pivot: Pose, pitch: float) -> Pose:

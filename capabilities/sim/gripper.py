@@ -21,7 +21,7 @@ from capabilities.sim.physics_thread import PhysicsThread
 from capabilities.sim.robot import post_command
 from capabilities.sim.tools import attach, detach, is_dynamic
 
-__all__ = ["GripperController", "SimGripper", "OPEN_POSITION"]
+__all__ = ["OPEN_POSITION", "GripperController", "SimGripper"]
 
 OPEN_POSITION = 0.0425  # m per finger: 85 mm stroke
 _FORCE = 60.0  # N per finger
@@ -203,13 +203,15 @@ class SimGripper:
 
     def close(self) -> CommandHandle:
         """Close the fingers (until they meet or stall on an object)."""
-        handle = CommandHandle("gripper_close")
-        return post_command(self._physics, handle, lambda: self._ctl.command(handle, True))
+        return self._command("gripper_close", True)
 
     def open(self) -> CommandHandle:
         """Open the fingers fully, releasing what they hold."""
-        handle = CommandHandle("gripper_open")
-        return post_command(self._physics, handle, lambda: self._ctl.command(handle, False))
+        return self._command("gripper_open", False)
+
+    def _command(self, name: str, closed: bool) -> CommandHandle:
+        handle = CommandHandle(name)
+        return post_command(self._physics, handle, lambda: self._ctl.command(handle, closed))
 
     def is_closed(self) -> bool:
         """True after a close command (the gripper's closed state)."""

@@ -270,33 +270,30 @@ class PhysicsThread:
     def _stand_still(self) -> None:
         """Serve calls without stepping while a block holds time (wall time not simulated)."""
         started, served = time.perf_counter(), self._serving_s
-        try:
-            item = self._queue.get(timeout=0.05)
-        except queue.Empty:
-            item = None
-        if item is not None:
-            self._execute(*item)
+        self._serve_one(0.05)
         self._serving_s = served + (time.perf_counter() - started)
 
     def _idle(self, seconds: float) -> None:
         """Sleep while ahead of the wall clock, but wake for queued commands."""
-        try:
-            item = self._queue.get(timeout=seconds)
-        except queue.Empty:
-            return
-        if item is None:
-            return
-        self._execute(*item)
+        self._serve_one(seconds)
 
     def _drain(self) -> None:
-        while True:
-            try:
-                item = self._queue.get_nowait()
-            except queue.Empty:
-                return
-            if item is None:
-                return
-            self._execute(*item)
+        while self._serve_one(None):
+            pass
+
+    def _serve_one(self, wait: float | None) -> bool:
+        """Run one queued call, waiting up to ``wait`` s for one (None: not at all).
+
+        False when none came, or the queue's end mark did (it is taken).
+        """
+        try:
+            item = self._queue.get_nowait() if wait is None else self._queue.get(timeout=wait)
+        except queue.Empty:
+            return False
+        if item is None:
+            return False
+        self._execute(*item)
+        return True
 
     def _execute(self, fn: Callable[[int], Any], future: Future[Any]) -> None:
         if not future.set_running_or_notify_cancel():

@@ -41,6 +41,7 @@ __all__ = [
     "TableSpec",
     "parse_scene",
     "read_scene",
+    "read_scene_json",
 ]
 
 FORMAT_VERSION = 1
@@ -238,8 +239,12 @@ def read_scene(scene: Path | str | dict[str, Any] | SceneSpec) -> SceneSpec:
         return scene
     if isinstance(scene, dict):
         return parse_scene(scene, "<scene dict>")
+    return parse_scene(read_scene_json(scene), str(scene))
+
+
+def read_scene_json(path: Path | str) -> Any:
+    """The parsed JSON of a scene file; raises SceneFileError (missing, not JSON)."""
     try:
-        data = read_json_file(scene, "scene")
+        return read_json_file(path, "scene")
     except JsonFileError as exc:
         raise SceneFileError(str(exc)) from exc
-    return parse_scene(data, str(scene))

@@ -19,7 +19,7 @@ from capabilities.sim.robot import post_command
 from capabilities.sim.tools import attach, body_frame_matrix, detach, is_dynamic
 from engine.types import Pose
 
-__all__ = ["SuctionController", "SimSuctionTool"]
+__all__ = ["SimSuctionTool", "SuctionController"]
 
 _CUP_RADIUS = 0.02  # m, matches resources/robots/suction_tool.urdf
 _REACH = 0.003  # m: a part this close to the cup face is sucked on
@@ -125,13 +125,15 @@ class SimSuctionTool:
 
     def suction_on(self) -> CommandHandle:
         """Switch the vacuum on (fails when the tool is not in the gripper)."""
-        handle = CommandHandle("suction_on")
-        return post_command(self._physics, handle, lambda: self._ctl.set_vacuum(handle, True))
+        return self._switch("suction_on", True)
 
     def suction_off(self) -> CommandHandle:
         """Switch the vacuum off, releasing the part."""
-        handle = CommandHandle("suction_off")
-        return post_command(self._physics, handle, lambda: self._ctl.set_vacuum(handle, False))
+        return self._switch("suction_off", False)
+
+    def _switch(self, name: str, on: bool) -> CommandHandle:
+        handle = CommandHandle(name)
+        return post_command(self._physics, handle, lambda: self._ctl.set_vacuum(handle, on))
 
     def vacuum_on(self) -> bool:
         """True while the vacuum is switched on."""

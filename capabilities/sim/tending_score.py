@@ -31,7 +31,7 @@ from capabilities.sim.bender import RELEASED, SLIPPED, WELD_BROKE, WireBender
 from capabilities.sim.scene import SceneState
 from engine.types import Pose
 
-__all__ = ["TrialCounters", "container_of", "lost_parts", "loose_things", "score_trial"]
+__all__ = ["TrialCounters", "container_of", "loose_things", "lost_parts", "score_trial"]
 
 RACK = "rack"  # the scene object whose tote counts as caught; other totes are scrap bins
 OVER_RIM = 0.03  # m over a tote's rim still counts as in it (a pile); higher: held over it

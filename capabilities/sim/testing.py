@@ -9,7 +9,7 @@ from capabilities.robot.commands import CommandHandle
 from capabilities.sim.cell import SimCell
 from engine.types import Pose
 
-__all__ = ["DOWN", "run", "down_at", "distance", "angle_between", "add_box"]
+__all__ = ["DOWN", "add_box", "angle_between", "distance", "down_at", "run"]
 
 DOWN = (1.0, 0.0, 0.0, 0.0)  # tool z axis pointing at the table
 

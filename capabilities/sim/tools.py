@@ -14,12 +14,12 @@ from capabilities.sim.transforms import matrix_to_pose, pose_to_matrix
 from engine.types import Pose
 
 __all__ = [
+    "attach",
     "body_frame_matrix",
     "body_frame_pose",
-    "link_com_matrix",
-    "attach",
     "detach",
     "is_dynamic",
+    "link_com_matrix",
 ]
 
 _ATTACH_FORCE = 400.0  # N: holds a few kg through fast moves

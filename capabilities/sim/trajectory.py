@@ -25,10 +25,10 @@ from capabilities.sim.transforms import (
 )
 
 __all__ = [
-    "Trapezoid",
-    "JointTrajectory",
     "CartesianTrajectory",
+    "JointTrajectory",
     "LinearPathError",
+    "Trapezoid",
     "plan_linear",
 ]
 

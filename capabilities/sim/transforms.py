@@ -22,14 +22,14 @@ from capabilities.geometry import (
 from engine.types import Pose
 
 __all__ = [
-    "pose_to_matrix",
     "matrix_to_pose",
-    "quat_to_matrix",
     "matrix_to_quat",
-    "slerp",
+    "pose_text_mm",
+    "pose_to_matrix",
+    "quat_to_matrix",
     "rotation_angle",
     "rotation_vector",
-    "pose_text_mm",
+    "slerp",
 ]
 
 

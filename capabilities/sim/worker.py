@@ -36,9 +36,9 @@ import numpy as np
 
 from capabilities.sim.objects import object_frame_pose, set_object_frame_pose
 from capabilities.sim.scene import SceneState, yaw_pose
-from capabilities.sim.scene_spec import SceneFileError
+from capabilities.sim.scene_spec import SceneFileError, read_scene_json
 from capabilities.sim.schedule import ScheduledActor
-from engine.json_reader import JsonFileError, JsonReader, read_json_file
+from engine.json_reader import JsonFileError, JsonReader
 from engine.types import Pose
 
 __all__ = [
@@ -159,11 +159,7 @@ def parse_worker(data: Any, source: str = "<scene>") -> WorkerSpec | None:
 
 def read_worker(path: Path | str) -> WorkerSpec | None:
     """The worker block of a scene file (None if it has none); raises SceneFileError."""
-    try:
-        data = read_json_file(path, "scene")
-    except JsonFileError as exc:
-        raise SceneFileError(str(exc)) from exc
-    return parse_worker(data, str(path))
+    return parse_worker(read_scene_json(path), str(path))
 
 
 def _draw(rng: np.random.Generator, span: Range) -> float:
