@@ -42,6 +42,7 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 from PySide6.QtCore import QEventLoop, QTimer
 from PySide6.QtWidgets import QApplication
 
+from bench._report import print_figures
 from capabilities.ur_emulator.process import EmulatorProcess
 from instructor_app.runtime.session import CellSession
 
@@ -146,11 +147,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     _app = QApplication.instance() or QApplication([])
     result = measure(max(1, args.reps), args.host)
-    if args.json:
-        print(json.dumps(result))
-    else:
-        for key, value in result.items():
-            print(f"{key:26} {value}")
+    print_figures(result, args.json, 26)
     return 0
 
 

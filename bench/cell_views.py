@@ -30,7 +30,6 @@ Run it on its own or through ``bench/gui.py`` (which runs it in a process of its
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 import tempfile
@@ -47,6 +46,7 @@ if not os.environ.get("DISPLAY"):
 from PySide6.QtCore import QEventLoop, QSettings, QTimer
 from PySide6.QtWidgets import QApplication
 
+from bench._report import print_figures
 from engine.tree import RunPolicy
 
 __all__ = ["measure_cell_views", "main"]
@@ -207,11 +207,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seconds", type=float, default=6.0, help="length of each phase")
     args = parser.parse_args(argv)
     results = measure_cell_views(args.seconds)
-    if args.json:
-        print(json.dumps(results))
-    else:
-        for key, value in results.items():
-            print(f"{key:26s} {value}")
+    print_figures(results, args.json, 26)
     return 0
 
 

@@ -44,6 +44,7 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 from PySide6.QtCore import QEvent, QEventLoop, QObject, QRectF, QTimer
 from PySide6.QtWidgets import QApplication
 
+from bench._report import print_figures
 from engine.files import save_plan
 from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
 from engine.status import Status
@@ -213,11 +214,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--frames", type=int, default=90, help="frames per measurement")
     args = parser.parse_args(argv)
     results = run_bench(args.frames)
-    if args.json:
-        print(json.dumps(results, indent=2))
-    else:
-        for key, value in results.items():
-            print(f"{key:26s} {value}")
+    print_figures(results, args.json, 26, indent=2)
     return 0
 
 

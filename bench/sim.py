@@ -27,11 +27,16 @@ and add it to the list that ``measurements()`` returns. Run from the repository 
 from __future__ import annotations
 
 import argparse
-import json
+import sys
 import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
+if __package__ in (None, ""):  # run as a script: make the repository importable
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from bench._report import print_figures
 from capabilities.sim.cell import SimCell
 from capabilities.sim.testing import add_box, down_at, run
 
@@ -171,11 +176,7 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         cell.close()
     results.update(measure_cup_to_bin())
-    if args.json:
-        print(json.dumps(results, indent=2))
-    else:
-        for key, value in results.items():
-            print(f"{key:24s} {value}")
+    print_figures(results, args.json, 24, indent=2)
     return 0
 
 

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import argparse
 import functools
-import json
 import statistics
 import sys
 import tempfile
@@ -34,6 +33,7 @@ from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from bench._report import print_figures
 from capabilities.ur.arm import URArm
 from capabilities.ur.connection import URConnection, fault_reason
 from capabilities.ur_emulator.process import EmulatorProcess
@@ -184,11 +184,7 @@ def main(argv: list[str] | None = None) -> int:
         "protective_stop_detect_ms": round(statistics.median(stops), 2),
         "protective_stop_halt_ticks": ticks,
     }
-    if args.json:
-        print(json.dumps(result))
-    else:
-        for key, value in result.items():
-            print(f"{key:32s} {value}")
+    print_figures(result, args.json, 32)
     return 0
 
 

@@ -1,0 +1,20 @@
+"""How a bench script prints its figures: a table, or one JSON object (``--json``)."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+from typing import Any
+
+__all__ = ["print_figures"]
+
+
+def print_figures(
+    figures: Mapping[str, Any], as_json: bool, width: int, indent: int | None = None
+) -> None:
+    """Print ``figures`` as one JSON object, or a line each with the name padded to ``width``."""
+    if as_json:
+        print(json.dumps(figures, indent=indent))
+    else:
+        for key, value in figures.items():
+            print(f"{key:{width}s} {value}")
