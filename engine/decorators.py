@@ -94,7 +94,26 @@ class ForceFailure(_MapsResult):
         return self.fail("forced failure", ErrorType.FAILED)
 
 
-class _Looping(Decorator):
+class _Clocked(Decorator):
+    """A decorator that times its child from its first tick since the last reset."""
+
+    _started: float | None = None
+
+    def _tick_child(self) -> tuple[Node, Status]:
+        if self._started is None:
+            self._started = self.ctx.clock()
+        child = self.children[0]
+        return child, child.tick()
+
+    def _elapsed(self) -> float:
+        started = self._started
+        return 0.0 if started is None else self.ctx.clock() - started
+
+    def on_reset(self) -> None:
+        self._started = None
+
+
+class _Looping(_Clocked):
     """Shared loop of Iterator and Enforce: reset the child on ``repeat_on``."""
 
     repeat_on = SUCCESS
@@ -117,13 +136,9 @@ class _Looping(Decorator):
         self.count = count
         self.timeout = timeout
         self.done = 0
-        self._started: float | None = None
 
     def update(self) -> Status:
-        if self._started is None:
-            self._started = self.ctx.clock()
-        child = self.children[0]
-        status = child.tick()
+        child, status = self._tick_child()
         if status is not RUNNING and status is not self.repeat_on:
             return status
         if status is self.repeat_on:
@@ -131,7 +146,7 @@ class _Looping(Decorator):
             if self.count is not None and self.done >= self.count:
                 return self._finish_count()
             child.reset()
-        if self.timeout is not None and self.ctx.clock() - self._started >= self.timeout:
+        if self.timeout is not None and self._elapsed() >= self.timeout:
             child.reset()
             self.message = f"time limit of {self.timeout:g} s reached after {self.done} rounds"
             if self.on_timeout is FAILURE:
@@ -145,8 +160,8 @@ class _Looping(Decorator):
         return self.on_count
 
     def on_reset(self) -> None:
+        super().on_reset()
         self.done = 0
-        self._started = None
 
 
 class Iterator(_Looping):
@@ -193,7 +208,7 @@ class Retry(Enforce):
         super().__init__(ctx, node_id, name, count=count)
 
 
-class Timeout(Decorator):
+class Timeout(_Clocked):
     """FAILURE, halting the child, when it runs longer than ``seconds``."""
 
     kind = "timeout"
@@ -205,17 +220,10 @@ class Timeout(Decorator):
         if seconds <= 0:
             raise ValueError(f"timeout must be above 0 s, not {seconds}")
         self.seconds = seconds
-        self._started: float | None = None
 
     def update(self) -> Status:
-        if self._started is None:
-            self._started = self.ctx.clock()
-        child = self.children[0]
-        status = child.tick()
-        if status is RUNNING and self.ctx.clock() - self._started >= self.seconds:
+        child, status = self._tick_child()
+        if status is RUNNING and self._elapsed() >= self.seconds:
             child.reset()
             return self.fail(f"timed out after {self.seconds:g} s", ErrorType.TIMEOUT)
         return status
-
-    def on_reset(self) -> None:
-        self._started = None
