@@ -128,41 +128,48 @@ def _figure3_tree(m: _Cell, finder: str, detect: str, title: str) -> NodeSpec:
     )
 
 
-def cup_to_bin() -> PlanSpec:
-    tree = _figure3_tree(_Cell("cup_to_bin"), "markers", "detect_markers", "cup to bin")
+def _figure3_plan(name: str, detect: tuple[str, str], root: str, title: str, doc: str) -> PlanSpec:
+    """Figure 3's plan ``name`` on the simulated cell, finding the cup with ``detect``."""
+    tree = _figure3_tree(_Cell(name), *detect, root)
     return PlanSpec(
         tree,
+        title,
+        doc,
+        RunPolicy.UNTIL_SUCCESS,
+        waypoints=waypoints(),
+        objects=["cup", "waste_bin"],
+        reset_cell=True,  # each run in the Instructor starts from the scene's seed
+        id=stable_id(CELL_EXAMPLES, name),
+    )
+
+
+def cup_to_bin() -> PlanSpec:
+    """Figure 3 through the ArUco markers on the cup and the bin."""
+    return _figure3_plan(
+        "cup_to_bin",
+        ("markers", "detect_markers"),
+        "cup to bin",
         "Cup to bin (Figure 3, simulated cell)",
         "The paper's Figure 3 on the simulated cell: find the cup and the waste bin through their "
         "markers, check the cup was found, query both poses, grasp the cup at its pose with the "
         "grasp of its object model and drop it over the bin. When the cup is not visible the selector falls "
         "back to WAIT (forced to fail) and the root, which runs until success, looks again. "
         "Run it with: costar run cup_to_bin.costar.json --cell sim --seed N. Runs to SUCCESS.",
-        RunPolicy.UNTIL_SUCCESS,
-        waypoints=waypoints(),
-        objects=["cup", "waste_bin"],
-        reset_cell=True,  # each run in the Instructor starts from the scene's seed
-        id=stable_id(CELL_EXAMPLES, "cup_to_bin"),
     )
 
 
 def cup_to_bin_vision() -> PlanSpec:
     """Figure 3 with model-based recognition (perception) in place of the ArUco markers."""
-    m = _Cell("cup_to_bin_vision")
-    tree = _figure3_tree(m, "perception", "detect_objects", "cup to bin (vision)")
-    return PlanSpec(
-        tree,
+    return _figure3_plan(
+        "cup_to_bin_vision",
+        ("perception", "detect_objects"),
+        "cup to bin (vision)",
         "Cup to bin, by vision (Figure 3, simulated cell)",
         "The paper's Figure 3 with model-based recognition instead of markers: the shoulder "
         "camera's point cloud is matched to the cup and waste-bin models, the plan checks the "
         "cup was found, queries both poses, grasps the cup at its pose with the grasp of its "
         "object model and drops it over the bin; when the cup is not recognised it waits and looks "
         "again. Run it with: costar run cup_to_bin_vision.costar.json --cell sim --seed N.",
-        RunPolicy.UNTIL_SUCCESS,
-        waypoints=waypoints(),
-        objects=["cup", "waste_bin"],
-        reset_cell=True,  # each run in the Instructor starts from the scene's seed
-        id=stable_id(CELL_EXAMPLES, "cup_to_bin_vision"),
     )
 
 

@@ -134,35 +134,34 @@ def handoff() -> SubtreeSpec:
     )
 
 
-def unholster() -> SubtreeSpec:
-    m = _Maker("unholster")
+def _from_home(name: str, title: str, step: str, doc: str) -> SubtreeSpec:
+    """Subtree ``name``: go home, then ``tool.<name>`` (the holster's approach is taught
+    from home).
+    """
+    m = _Maker(name)
     tree = m.node(
-        NodeKind.SEQUENCE,
-        "Unholster",
-        m.op("motion.go_home", "home"),  # the holster's approach is taught from home
-        m.op("tool.unholster", "take the suction tool"),
+        NodeKind.SEQUENCE, title, m.op("motion.go_home", "home"), m.op(f"tool.{name}", step)
     )
-    return _subtree(
+    return _subtree(name, title, doc, tree)
+
+
+def unholster() -> SubtreeSpec:
+    """The Unholster subtree: take the suction tool with the gripper."""
+    return _from_home(
         "unholster",
         "Unholster",
+        "take the suction tool",
         "Takes the suction tool out of its holster with the gripper.",
-        tree,
     )
 
 
 def holster() -> SubtreeSpec:
-    m = _Maker("holster")
-    tree = m.node(
-        NodeKind.SEQUENCE,
-        "Holster",
-        m.op("motion.go_home", "home"),
-        m.op("tool.holster", "put the suction tool back"),
-    )
-    return _subtree(
+    """The Holster subtree: put the suction tool back."""
+    return _from_home(
         "holster",
         "Holster",
+        "put the suction tool back",
         "Puts the suction tool back in its holster; the gripper is free.",
-        tree,
     )
 
 
