@@ -13,6 +13,7 @@ import math
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import Future
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from capabilities.faults import PROTECTIVE_STOP
@@ -289,24 +290,18 @@ def _lost(exc: BaseException, conn: URConnection) -> str:
     return reason if reason.startswith("connection lost") else f"connection lost ({ur_words(exc)})"
 
 
+@dataclass(eq=False)  # by identity: the connection drops it from its list of monitors
 class _Monitor:
     """Watches one asynchronous move on the I/O thread."""
 
-    def __init__(
-        self,
-        handle: CommandHandle,
-        op_before: int,
-        stop_name: str,
-        arrived: Callable[[URState], bool],
-    ) -> None:
-        self.handle = handle
-        self.op_before = op_before
-        self.stop_name = stop_name
-        self.arrived = arrived
-        self.started = False
-        self.deadline = 0.0
-        self.script_gone_at: float | None = None
-        self.script_run = -1  # the connection's script_runs when the move was sent
+    handle: CommandHandle
+    op_before: int
+    stop_name: str
+    arrived: Callable[[URState], bool]
+    started: bool = False
+    deadline: float = 0.0
+    script_gone_at: float | None = None
+    script_run: int = -1  # the connection's script_runs when the move was sent
 
     def _debounce(self, now: float) -> bool:
         """True while a stopped script has been seen for less than the grace time."""
