@@ -140,6 +140,7 @@ def _collect(figures: dict[str, list[float]], reps: int, kinds: list[Any]) -> No
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Measure the GUI thread while cells open; print the figures (``--json``: one JSON object)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.add_argument("--reps", type=int, default=3, help="openings of each kind")

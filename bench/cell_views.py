@@ -152,6 +152,9 @@ def _phase(window: Any, shown: bool, seconds: float) -> dict[str, Any]:
 
 
 def measure_cell_views(seconds: float = 6.0) -> dict[str, Any]:
+    """The camera panel's and the 3D scene's frame rates and the app's CPU while a plan runs,
+    with the views on and off.
+    """
     from instructor_app.app import HeadlessDialogs
     from instructor_app.main_window import MainWindow
     from instructor_app.runtime.session import CellSession

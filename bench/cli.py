@@ -126,6 +126,9 @@ def measure(runs: int = 5, compile_each_time: bool = False) -> dict[str, Any]:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Time the start-up of each command against ``python -c pass``; print the table
+    (``--json``: also one JSON object).
+    """
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=5, help="timed runs per command (median)")
     parser.add_argument(

@@ -73,6 +73,7 @@ def _false_positives(found: list[Recognition], truth: dict[str, Any]) -> list[st
 
 
 def summarise(results: list[dict[str, Any]]) -> dict[str, Any]:
+    """Recall, median position and rotation errors and plate accuracy over every scene's scores."""
     scores: list[ObjectScore] = [s for r in results for s in r["scores"]]
     found = [s for s in scores if s.found]
     plates = [s for s in scores if s.model.startswith("plate_")]
@@ -94,6 +95,7 @@ def summarise(results: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 def main() -> None:
+    """Run recognition over ``--scenes`` random scenes and print the summary."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--scenes", type=int, default=50, help="number of scenes (seeds 0..N-1)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")

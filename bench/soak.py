@@ -175,6 +175,7 @@ def soak(plan: str, hours: float, seed: int, stall_s: float, sample_s: float) ->
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Tend for ``--hours`` simulated hours; print memory growth, stalls and tick overruns."""
     parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
     parser.add_argument("--hours", type=float, default=4.0, help="simulated hours")
     parser.add_argument("--seed", type=int, default=2000)

@@ -152,6 +152,7 @@ def _wait(predicate: Callable[[], bool], timeout: float = 20.0) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Measure the UR cell against the emulator; print the figures (``--json``: one JSON object)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--host", default="127.0.0.250")
     parser.add_argument("--version", default="5.12", choices=("3.15", "5.9", "5.12"))

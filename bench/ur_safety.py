@@ -99,6 +99,9 @@ def busy_load(jobs: int) -> Iterator[None]:
 
 
 def wait_for(predicate: Callable[[], bool], timeout: float, step: float = 0.01) -> bool:
+    """True once ``predicate()`` holds, polled every ``step`` s; its last answer after
+    ``timeout`` s.
+    """
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         if predicate():
@@ -142,6 +145,7 @@ def stop_trial(emulator: EmulatorProcess, cell_file: Path, plan_file: Path, sig:
 
 
 def measure_stops(host: str, trials: int, out: Any) -> dict[str, Any]:
+    """Per stop signal: how often and how fast ``trials`` runs stopped the moving arm."""
     results: dict[str, Any] = {}
     with tempfile.TemporaryDirectory(prefix="costar-stops-") as scratch:
         cell_file, plan_file = Path(scratch, "emu.cell.json"), Path(scratch, "p.costar.json")
@@ -198,6 +202,9 @@ def _unlocked(pendant: Any) -> bool:
 
 
 def recovery_trial(emulator: EmulatorProcess, cell_file: Path, fault: str) -> dict:
+    """One run with ``fault`` injected mid-move: whether the cell held and the run went on after
+    the recovery.
+    """
     plan = moves_plan((0.3, -0.6, 0.2), 0.5)
     held: list[str] = []
     with open_cell(str(cell_file)) as cell:
@@ -230,6 +237,7 @@ def recovery_trial(emulator: EmulatorProcess, cell_file: Path, fault: str) -> di
 
 
 def measure_recoveries(host: str, trials: int, out: Any) -> dict[str, Any]:
+    """Per fault: how many of ``trials`` runs recovered, each on a fresh emulator."""
     results: dict[str, Any] = {}
     with tempfile.TemporaryDirectory(prefix="costar-faults-") as scratch:
         cell_file = Path(scratch, "emu.cell.json")
@@ -247,6 +255,7 @@ def measure_recoveries(host: str, trials: int, out: Any) -> dict[str, Any]:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run the stop and recovery trials against the emulator; print the report."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[1])
     parser.add_argument("--trials", type=int, default=20)
     parser.add_argument("--load", type=int, default=0, help="busy processes beside the trials")

@@ -59,7 +59,7 @@ class NewModel:
 
 
 def valid_model_name(name: str) -> str:
-    """ "" when ``name`` can name a model folder, else what is wrong with it."""
+    """What is wrong with ``name`` as a model folder's name; "" when it can name one."""
     if not _NAME.match(name):
         return (
             f"{name!r} is not a model name: use lower-case letters, digits and underscores, "

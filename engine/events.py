@@ -22,6 +22,8 @@ __all__ = [
 
 @dataclass(frozen=True, slots=True)
 class RunStarted:
+    """A run of the plan named ``plan`` started."""
+
     time: float
     plan: str
 
@@ -41,6 +43,8 @@ class StatusChanged:
 
 @dataclass(frozen=True, slots=True)
 class BlackboardWritten:
+    """A node wrote ``value`` under ``key`` on the blackboard."""
+
     tick: int
     key: str
     value: Any
@@ -50,6 +54,8 @@ class BlackboardWritten:
 
 @dataclass(frozen=True, slots=True)
 class LogMessage:
+    """A node logged ``message``."""
+
     tick: int
     node_id: str
     message: str

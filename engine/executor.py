@@ -42,6 +42,8 @@ __all__ = ["Executor", "ExecutorState", "run_to_end"]
 
 
 class ExecutorState(str, enum.Enum):
+    """Where the executor is: ready to start, running, paused or finished."""
+
     READY = "ready"
     RUNNING = "running"
     PAUSED = "paused"

@@ -174,10 +174,10 @@ def file_name(name: str) -> str:
 
 
 def check_folder(root: Path, folder: str) -> Path:
-    """The library folder ``folder`` names: relative to ``root`` and inside it.
+    r"""The library folder ``folder`` names: relative to ``root`` and inside it.
 
     Raises:
-        LibraryError: ``folder`` is absolute (``/x``, ``C:\\x``, ``C:/x``, ``\\\\server\\share``),
+        LibraryError: ``folder`` is absolute (``/x``, ``C:\x``, ``C:/x``, ``\\server\share``),
             has a ``..`` part, a control character (NUL included) or a ``:``, or leads out of
             the library through a symbolic link.
     """

@@ -178,6 +178,9 @@ def save_plan(plan: PlanSpec, path: str | os.PathLike[str]) -> None:
 
 
 def write_atomic(target: Path, data: bytes) -> None:
+    """Replace ``target`` with ``data`` atomically (a synced temporary file renamed over it),
+    keeping its permissions.
+    """
     tmp = target.with_name(f".{target.name}.{uuid.uuid4().hex[:8]}.tmp")
     done = False
     try:

@@ -40,6 +40,8 @@ def new_id() -> str:
 
 
 class Category(str, enum.Enum):
+    """How many children a node kind takes: several (composite), one (decorator) or none."""
+
     COMPOSITE = "composite"
     DECORATOR = "decorator"
     LEAF = "leaf"

@@ -132,6 +132,9 @@ def stated(params: dict[str, Binding]) -> dict[str, Binding]:
 def check_bound_ports(
     check: Check, node: NodeSpec, manifest: OperationManifest, params: dict[str, Binding]
 ) -> None:
+    """Check each parameter a node binds: the port exists, a result is stored under a name, a
+    fixed value fits.
+    """
     for port_name, binding in params.items():
         port = manifest.port(port_name)
         if port is None:
@@ -151,6 +154,9 @@ def check_bound_ports(
 def check_unbound_ports(
     check: Check, node: NodeSpec, manifest: OperationManifest, params: dict[str, Binding]
 ) -> None:
+    """Check the ports a node leaves unbound: a required one is an error, a query's unstored
+    result a warning.
+    """
     for port in manifest.ports:
         if port.name in params:
             continue
@@ -174,6 +180,7 @@ def check_unbound_ports(
 def check_output(
     check: Check, node: NodeSpec, port: str, binding: Binding, types: tuple[ParamType, ...]
 ) -> None:
+    """Check a result port is bound to a name, and record the node as a writer of that name."""
     if not binding.is_ref:
         check.add(
             ERROR,
@@ -257,23 +264,30 @@ def check_named_operation(check: Check, node: NodeSpec, port: PortSpec, binding:
 
 
 def fits(ptype: ParamType, accepted: Sequence[ParamType]) -> bool:
+    """True when a value of ``ptype`` is accepted by a port of the ``accepted`` types."""
     return ptype in accepted or ParamType.ANY in accepted
 
 
 def fits_any(given: Sequence[ParamType], accepted: Sequence[ParamType]) -> bool:
+    """True when one of the ``given`` types (or Any) fits the ``accepted`` ones."""
     return ParamType.ANY in given or any(fits(t, accepted) for t in given)
 
 
 def any_type(a: Sequence[ParamType], b: Sequence[ParamType]) -> bool:
+    """True when either side accepts any type."""
     return ParamType.ANY in a or ParamType.ANY in b
 
 
 def type_names(types: Sequence[ParamType]) -> str:
+    """The types in words: "a Pose or a Waypoint" ("a value" for none)."""
     names = [f"a {ParamType(t).value}" for t in types]
     return " or ".join(names) if names else "a value"
 
 
 def close_names(word: str, candidates: Iterable[str]) -> str:
+    """A " (did you mean ...?)" hint naming up to three ``candidates`` close to ``word``; ""
+    when none is.
+    """
     matches = difflib.get_close_matches(word, list(candidates), n=3, cutoff=0.6)
     return f" (did you mean {' or '.join(repr(m) for m in matches)}?)" if matches else ""
 

@@ -14,6 +14,8 @@ __all__ = ["CameraDevice", "FrameLike", "MarkerLayout"]
 
 
 class FrameLike(Protocol):
+    """A camera frame as marker detection reads it: colour, depth, intrinsics, pose, time."""
+
     rgb: np.ndarray
     depth: np.ndarray | None
     K: np.ndarray

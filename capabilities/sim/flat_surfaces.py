@@ -108,10 +108,12 @@ class FlatSurfaces:
         depth along the optical axis, NaN where nothing was hit), in place.
 
         Args:
-            rgb, depth: the rendered picture.
+            rgb: the rendered picture's colours.
+            depth: the rendered picture's depths.
             K: the picture's intrinsics (OpenCV convention).
             T_world_camera: the camera (OpenCV frame) in the world.
-            near, far: the camera's clipping distances (nothing is drawn outside them).
+            near: the camera's near clipping distance (nothing nearer is drawn).
+            far: the camera's far clipping distance (nothing farther is drawn).
         """
         a, b = self._pixel_rays(depth.shape, K)
         m = pose_to_matrix(T_world_camera)

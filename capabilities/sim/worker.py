@@ -84,6 +84,8 @@ class NudgeSpec:
 
 @dataclass(frozen=True)
 class WorkerSpec:
+    """The ``worker`` block of a scene: the person's hand-offs and nudges."""
+
     handoffs: tuple[HandoffSpec, ...] = ()
     nudges: tuple[NudgeSpec, ...] = ()
 

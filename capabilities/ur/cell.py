@@ -216,7 +216,10 @@ class URCellSession(ClosesOnExit):
 
 
 def _last_heard(connection: URConnection) -> str:
-    """ "; last heard 12 s ago: robot mode RUNNING, safety mode NORMAL, program running"."""
+    """What was last heard of the robot, as a suffix of a fault; "" when nothing was.
+
+    For example "; last heard 12 s ago: robot mode RUNNING, safety mode NORMAL, program running".
+    """
     last = connection.last_heard
     if not last.stamp:
         return ""

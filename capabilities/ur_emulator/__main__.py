@@ -157,6 +157,7 @@ def _emulator(args: argparse.Namespace, stack: contextlib.ExitStack) -> UREmulat
 
 
 def main(argv: list[str] | None = None, prog: str = "python -m capabilities.ur_emulator") -> int:
+    """Run the emulator from the command line until stopped; the exit status."""
     parser = argparse.ArgumentParser(
         prog=prog,
         description="A loopback UR controller (dashboard, script port, RTDE) backed by the "

@@ -1,7 +1,7 @@
-"""Our ids in BehaviorTree.CPP's allowed characters, reversibly.
+r"""Our ids in BehaviorTree.CPP's allowed characters, reversibly.
 
 BehaviorTree.CPP 4.8.4 and later refuse model ids (and BehaviorTree ids) that hold ``.``,
-``:``, ``/``, spaces, quotes, ``<>&*?|\\`` or control characters, and an XML element name
+``:``, ``/``, spaces, quotes, ``<>&*?|\`` or control characters, and an XML element name
 must start with a letter. Operation ids are ``capability.verb_object``, so the usual id
 only needs its dots mapped: ``motion.move_to`` <-> ``motion__move_to``. That "plain" form is
 used when it can be undone unambiguously: the id is letters and digits in runs joined by

@@ -17,6 +17,7 @@ from tools.generators import (
 
 
 def main() -> int:
+    """Run every generator, writing the shipped files under ``resources/``; the exit status."""
     status = make_objects.main([])
     for generator in (
         make_clear_stop,

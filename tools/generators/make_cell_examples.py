@@ -42,6 +42,7 @@ BIN_DROP_Z = 0.36  # m above the bin's bottom: 14 cm over its 22 cm rim
 
 
 def waypoints() -> list[Waypoint]:
+    """The taught waypoints of the Figure 3 plans on the simulated cell."""
     return [
         Waypoint("observe", WaypointFrame.JOINTS, joints=JointConfig(OBSERVE_JOINTS)),
         Waypoint(
@@ -67,6 +68,7 @@ RACK_DROP_Z, OVER_RACK_Z = 0.235, 0.32
 
 
 def tending_waypoints() -> list[Waypoint]:
+    """The taught waypoints of the tending example on the simulated cell."""
     return [
         Waypoint("observe", WaypointFrame.JOINTS, joints=JointConfig(OBSERVE_JOINTS)),
         Waypoint("over exit", WaypointFrame.WORLD, Pose((*EXIT_XY, ABOVE_Z), EXIT_DOWN)),
@@ -259,6 +261,7 @@ def tending_paper() -> PlanSpec:
 
 
 def main() -> None:
+    """Write the simulated cell's example plans."""
     path = HERE / "cup_to_bin.costar.json"
     save_plan(cup_to_bin(), path)
     WaypointLibrary(waypoints()).save(waypoints_path_for(path))

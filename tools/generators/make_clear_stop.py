@@ -62,6 +62,7 @@ def clear_stop_and_back_off() -> SubtreeSpec:
 
 
 def main() -> None:
+    """Write the ClearStopAndBackOff subtree into the shipped library."""
     write_library(LIBRARY, [clear_stop_and_back_off()], RESOURCES)
 
 

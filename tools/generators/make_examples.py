@@ -440,6 +440,7 @@ def node_examples() -> dict[str, PlanSpec]:
 
 
 def main() -> None:
+    """Write Figure 3's debug plan and the example plan of each node kind."""
     save_plan(figure3(), HERE / "figure3_debug.costar.json")
     for name, plan in node_examples().items():
         save_plan(plan, HERE / "nodes" / f"{name}.costar.json")

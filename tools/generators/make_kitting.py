@@ -66,6 +66,7 @@ def _turned(yaw: float) -> tuple[float, float, float, float]:
 
 
 def observe() -> Waypoint:
+    """The joint-space waypoint from which the shoulder camera sees the table."""
     return Waypoint("observe", WaypointFrame.JOINTS, joints=JointConfig(OBSERVE_JOINTS))
 
 
@@ -105,6 +106,7 @@ def _subtree(key: str, name: str, description: str, tree: NodeSpec, **ports: Any
 
 
 def handoff() -> SubtreeSpec:
+    """The Handoff subtree: step out of view and wait until a person hands over the bin."""
     m = _Maker("handoff")
     tree = m.node(
         NodeKind.SEQUENCE,
@@ -166,6 +168,7 @@ def holster() -> SubtreeSpec:
 
 
 def transfer() -> SubtreeSpec:
+    """The Transfer subtree: find a plate on the table and put it into the kit bin."""
     m = _Maker("transfer")
     tree = m.node(
         NodeKind.SEQUENCE,
@@ -216,6 +219,7 @@ def transfer() -> SubtreeSpec:
 
 
 def return_bin() -> SubtreeSpec:
+    """The Return subtree: grasp the bin by its wall and put it down at the return place."""
     m = _Maker("return")
     tree = m.node(
         NodeKind.SEQUENCE,
@@ -248,10 +252,12 @@ def return_bin() -> SubtreeSpec:
 
 
 def library() -> list[SubtreeSpec]:
+    """The kitting subtrees, in the order they are written."""
     return [handoff(), unholster(), transfer(), holster(), return_bin()]
 
 
 def wall_grasp() -> Waypoint:
+    """Above the grasp on the kit bin's wall, relative to the bin."""
     return Waypoint(
         "above the bin's wall",
         WaypointFrame.OBJECT,
@@ -261,12 +267,14 @@ def wall_grasp() -> Waypoint:
 
 
 def return_place() -> Waypoint:
+    """Above where the bin is put down after kitting (world frame)."""
     x, y = RETURN_AT
     at = Pose((x, y + WALL_Y, WALL_GRASP_Z + HOVER + 0.003), DOWN)
     return Waypoint("above the return place", WaypointFrame.WORLD, at)
 
 
 def kitting() -> PlanSpec:
+    """The kitting plan: hand-off, plates into the bin, return the bin."""
     subs = {s.id.split(".")[1]: s for s in library()}
     m = _Maker("kitting")
 
@@ -327,6 +335,7 @@ def kitting() -> PlanSpec:
 
 
 def main() -> None:
+    """Write the kitting plan and its subtrees."""
     write_library(LIBRARY, library(), RESOURCES)
     plan = HERE / "kitting.costar.json"
     save_plan(kitting(), plan)

@@ -149,6 +149,7 @@ def _part_cycle(
 
 
 def tending() -> PlanSpec:
+    """Our tending plan for the wire bender, with its recovery subtrees."""
     subs = {s.name: s for folder in library().values() for s in folder}
     subs["ClearStopAndBackOff"] = clear_stop()
     wps = {w.name: w for w in waypoints()}
@@ -256,6 +257,7 @@ def tending() -> PlanSpec:
 
 
 def main() -> None:
+    """Write our tending plan and the tending and recovery subtrees."""
     for folder, subtrees in library().items():
         write_library(LIBRARY / folder, subtrees, RESOURCES)
     plan = HERE / "tending.costar.json"

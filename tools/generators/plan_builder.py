@@ -121,6 +121,7 @@ def _bound(params: dict[str, Binding | str]) -> dict[str, Binding]:
 
 
 def fixed(value: Any, ptype: ParamType) -> Binding:
+    """A fixed parameter value of type ``ptype``."""
     return Binding.fixed(value, ptype)
 
 
@@ -130,6 +131,7 @@ def obj(name: str) -> Binding:
 
 
 def port(name: str, ptype: ParamType, doc: str, default: Any = None) -> SubtreePort:
+    """A subtree port: its name, type, doc and default."""
     return SubtreePort(name, ptype, doc, default)
 
 

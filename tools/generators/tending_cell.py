@@ -50,6 +50,7 @@ TAKE_TIME = 15.0  # s: simulated seconds for a pick (its moves take about 5)
 
 
 def observe() -> Waypoint:
+    """The joint-space waypoint from which the shoulder camera sees the cell."""
     return Waypoint("observe", WaypointFrame.JOINTS, joints=JointConfig(OBSERVE_JOINTS))
 
 

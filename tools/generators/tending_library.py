@@ -1,5 +1,6 @@
-"""The shipped tending and recovery subtrees of our wire-bender tending plan (written by
-``make_tending.py``):
+"""The shipped tending and recovery subtrees of our wire-bender tending plan.
+
+Written by ``make_tending.py``:
 
 - ``resources/library/tending``: PickAtExit (take a part at the exit with taught waypoints
   and feel it held before and after lifting), PlaceOnRack (drop it into the rack's tote,
@@ -59,6 +60,7 @@ def _piece_ports() -> list[SubtreePort]:
 
 
 def pick_at_exit() -> SubtreeSpec:
+    """The PickAtExit subtree: take a part at the exit, feeling it held."""
     m = TendingMaker("pick_at_exit")
     tree = m.take("PickAtExit", "ABOVE", "AT")
     return subtree(
@@ -72,6 +74,7 @@ def pick_at_exit() -> SubtreeSpec:
 
 
 def wait_for_part() -> SubtreeSpec:
+    """The WaitForPart subtree: wait for the machine's arm to drop a part."""
     m = TendingMaker("wait_for_part")
     tree = m.node(
         NodeKind.CATCH,
@@ -112,6 +115,7 @@ def wait_for_part() -> SubtreeSpec:
 
 
 def place_on_rack() -> SubtreeSpec:
+    """The PlaceOnRack subtree: drop what the gripper holds into the rack's tote."""
     m = TendingMaker("place_on_rack")
     tree = m.node(
         NodeKind.SEQUENCE,
@@ -136,6 +140,7 @@ def place_on_rack() -> SubtreeSpec:
 
 
 def regrasp() -> SubtreeSpec:
+    """The Regrasp recovery: let go and take the part at the exit again."""
     m = TendingMaker("regrasp")
     tree = m.node(
         NodeKind.RETRY,
@@ -161,6 +166,7 @@ def regrasp() -> SubtreeSpec:
 
 
 def discard_to_scrap() -> SubtreeSpec:
+    """The DiscardToScrap recovery: a bad part and its pieces into the scrap bin."""
     m = TendingMaker("discard_to_scrap")
     held = m.held_into_scrap("SCRAP")
 
@@ -221,6 +227,7 @@ def discard_to_scrap() -> SubtreeSpec:
 
 
 def reregister_rack() -> SubtreeSpec:
+    """The ReRegisterRack recovery: find the rack again through its markers."""
     m = TendingMaker("reregister_rack")
     tree = m.node(
         NodeKind.SEQUENCE,
@@ -314,6 +321,7 @@ def _to_the_rack_then_the_left_piece(m: TendingMaker) -> list[NodeSpec]:
 
 
 def part_then_left_piece() -> SubtreeSpec:
+    """The PartThenLeftPiece recovery: the part to the rack, then a left-over piece to scrap."""
     m = TendingMaker("part_then_left_piece")
     # A discard the next part cut short leaves the left piece where that part lands (a bar of
     # either shape lies on its spot): the part goes to the rack first, the piece after. A
