@@ -2,11 +2,19 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 from collections.abc import Mapping
 from typing import Any
 
-__all__ = ["print_figures"]
+__all__ = ["figures_parser", "print_figures"]
+
+
+def figures_parser(doc: str | None) -> argparse.ArgumentParser:
+    """A bench script's argument parser: described by its doc's first line, with ``--json``."""
+    parser = argparse.ArgumentParser(description=(doc or "").splitlines()[0])
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    return parser
 
 
 def print_figures(

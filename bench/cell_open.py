@@ -24,7 +24,6 @@ Run from the repository root::
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import statistics
@@ -42,7 +41,7 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 from PySide6.QtCore import QEventLoop, QTimer
 from PySide6.QtWidgets import QApplication
 
-from bench._report import print_figures
+from bench._report import figures_parser, print_figures
 from capabilities.ur_emulator.process import EmulatorProcess
 from instructor_app.runtime.session import CellSession
 
@@ -141,8 +140,7 @@ def _collect(figures: dict[str, list[float]], reps: int, kinds: list[Any]) -> No
 
 def main(argv: list[str] | None = None) -> int:
     """Measure the GUI thread while cells open; print the figures (``--json``: one JSON object)."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser = figures_parser(__doc__)
     parser.add_argument("--reps", type=int, default=3, help="openings of each kind")
     parser.add_argument("--host", default="127.254.0.2", help="loopback address of the emulator")
     args = parser.parse_args(argv)

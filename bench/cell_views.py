@@ -29,7 +29,6 @@ Run it on its own or through ``bench/gui.py`` (which runs it in a process of its
 
 from __future__ import annotations
 
-import argparse
 import os
 import sys
 import tempfile
@@ -46,7 +45,7 @@ if not os.environ.get("DISPLAY"):
 from PySide6.QtCore import QEventLoop, QSettings, QTimer
 from PySide6.QtWidgets import QApplication
 
-from bench._report import print_figures
+from bench._report import figures_parser, print_figures
 from engine.tree import RunPolicy
 
 __all__ = ["measure_cell_views", "main"]
@@ -205,8 +204,7 @@ def measure_cell_views(seconds: float = 6.0) -> dict[str, Any]:
 
 def main(argv: list[str] | None = None) -> int:
     """Print the figures (``--json``: one JSON object)."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser = figures_parser(__doc__)
     parser.add_argument("--seconds", type=float, default=6.0, help="length of each phase")
     args = parser.parse_args(argv)
     results = measure_cell_views(args.seconds)

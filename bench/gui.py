@@ -24,7 +24,6 @@ Run from the repository root::
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import random
@@ -44,7 +43,7 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 from PySide6.QtCore import QEvent, QEventLoop, QObject, QRectF, QTimer
 from PySide6.QtWidgets import QApplication
 
-from bench._report import print_figures
+from bench._report import figures_parser, print_figures
 from engine.files import save_plan
 from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
 from engine.status import Status
@@ -209,8 +208,7 @@ def measure_cell_views_in_a_process() -> dict[str, Any]:
 
 def main(argv: list[str] | None = None) -> int:
     """Print the figures (``--json``: one JSON object)."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser = figures_parser(__doc__)
     parser.add_argument("--frames", type=int, default=90, help="frames per measurement")
     args = parser.parse_args(argv)
     results = run_bench(args.frames)

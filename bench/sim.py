@@ -26,7 +26,6 @@ and add it to the list that ``measurements()`` returns. Run from the repository 
 
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 from collections.abc import Callable
@@ -36,7 +35,7 @@ from typing import Any
 if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from bench._report import print_figures
+from bench._report import figures_parser, print_figures
 from capabilities.sim.cell import SimCell
 from capabilities.sim.testing import add_box, down_at, run
 
@@ -163,8 +162,7 @@ def measurements() -> list[Measurement]:
 
 def main(argv: list[str] | None = None) -> int:
     """Run every measurement and print the figures (``--json`` for one JSON object)."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser = figures_parser(__doc__)
     args = parser.parse_args(argv)
     t0 = time.perf_counter()
     cell = SimCell(speed=None)

@@ -29,8 +29,8 @@ from typing import Any
 
 import numpy as np
 
-from capabilities.sim.scene_spec import SceneFileError
-from engine.json_reader import JsonFileError, JsonReader
+from capabilities.sim.scene_spec import SceneFileError, parse_block
+from engine.json_reader import JsonReader
 
 __all__ = [
     "BenderSpec",
@@ -149,12 +149,9 @@ def parse_bender(data: Any, source: str = "<scene>") -> BenderSpec | None:
     Raises:
         SceneFileError: the block is off; the message names ``source`` and the JSON path.
     """
-    if not isinstance(data, dict) or "bender" not in data:
+    spec = parse_block(data, source, "bender", _FIELDS, _spec)
+    if spec is None:
         return None
-    try:
-        spec = _spec(JsonReader(data, source).child("bender", _FIELDS, optional=False))
-    except JsonFileError as exc:
-        raise SceneFileError(str(exc)) from exc
     if spec.interval < 2 * spec.swing + spec.hold:
         raise SceneFileError(
             f"{source}: $.bender.interval: at least swing * 2 + hold "

@@ -23,9 +23,10 @@ randomisation; ``capabilities.sim.scene.load_scene`` builds it in pybullet. Fiel
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from capabilities.sim.objects import SceneError
 from engine.json_reader import JsonFileError, JsonReader, read_json_file
@@ -39,12 +40,15 @@ __all__ = [
     "SceneFileError",
     "SceneSpec",
     "TableSpec",
+    "parse_block",
     "parse_scene",
     "read_scene",
     "read_scene_json",
 ]
 
 FORMAT_VERSION = 1
+
+T = TypeVar("T")
 
 
 class SceneFileError(SceneError):
@@ -240,6 +244,22 @@ def read_scene(scene: Path | str | dict[str, Any] | SceneSpec) -> SceneSpec:
     if isinstance(scene, dict):
         return parse_scene(scene, "<scene dict>")
     return parse_scene(read_scene_json(scene), str(scene))
+
+
+def parse_block(
+    data: Any, source: str, name: str, fields: tuple[str, ...], build: Callable[[JsonReader], T]
+) -> T | None:
+    """``build`` of the block ``name`` of a parsed scene file (with ``fields``); None without one.
+
+    Raises:
+        SceneFileError: the block is off; the message names ``source`` and the JSON path.
+    """
+    if not isinstance(data, dict) or name not in data:
+        return None
+    try:
+        return build(JsonReader(data, source).child(name, fields, optional=False))
+    except JsonFileError as exc:
+        raise SceneFileError(str(exc)) from exc
 
 
 def read_scene_json(path: Path | str) -> Any:

@@ -36,9 +36,9 @@ import numpy as np
 
 from capabilities.sim.objects import object_frame_pose, set_object_frame_pose
 from capabilities.sim.scene import SceneState, yaw_pose
-from capabilities.sim.scene_spec import SceneFileError, read_scene_json
+from capabilities.sim.scene_spec import parse_block, read_scene_json
 from capabilities.sim.schedule import ScheduledActor
-from engine.json_reader import JsonFileError, JsonReader
+from engine.json_reader import JsonReader
 from engine.types import Pose
 
 __all__ = [
@@ -147,16 +147,14 @@ def parse_worker(data: Any, source: str = "<scene>") -> WorkerSpec | None:
     Raises:
         SceneFileError: the block is off; the message names ``source`` and the JSON path.
     """
-    if not isinstance(data, dict) or "worker" not in data:
-        return None
-    try:
-        block = JsonReader(data, source).child("worker", ("handoffs", "nudges"), optional=False)
-        return WorkerSpec(
-            tuple(_handoff(h) for h in block.items("handoffs", "handoffs")),
-            tuple(_nudge(n) for n in block.items("nudges", "nudges")),
-        )
-    except JsonFileError as exc:
-        raise SceneFileError(str(exc)) from exc
+    return parse_block(data, source, "worker", ("handoffs", "nudges"), _worker)
+
+
+def _worker(block: JsonReader) -> WorkerSpec:
+    return WorkerSpec(
+        tuple(_handoff(h) for h in block.items("handoffs", "handoffs")),
+        tuple(_nudge(n) for n in block.items("nudges", "nudges")),
+    )
 
 
 def read_worker(path: Path | str) -> WorkerSpec | None:
