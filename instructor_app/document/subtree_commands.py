@@ -64,10 +64,10 @@ class DropUnusedSubtreesCommand(PlanFieldCommand):
         super().redo()
 
 
-def _layout_of(document: PlanModel, node_id: str, new_id: str) -> dict[str, NodeLayout]:
-    """The node's layout entry under the id of the node that takes its place."""
+def _in_place_of(document: PlanModel, node_id: str, node: NodeSpec) -> ReplaceNodeCommand:
+    """Put ``node`` where ``node_id`` is, at its canvas position if it was placed by hand."""
     layout = document.plan.layout.get(node_id)
-    return {new_id: layout} if layout else {}
+    return ReplaceNodeCommand(document, node_id, node, {node.id: layout} if layout else {})
 
 
 class PasteWithSubtreesCommand(CompoundCommand):
@@ -111,9 +111,8 @@ class UseSavedSubtreeCommand(CompoundCommand):
     ) -> None:
         original = document.node(node_id)
         super().__init__(document, f"Save {original.label} as the subtree {saved.name}")
-        layout = _layout_of(document, node_id, instance.id)
         self.add(EmbedSubtreesCommand(document, [saved]))
-        self.add(ReplaceNodeCommand(document, node_id, instance, layout))
+        self.add(_in_place_of(document, node_id, instance))
 
 
 class DetachInstanceCommand(CompoundCommand):
@@ -121,8 +120,7 @@ class DetachInstanceCommand(CompoundCommand):
 
     def __init__(self, document: PlanModel, node_id: str, nodes: NodeSpec) -> None:
         super().__init__(document, f"Detach {document.node(node_id).label}")
-        layout = _layout_of(document, node_id, nodes.id)
-        self.add(ReplaceNodeCommand(document, node_id, nodes, layout))
+        self.add(_in_place_of(document, node_id, nodes))
         self.add(DropUnusedSubtreesCommand(document))
 
 
@@ -132,9 +130,8 @@ class UpdateInstanceCommand(CompoundCommand):
     def __init__(
         self, document: PlanModel, node_id: str, newer: SubtreeSpec, updated: NodeSpec
     ) -> None:
-        instance = document.node(node_id)
-        super().__init__(document, f"Update {instance.label} to version {newer.version}")
-        layout = _layout_of(document, node_id, updated.id)
+        label = document.node(node_id).label
+        super().__init__(document, f"Update {label} to version {newer.version}")
         self.add(EmbedSubtreesCommand(document, [newer]))
-        self.add(ReplaceNodeCommand(document, node_id, updated, layout))
+        self.add(_in_place_of(document, node_id, updated))
         self.add(DropUnusedSubtreesCommand(document))
