@@ -169,7 +169,7 @@ def measure_cell_views(seconds: float = 6.0) -> dict[str, Any]:
             window.resize(1920, 1080)
             window.show()
             window.document.open(PLAN)
-            window.document.set_plan_field("run_policy", RunPolicy.FOREVER)
+            window.document.set_run_policy(RunPolicy.FOREVER)
             assert window.controller.run(), "the plan did not start"
             first_picture = _first_pictures(window)
             off = _phase(window, False, seconds)

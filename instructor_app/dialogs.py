@@ -29,7 +29,7 @@ class Dialogs:
         return QMessageBox(parent)
 
     def ask_save_changes(self, parent: QWidget, name: str) -> str:
-        """ "save", "discard" or "cancel"."""
+        """Ask whether to save the changes: "save", "discard" or "cancel"."""
         box = self.make_box(parent)
         box.setIcon(QMessageBox.Icon.Warning)
         box.setWindowTitle(APP_TITLE)

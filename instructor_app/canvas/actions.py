@@ -122,18 +122,7 @@ class CanvasActions(QObject):
         return ids[0]
 
     def delete(self) -> None:
-        ids = self._top_most(self.selected())
-        if not ids:
-            raise DocumentError("select a node to delete")
-        stack = self.document.undo_stack
-        stack.beginMacro(
-            "Delete nodes" if len(ids) > 1 else f"Delete {self.document.node(ids[0]).label}"
-        )
-        try:
-            for node_id in ids:
-                self.document.remove_node(node_id)
-        finally:
-            stack.endMacro()
+        self.document.remove_nodes(self._top_most(self.selected()))
 
     def copy(self) -> None:
         self._to_clipboard(self.document.subtree_json(self._current()))

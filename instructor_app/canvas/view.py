@@ -270,18 +270,13 @@ class CanvasView(QWidget):
         """
         doc = self.document
         try:
-            current_parent, _, _ = doc.locate(node_id)
-            index = len(doc.node(parent_id).children) - (1 if current_parent == parent_id else 0)
-            stack = doc.undo_stack
-            stack.beginMacro(f"Move {doc.node(node_id).label}")
-            try:
-                doc.move_node(node_id, parent_id, index)
-                placed = doc.plan.layout.get(node_id)
-                if has_position(placed):
-                    keep = NodeLayout(collapsed=True) if placed and placed.collapsed else None
-                    doc.set_layout({node_id: keep}, "Place automatically")
-            finally:
-                stack.endMacro()
+            placed = doc.plan.layout.get(node_id)
+            layouts: dict[str, NodeLayout | None] = {}
+            if has_position(placed):
+                layouts[node_id] = (
+                    NodeLayout(collapsed=True) if placed and placed.collapsed else None
+                )
+            doc.move_to_end(node_id, parent_id, layouts)
         except DocumentError as exc:
             self.message.emit(str(exc))
         self.mirror.restore_link(node_id)

@@ -1,32 +1,42 @@
 """PlanDocument: a PlanModel with its undo stack and its file.
 
 Every edit a view makes goes through a method here that pushes one undo command
-(:mod:`instructor_app.document.commands`); the commands call the model's public mutators.
+(:mod:`instructor_app.document.commands`; an edit of several changes is one command with
+children); the commands call the model's public mutators.
 """
 
 from __future__ import annotations
 
 import copy
 from pathlib import Path
-from typing import Any
 
 from PySide6.QtCore import QObject
-from PySide6.QtGui import QUndoStack
+from PySide6.QtGui import QUndoCommand, QUndoStack
 
 from engine.files import PlanFileError, load_plan, loads_plan, save_plan
-from engine.spec import Binding, NodeLayout, NodeSpec, PlanSpec
-from engine.types import ParamType, Waypoint
+from engine.spec import Binding, NodeLayout, NodeSpec, ParameterDecl, PlanSpec
+from engine.tree import RunPolicy
+from engine.types import Waypoint
 from instructor_app.document import tree_ops
 from instructor_app.document.commands import (
     AddNodeCommand,
+    DeclareParameterCommand,
+    DeleteNodesCommand,
     MoveNodeCommand,
     RemoveNodeCommand,
+    RemoveWaypointCommand,
     RenameCommand,
+    RenamePlanCommand,
+    ReparentCommand,
+    ReplaceWaypointCommand,
     SetLayoutCommand,
     SetParamCommand,
-    SetPlanFieldCommand,
+    SetResetCellCommand,
+    SetRunPolicyCommand,
+    StoreWaypointsCommand,
 )
 from instructor_app.document.model import DocumentError, PlanModel
+from instructor_app.document.subtree_commands import PasteWithSubtreesCommand
 
 __all__ = ["PlanDocument"]
 
@@ -50,7 +60,8 @@ class PlanDocument(PlanModel):
 
     # ------------------------------------------------------------------ editing (undoable)
 
-    def _push(self, command: Any) -> None:
+    def push(self, command: QUndoCommand) -> None:
+        """Do ``command`` and put it on the undo stack (the editing methods' one way in)."""
         try:
             self.undo_stack.push(command)
         except tree_ops.TreeEditError as exc:
@@ -64,24 +75,60 @@ class PlanDocument(PlanModel):
         layout: dict[str, NodeLayout] | None = None,
     ) -> str:
         """Add a node (or subtree) under ``parent_id`` (None: as the root); returns its id."""
-        if parent_id is None and self.plan.tree is not None:
-            raise DocumentError("the plan already has a root node; add the node under it")
-        if parent_id is not None:
-            parent = self.node(parent_id)
-            if not tree_ops.can_have_child(parent):
-                raise DocumentError(f"{parent.label!r} cannot take another child")
-            index = len(parent.children) if index is None else index
-        self._push(AddNodeCommand(self, node, parent_id, index or 0, layout))
+        parent_id, index = self._place(parent_id, index)
+        self.push(AddNodeCommand(self, node, parent_id, index, layout))
         return node.id
 
+    def _place(self, parent_id: str | None, index: int | None) -> tuple[str | None, int]:
+        """Where a new node goes: under ``parent_id`` (None: as the root) at ``index``
+        (None: last); DocumentError if it cannot go there.
+        """
+        if parent_id is None and self.plan.tree is not None:
+            raise DocumentError("the plan already has a root node; add the node under it")
+        if parent_id is None:
+            return None, 0
+        parent = self.node(parent_id)
+        if not tree_ops.can_have_child(parent):
+            raise DocumentError(f"{parent.label!r} cannot take another child")
+        return parent_id, len(parent.children) if index is None else index
+
     def remove_node(self, node_id: str) -> None:
+        """Delete a node with the nodes below it."""
         self.node(node_id)
-        self._push(RemoveNodeCommand(self, node_id))
+        self.push(RemoveNodeCommand(self, node_id))
+
+    def remove_nodes(self, node_ids: list[str]) -> None:
+        """Delete several nodes (none below another) with the nodes below them: one step."""
+        if not node_ids:
+            raise DocumentError("select a node to delete")
+        for node_id in node_ids:
+            self.node(node_id)
+        self.push(DeleteNodesCommand(self, node_ids))
 
     def move_node(self, node_id: str, parent_id: str, index: int) -> None:
         """Reparent or reorder; ``index`` counts in the new parent's children as they are
         after the node was taken out.
         """
+        if self._moves(node_id, parent_id, index):
+            self.push(MoveNodeCommand(self, node_id, parent_id, index))
+
+    def move_to_end(
+        self,
+        node_id: str,
+        parent_id: str,
+        layouts: dict[str, NodeLayout | None] | None = None,
+    ) -> None:
+        """Make a node the last child of ``parent_id`` (a drag onto a node, a new link), and
+        change ``layouts`` (the node's hand-placed position) in the same undo step.
+        """
+        current_parent, _, _ = self.locate(node_id)
+        index = len(self.node(parent_id).children) - (1 if current_parent == parent_id else 0)
+        moves = self._moves(node_id, parent_id, index)
+        if moves or layouts:
+            self.push(ReparentCommand(self, node_id, parent_id, index if moves else None, layouts))
+
+    def _moves(self, node_id: str, parent_id: str, index: int) -> bool:
+        """Whether the node goes elsewhere; DocumentError if it cannot go there."""
         node = self.node(node_id)
         target = self.node(parent_id)
         if parent_id in tree_ops.subtree_ids(node):
@@ -93,27 +140,54 @@ class PlanDocument(PlanModel):
         places = len(target.children) + extra  # places once the node is taken out, plus one
         if not 0 <= index < places:
             raise DocumentError(f"{target.label!r} has no place {index} (0 to {places - 1})")
-        if current_parent == parent_id and current_index == index:
-            return  # nothing moves: no undo step
-        self._push(MoveNodeCommand(self, node_id, parent_id, index))
+        return not (current_parent == parent_id and current_index == index)  # else: no step
 
     def set_param(self, node_id: str, port: str, binding: Binding | None) -> None:
-        self._push(SetParamCommand(self, node_id, port, binding))
+        self.push(SetParamCommand(self, node_id, port, binding))
 
     def rename(self, node_id: str, name: str) -> None:
         if self.node(node_id).name != name:
-            self._push(RenameCommand(self, node_id, name))
+            self.push(RenameCommand(self, node_id, name))
 
     def set_layout(self, layouts: dict[str, NodeLayout | None], text: str = "Move nodes") -> None:
-        self._push(SetLayoutCommand(self, layouts, text))
+        self.push(SetLayoutCommand(self, layouts, text))
 
     def set_collapsed(self, node_id: str, collapsed: bool) -> None:
         layout = copy.copy(self.plan.layout.get(node_id)) or NodeLayout()
         layout.collapsed = collapsed
         self.set_layout({node_id: layout}, "Collapse" if collapsed else "Expand")
 
-    def set_plan_field(self, field: str, value: Any) -> None:
-        self._push(SetPlanFieldCommand(self, field, value))
+    # plan-wide fields, each a command named for the edit
+
+    def rename_plan(self, name: str) -> None:
+        """Give the plan a new name."""
+        self.push(RenamePlanCommand(self, name))
+
+    def set_run_policy(self, policy: RunPolicy) -> None:
+        """Run the plan once, until success or forever."""
+        self.push(SetRunPolicyCommand(self, policy))
+
+    def set_reset_cell(self, reset: bool) -> None:
+        """Put the cell back to its scene's start before each run, or not."""
+        self.push(SetResetCellCommand(self, reset))
+
+    def declare_parameter(self, decl: ParameterDecl) -> None:
+        """Declare a plan parameter, replacing the one of that name if there is one."""
+        self.push(DeclareParameterCommand(self, decl))
+
+    def store_waypoints(self, waypoints: list[Waypoint]) -> None:
+        """Put waypoints in the plan: same-named ones are replaced in place, others appended
+        (no undo step when that changes nothing).
+        """
+        command = StoreWaypointsCommand(self, waypoints)
+        if command.new != command.old:
+            self.push(command)
+
+    def remove_waypoint(self, name: str) -> None:
+        """Take the waypoint ``name`` out of the plan's list."""
+        if all(w.name != name for w in self.plan.waypoints):
+            raise DocumentError(f"the plan has no waypoint {name!r}")
+        self.push(RemoveWaypointCommand(self, name))
 
     def replace_waypoint(
         self, old_name: str, new: Waypoint, text: str = "", bind: tuple[str, str] | None = None
@@ -122,34 +196,10 @@ class PlanDocument(PlanModel):
         none) and into every fixed binding that holds that waypoint, and bind it to the
         port ``bind`` = (node id, port) if given: one undo step.
         """
-        waypoints = list(self.plan.waypoints)
-        names = [w.name for w in waypoints]
+        names = [w.name for w in self.plan.waypoints]
         if new.name != old_name and new.name in names:
             raise DocumentError(f"there is already a waypoint {new.name!r}")
-        if old_name in names:
-            waypoints[names.index(old_name)] = new
-        else:
-            waypoints.append(new)
-        bound = [
-            (node.id, port, binding)
-            for _, node in self.plan.walk()
-            for port, binding in node.params.items()
-            if not binding.is_ref
-            and isinstance(binding.value, Waypoint)
-            and binding.value.name == old_name
-            and (node.id, port) != bind
-        ]
-        if bind is not None:
-            bound.append((bind[0], bind[1], Binding.fixed(new, ParamType.WAYPOINT)))
-        self.undo_stack.beginMacro(text or f"Change the waypoint {old_name!r}")
-        try:
-            self.set_plan_field("waypoints", waypoints)
-            for node_id, port, binding in bound:
-                self.set_param(
-                    node_id, port, Binding.fixed(new, binding.type or ParamType.WAYPOINT)
-                )
-        finally:
-            self.undo_stack.endMacro()
+        self.push(ReplaceWaypointCommand(self, old_name, new, text, bind))
 
     def paste(self, text: str, parent_id: str | None, index: int | None = None) -> str:
         """Insert clipboard text (from :meth:`subtree_json`) with fresh ids; returns the new id."""
@@ -163,12 +213,10 @@ class PlanDocument(PlanModel):
         missing = [s for s in fragment.subtrees if self.plan.subtree(s.ref) is None]
         if not missing:
             return self.add_node(clone, parent_id, index, layout)
-        self.undo_stack.beginMacro(f"Paste {clone.label}")  # its instances' subtrees come too
-        try:
-            self._push(SetPlanFieldCommand(self, "subtrees", [*self.plan.subtrees, *missing]))
-            return self.add_node(clone, parent_id, index, layout)
-        finally:
-            self.undo_stack.endMacro()
+        # its instances' subtrees come too
+        parent_id, index = self._place(parent_id, index)
+        self.push(PasteWithSubtreesCommand(self, clone, parent_id, index, layout, missing))
+        return clone.id
 
     def duplicate(self, node_id: str) -> str:
         """A copy of the node placed right after it."""

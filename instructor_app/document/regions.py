@@ -62,12 +62,9 @@ def save_region(
     if node is not None and port is not None:
         document.set_param(node.id, port, Binding.fixed(region, ParamType.REGION))
         return f"{node.label}: {port}"
-    params = [copy.copy(p) for p in document.plan.parameters]
-    for decl in params:
-        if decl.name == name:
-            decl.type, decl.value = ParamType.REGION, region
-            break
-    else:
-        params.append(ParameterDecl(name, ParamType.REGION, region, "drawn by pointing"))
-    document.set_plan_field("parameters", params)
+    decl = next((copy.copy(p) for p in document.plan.parameters if p.name == name), None)
+    if decl is None:
+        decl = ParameterDecl(name, ParamType.REGION, region, "drawn by pointing")
+    decl.type, decl.value = ParamType.REGION, region
+    document.declare_parameter(decl)
     return f"plan parameter {name}"

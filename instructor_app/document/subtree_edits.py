@@ -3,9 +3,8 @@
 An instance and the definition it runs travel together: inserting an instance embeds its
 subtree in the plan (``PlanSpec.subtrees``); saving nodes as a subtree replaces them with an
 instance of it; detaching turns an instance back into plain nodes; updating moves an
-instance to the library's newer version. Each is a macro of the document's small commands
-(:class:`ReplaceNodeCommand`, :class:`AddNodeCommand`, :class:`SetPlanFieldCommand` of
-``subtrees``), so undo restores the plan byte for byte.
+instance to the library's newer version. Each pushes one compound command of
+:mod:`instructor_app.document.subtree_commands`, so undo restores the plan byte for byte.
 """
 
 from __future__ import annotations
@@ -13,23 +12,23 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 
 from engine.operations import OperationSource
-from engine.spec import NodeSpec, SubtreeSpec
+from engine.spec import SubtreeSpec
 from engine.subtree_ops import (
     OpenPort,
     detach,
     instance_of,
     make_subtree,
     ports_of,
-    subtrees_in_use,
     update,
-)
-from instructor_app.document.commands import (
-    AddNodeCommand,
-    ReplaceNodeCommand,
-    SetPlanFieldCommand,
 )
 from instructor_app.document.editing import PlanDocument
 from instructor_app.document.model import DocumentError
+from instructor_app.document.subtree_commands import (
+    DetachInstanceCommand,
+    InsertInstanceCommand,
+    UpdateInstanceCommand,
+    UseSavedSubtreeCommand,
+)
 from instructor_app.document.tree_ops import can_have_child
 
 __all__ = ["SubtreeEditor"]
@@ -45,17 +44,6 @@ class SubtreeEditor:
     def __init__(self, document: PlanDocument) -> None:
         self.document = document
 
-    def _embedded_with(self, *subtrees: SubtreeSpec) -> list[SubtreeSpec]:
-        have = list(self.document.plan.subtrees)
-        for subtree in subtrees:
-            if all(s.ref != subtree.ref for s in have):
-                have.append(subtree)
-        return have
-
-    def _unused_dropped(self, subtrees: list[SubtreeSpec]) -> list[SubtreeSpec]:
-        """The definitions some instance of the plan still runs."""
-        return subtrees_in_use(self.document.plan.tree, subtrees)
-
     def insert_instance(
         self, subtree: SubtreeSpec, parent_id: str | None, index: int | None = None
     ) -> str:
@@ -68,13 +56,7 @@ class SubtreeEditor:
         node = instance_of(subtree)
         if parent_id is not None and index is None:
             index = len(doc.node(parent_id).children)
-        stack = doc.undo_stack
-        stack.beginMacro(f"Insert {subtree.name}")
-        try:
-            stack.push(SetPlanFieldCommand(doc, "subtrees", self._embedded_with(subtree)))
-            stack.push(AddNodeCommand(doc, node, parent_id, index or 0))
-        finally:
-            stack.endMacro()
+        doc.push(InsertInstanceCommand(doc, subtree, node, parent_id, index or 0))
         return node.id
 
     def save_as_subtree(
@@ -115,16 +97,7 @@ class SubtreeEditor:
         original = doc.node(node_id)
         instance = instance_of(saved, original, open_ports)
         instance.name = original.name or saved.name
-        layout = doc.plan.layout.get(node_id)
-        stack = doc.undo_stack
-        stack.beginMacro(f"Save {original.label} as the subtree {saved.name}")
-        try:
-            stack.push(SetPlanFieldCommand(doc, "subtrees", self._embedded_with(saved)))
-            stack.push(
-                ReplaceNodeCommand(doc, node_id, instance, {instance.id: layout} if layout else {})
-            )
-        finally:
-            stack.endMacro()
+        doc.push(UseSavedSubtreeCommand(doc, node_id, saved, instance))
         return instance.id
 
     def detach(self, node_id: str) -> str:
@@ -135,29 +108,11 @@ class SubtreeEditor:
             nodes = detach(doc.plan, instance)
         except ValueError as exc:
             raise DocumentError(str(exc)) from exc
-        self._replace(node_id, nodes, f"Detach {instance.label}")
+        doc.push(DetachInstanceCommand(doc, node_id, nodes))
         return nodes.id
 
     def update(self, node_id: str, newer: SubtreeSpec) -> None:
         """Move an instance to another version of its subtree, keeping what still fits."""
         doc = self.document
         instance = doc.node(node_id)
-        doc.undo_stack.beginMacro(f"Update {instance.label} to version {newer.version}")
-        try:
-            doc.undo_stack.push(SetPlanFieldCommand(doc, "subtrees", self._embedded_with(newer)))
-            self._replace(node_id, update(instance, newer), "")
-        finally:
-            doc.undo_stack.endMacro()
-
-    def _replace(self, node_id: str, node: NodeSpec, text: str) -> None:
-        doc = self.document
-        layout = doc.plan.layout.get(node_id)
-        stack = doc.undo_stack
-        stack.beginMacro(text or f"Replace {doc.node(node_id).label}")
-        try:
-            stack.push(ReplaceNodeCommand(doc, node_id, node, {node.id: layout} if layout else {}))
-            kept = self._unused_dropped(list(doc.plan.subtrees))
-            if len(kept) != len(doc.plan.subtrees):
-                stack.push(SetPlanFieldCommand(doc, "subtrees", kept))
-        finally:
-            stack.endMacro()
+        doc.push(UpdateInstanceCommand(doc, node_id, newer, update(instance, newer)))

@@ -76,6 +76,7 @@ def detach(plan: PlanSpec, node_id: str) -> tuple[str | None, int, NodeSpec]:
 
 
 def subtree_ids(node: NodeSpec) -> Iterator[str]:
+    """The ids of the node and of every node below it."""
     for _, child in node.walk():
         yield child.id
 

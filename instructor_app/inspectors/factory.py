@@ -98,5 +98,5 @@ def editor_for(
 
 
 def type_names(types: Sequence[ParamType]) -> str:
-    """ "Pose or Waypoint"."""
+    """The types as the user reads them, e.g. "Pose or Waypoint"."""
     return " or ".join(t.value for t in types)

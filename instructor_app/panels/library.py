@@ -11,11 +11,10 @@ that use it. Files that could not be read are listed by name under the tree.
 from __future__ import annotations
 
 import html
-import json
 from collections.abc import Iterable, Sequence
+from typing import Any
 
-from PySide6.QtCore import QMimeData, Qt, Signal
-from PySide6.QtGui import QKeyEvent
+from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import (
     QHBoxLayout,
     QLabel,
@@ -23,7 +22,6 @@ from PySide6.QtWidgets import (
     QPushButton,
     QSizePolicy,
     QTextBrowser,
-    QTreeWidget,
     QTreeWidgetItem,
     QVBoxLayout,
     QWidget,
@@ -32,7 +30,7 @@ from PySide6.QtWidgets import (
 from engine.library import Library, LibraryEntry
 from engine.spec import NodeKind, NodeSpec, SubtreePort, SubtreeSpec
 from engine.subtree_ops import Usage
-from instructor_app.node_factory import PALETTE_MIME
+from instructor_app.panels.palette_tree import PaletteDragTree
 
 __all__ = ["LibraryPanel", "preview_html"]
 
@@ -84,28 +82,14 @@ def preview_html(subtree: SubtreeSpec, folder: str = "", shipped: bool = False) 
     )
 
 
-class _SubtreeTree(QTreeWidget):
+class _SubtreeTree(PaletteDragTree):
     """The folders and subtrees; a subtree drags as a palette item of kind subtree."""
 
-    item_entered = Signal(object)
-
-    def mimeData(self, items: Iterable[QTreeWidgetItem]) -> QMimeData:
-        mime = QMimeData()
-        for item in items:
-            entry = item.data(0, _ENTRY_ROLE)
-            if entry is not None:
-                payload = {"kind": NodeKind.SUBTREE.value, "op": entry.subtree.id}
-                mime.setData(PALETTE_MIME, json.dumps(payload).encode("utf-8"))
-        return mime
-
-    def mimeTypes(self) -> list[str]:
-        return [PALETTE_MIME]
-
-    def keyPressEvent(self, event: QKeyEvent) -> None:
-        if event.key() in (Qt.Key.Key_Return, Qt.Key.Key_Enter) and self.currentItem():
-            self.item_entered.emit(self.currentItem())
-            return
-        super().keyPressEvent(event)
+    def drag_payload(self, item: QTreeWidgetItem) -> tuple[dict[str, Any], str] | None:
+        entry = item.data(0, _ENTRY_ROLE)
+        if entry is None:
+            return None  # a folder
+        return {"kind": NodeKind.SUBTREE.value, "op": entry.subtree.id}, ""
 
 
 class LibraryPanel(QWidget):

@@ -11,10 +11,9 @@ tooltip, and cannot be inserted or dragged.
 
 from __future__ import annotations
 
-import json
-from collections.abc import Iterable
+from typing import Any
 
-from PySide6.QtCore import QEvent, QMimeData, QObject, QSize, Qt, Signal
+from PySide6.QtCore import QEvent, QObject, QSize, Qt, Signal
 from PySide6.QtGui import QColor, QIcon, QKeyEvent, QPainter, QPixmap
 from PySide6.QtWidgets import (
     QLineEdit,
@@ -28,7 +27,8 @@ from PySide6.QtWidgets import (
 
 from engine.operations import OperationKind, OperationSource
 from engine.spec import KIND_CATEGORY, Category, NodeKind
-from instructor_app.node_factory import PALETTE_MIME, PaletteItem, palette_items
+from instructor_app.node_factory import PaletteItem, palette_items
+from instructor_app.panels.palette_tree import PaletteDragTree
 
 __all__ = ["PalettePanel", "item_colour", "search_rank"]
 
@@ -107,27 +107,14 @@ def _icon(colour: QColor, round_shape: bool) -> QIcon:
     return QIcon(pixmap)
 
 
-class _PaletteTree(QTreeWidget):
+class _PaletteTree(PaletteDragTree):
     """The list itself: drags palette items, inserts on Enter."""
 
-    item_entered = Signal(object)
-
-    def mimeData(self, items: Iterable[QTreeWidgetItem]) -> QMimeData:
-        mime = QMimeData()
-        chosen = [i.data(0, _ITEM_ROLE) for i in items if i.data(0, _ITEM_ROLE) is not None]
-        if chosen:
-            mime.setData(PALETTE_MIME, json.dumps(chosen[0].payload).encode("utf-8"))
-            mime.setText(chosen[0].op or chosen[0].kind.value)
-        return mime
-
-    def mimeTypes(self) -> list[str]:
-        return [PALETTE_MIME]
-
-    def keyPressEvent(self, event: QKeyEvent) -> None:
-        if event.key() in (Qt.Key.Key_Return, Qt.Key.Key_Enter) and self.currentItem():
-            self.item_entered.emit(self.currentItem())
-            return
-        super().keyPressEvent(event)
+    def drag_payload(self, item: QTreeWidgetItem) -> tuple[dict[str, Any], str] | None:
+        chosen = item.data(0, _ITEM_ROLE)
+        if chosen is None:
+            return None  # a group
+        return chosen.payload, chosen.op or chosen.kind.value
 
 
 class _HitKeys(QObject):

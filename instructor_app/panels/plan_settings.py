@@ -1,7 +1,7 @@
 """The plan's own settings: its name and its run policy (the paper's root "evaluated until it
 returns SUCCESS" is the policy "until success").
 
-Each finished edit is one document command (``set_plan_field``); the panel follows the
+Each finished edit is one document command (``rename_plan``, ``set_run_policy``, ``set_reset_cell``); the panel follows the
 document (undo, open, new) without echoing edits back.
 """
 
@@ -58,16 +58,16 @@ class PlanSettingsPanel(QWidget):
     def _name_finished(self) -> None:
         name = self.name_field.text().strip()
         if name and name != self.document.plan.name:
-            self.document.set_plan_field("name", name)
+            self.document.rename_plan(name)
 
     def _policy_chosen(self, index: int) -> None:
         policy = RunPolicy(self.policy_combo.itemData(index))
         if policy is not RunPolicy(self.document.plan.run_policy):
-            self.document.set_plan_field("run_policy", policy)
+            self.document.set_run_policy(policy)
 
     def _reset_clicked(self, checked: bool) -> None:
         if checked != self.document.plan.reset_cell:
-            self.document.set_plan_field("reset_cell", checked)
+            self.document.set_reset_cell(checked)
 
     def _refresh(self) -> None:
         plan = self.document.plan

@@ -230,22 +230,18 @@ class WaypointsPanel(QWidget):
 
     def remove_selected(self) -> None:
         row = self.list.currentRow()
-        current = list(self.document.plan.waypoints)
+        current = self.document.plan.waypoints
         if not 0 <= row < len(current):
             return
-        gone = current.pop(row)
-        self.document.set_plan_field("waypoints", current)
-        self.message.emit(f"Removed the waypoint {gone.name!r}")
+        gone = current[row].name
+        self.document.remove_waypoint(gone)
+        self.message.emit(f"Removed the waypoint {gone!r}")
 
     # ------------------------------------------------------------------ internals
 
     def _store(self, waypoints: Sequence[Waypoint], text: str) -> None:
         """Replace same-named waypoints in place, append the others: one command."""
-        by_name = {w.name: w for w in waypoints}
-        merged = [by_name.pop(w.name, w) for w in self.document.plan.waypoints]
-        merged += list(by_name.values())
-        if merged != list(self.document.plan.waypoints):
-            self.document.set_plan_field("waypoints", merged)
+        self.document.store_waypoints(list(waypoints))
         self.message.emit(text)
 
     def _replace(self, old_name: str, new: Waypoint, text: str) -> bool:

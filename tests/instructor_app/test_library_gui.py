@@ -121,8 +121,13 @@ def test_save_selection_as_subtree_runs_undoes_and_detaches(
     window.document.undo_stack.undo()
     assert window.document.serialized() == before
     window.document.undo_stack.redo()
+    with_instance, label = window.document.serialized(), window.document.node(instance_id).label
     select(window, instance_id)
     window.library.actions["detach"].trigger()
+    assert window.document.undo_stack.undoText() == f"Detach {label}"  # one step, its children:
+    window.document.undo_stack.undo()  # the nodes back, and the definition they dropped
+    assert window.document.serialized() == with_instance
+    window.document.undo_stack.redo()
     part = _node(window, "part")
     assert part.kind is NodeKind.SEQUENCE and part.children[0].params["message"] == _text("hello")
     assert window.document.plan.subtrees == []
@@ -199,8 +204,16 @@ def test_a_newer_library_version_is_shown_and_the_instance_updates(
     problems = window.views.validation.problems()
     assert any("newer version" in p.message and p.node_id == instance_id for p in problems)
     select(window, instance_id)
+    before, label = window.document.serialized(), window.document.node(instance_id).label
     window.library.actions["update"].trigger()
     assert window.document.node(instance_id).subtree.version == 2  # type: ignore[union-attr]
+    stack = window.document.undo_stack
+    assert stack.undoText() == f"Update {label} to version 2"
+    after = window.document.serialized()
+    stack.undo()
+    assert window.document.serialized() == before
+    stack.redo()
+    assert window.document.serialized() == after
     qtbot.waitUntil(
         lambda: not any("newer version" in p.message for p in window.views.validation.problems())
     )

@@ -398,3 +398,40 @@ def test_zoomed_out_links_are_one_overview_path(view: CanvasView, doc: PlanDocum
     assert all(port.isVisible() for port in view.item(new_id).inputs)
     pipe = view.item(new_id).inputs[0].connected_pipes[0]
     assert pipe.isVisible()
+
+
+def test_deleting_two_selected_siblings_is_one_step_that_puts_them_back(
+    view: CanvasView, doc: PlanDocument
+) -> None:
+    before = doc.serialized()
+    pick, c = nid(doc, "pick"), nid(doc, "c")
+    view.item(pick).setSelected(True)
+    view.item(c).setSelected(True)
+    view.item(nid(doc, "a")).setSelected(True)  # inside pick: goes with it
+    view.action("delete").trigger()
+    assert doc.plan.find(pick) is None and doc.plan.find(c) is None
+    assert doc.undo_stack.count() == 1 and doc.undo_stack.undoText() == "Delete nodes"
+    doc.undo_stack.undo()
+    assert doc.serialized() == before and view.node_count() == 7
+
+
+def test_dragging_a_placed_node_onto_another_is_one_move_step(
+    view: CanvasView, doc: PlanDocument
+) -> None:
+    c, pick = nid(doc, "c"), nid(doc, "pick")
+    doc.set_layout({c: NodeLayout(400.0, 400.0)})
+    before = doc.serialized()
+    item = view.item(c)
+    start = item.pos()
+    item.setPos(
+        view.item(pick).mapToScene(view.item(pick).shape_rect().center())
+        - item.shape_rect().center()
+    )
+    view.viewer.moved_nodes.emit({item: [start.x(), start.y()]})
+    assert doc.locate(c)[0] == pick and c not in doc.plan.layout  # placed automatically
+    assert doc.undo_stack.undoText() == "Move c"
+    after = doc.serialized()
+    doc.undo_stack.undo()
+    assert doc.serialized() == before and doc.plan.layout[c] == NodeLayout(400.0, 400.0)
+    doc.undo_stack.redo()
+    assert doc.serialized() == after

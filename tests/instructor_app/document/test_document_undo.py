@@ -76,16 +76,15 @@ EDITS: dict[str, Edit] = {
     "layout": lambda d: d.set_layout(
         {named(d, "transfer"): NodeLayout(5.0, 6.0), d.plan.tree.id: NodeLayout(1.0, 2.0)}
     ),
-    "plan name": lambda d: d.set_plan_field("name", "renamed plan"),
-    "plan description": lambda d: d.set_plan_field("description", "another text"),
-    "plan run policy": lambda d: d.set_plan_field("run_policy", RunPolicy.FOREVER),
-    "plan parameters": lambda d: d.set_plan_field(
-        "parameters", [ParameterDecl("SPEED", ParamType.NUMBER, 0.25)]
+    "plan name": lambda d: d.rename_plan("renamed plan"),
+    "plan run policy": lambda d: d.set_run_policy(RunPolicy.FOREVER),
+    "plan reset cell": lambda d: d.set_reset_cell(not d.plan.reset_cell),
+    "plan parameters": lambda d: d.declare_parameter(
+        ParameterDecl("SPEED", ParamType.NUMBER, 0.25)
     ),
-    "plan waypoints": lambda d: d.set_plan_field(
-        "waypoints", [Waypoint("above bin", pose=Pose((0.4, 0.2, 0.3)))]
+    "plan waypoints": lambda d: d.store_waypoints(
+        [Waypoint("above bin", pose=Pose((0.4, 0.2, 0.3)))]
     ),
-    "plan objects": lambda d: d.set_plan_field("objects", ["cup", "bin"]),
     "paste": lambda d: d.paste(d.subtree_json(named(d, "transfer")), named(d, "transfer or wait")),
     "duplicate": lambda d: d.duplicate(named(d, "transfer")),
     "cut": lambda d: d.cut(named(d, "transfer")),
@@ -198,7 +197,7 @@ def _random_edit(document: PlanDocument, rng: random.Random) -> bool:
         elif choice == 7 and node is not document.plan.tree:
             document.duplicate(node.id)
         elif choice == 8:
-            document.set_plan_field("name", f"plan {rng.randrange(1000)}")
+            document.rename_plan(f"plan {rng.randrange(1000)}")
         else:
             return False
     except DocumentError:

@@ -108,7 +108,7 @@ def test_fixed_reference_switch(
 
 def test_type_switch_uses_the_plan_waypoints(panel: InspectorPanel, document: PlanDocument) -> None:
     waypoint = Waypoint("above_cup", pose=Pose((0.4, 0.0, 0.3)))
-    document.set_plan_field("waypoints", [waypoint])
+    document.store_waypoints([waypoint])
     before = document.serialized()
     count = document.undo_stack.count()
     panel.show_node("move")
@@ -126,7 +126,7 @@ def test_output_name_and_completion(
     qtbot: QtBot, panel: InspectorPanel, document: PlanDocument
 ) -> None:
     before = document.serialized()
-    document.set_plan_field("parameters", [ParameterDecl("SPEED", ParamType.NUMBER, 1.0)])
+    document.declare_parameter(ParameterDecl("SPEED", ParamType.NUMBER, 1.0))
     panel.show_node("query")
     row = panel.port_row("result")
     qtbot.keyClicks(row.ref_field, "CUP_POSE")

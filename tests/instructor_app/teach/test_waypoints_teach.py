@@ -211,7 +211,7 @@ def test_inspector_teach_fills_a_pose_and_teaches_a_waypoint_again(
     qtbot: Any, doc: PlanDocument, inspector: InspectorPanel, cell: FakeCell
 ) -> None:
     smart = Waypoint("above cup", WaypointFrame.OBJECT, Pose((0.0, 0.0, 0.1), DOWN), None, "cup")
-    doc.set_plan_field("waypoints", [smart])
+    doc.store_waypoints([smart])
     node_id = plan_using(doc, smart)
     inspector.show_node(node_id)
     assert set(inspector.teach_buttons) == {"target", "reference"}  # Pose or Waypoint ports
@@ -237,7 +237,7 @@ def test_inspector_teach_on_an_unset_waypoint_makes_one_named_after_the_node(
 ) -> None:
     root = doc.add_node(NodeSpec(NodeKind.SEQUENCE, "Main"))
     node_id = doc.add_node(NodeSpec(NodeKind.OPERATION, "over bin", op="motion.move_to"), root)
-    doc.set_plan_field("waypoints", [Waypoint("over bin", pose=Pose())])
+    doc.store_waypoints([Waypoint("over bin", pose=Pose())])
     inspector.show_node(node_id)
     assert not inspector.teach_buttons["target"].move_button.isEnabled()  # nothing to go to
     qtbot.mouseClick(inspector.teach_buttons["target"].teach_button, Qt.MouseButton.LeftButton)
