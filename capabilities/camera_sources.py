@@ -21,6 +21,7 @@ def open_source(name: str, kind: str, where: str, base: Path | None = None) -> C
         kind: "recorded" (``where`` is the recording folder), "stream" (``where`` is the frame
             server's "host:port") or "realsense" (``where`` is the device's serial number, ""
             for the only one connected).
+        where: the recording folder, the server's address or the serial number (see kind).
         base: the cell file's folder (a relative recording folder is relative to it).
 
     Raises:

@@ -59,7 +59,7 @@ class NewModel:
 
 
 def valid_model_name(name: str) -> str:
-    """ "" when ``name`` can name a model folder, else what is wrong with it."""
+    """The empty text when ``name`` can name a model folder, else what is wrong with it."""
     if not _NAME.match(name):
         return (
             f"{name!r} is not a model name: use lower-case letters, digits and underscores, "

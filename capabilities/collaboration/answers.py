@@ -1,9 +1,9 @@
-"""Answering operator prompts without the Instructor: ``costar run --confirm yes|no|ask``.
+r"""Answering operator prompts without the Instructor: ``costar run --confirm yes|no|ask``.
 
 - ``yes`` / ``no``: every prompt is answered at once (unattended runs, scripts, tests).
 - ``ask`` (the default): the question is printed and a line is read from the input: a line
   starting with "y" answers yes, any other line no. This works with a pipe as well as a
-  terminal (``printf 'y\\nn\\n' | costar run ...``). At the end of the input every open and
+  terminal (``printf 'y\nn\n' | costar run ...``). At the end of the input every open and
   later prompt is answered no: nobody is there to say yes, and a robot must not take
   silence for consent.
 

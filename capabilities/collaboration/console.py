@@ -115,6 +115,8 @@ class Prompt:
 
 
 class ConsoleEventKind(str, enum.Enum):
+    """What happened on the console: a prompt shown or closed, a button pressed."""
+
     PROMPT_SHOWN = "prompt_shown"
     PROMPT_CLOSED = "prompt_closed"
     BUTTON_PRESSED = "button_pressed"

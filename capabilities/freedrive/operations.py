@@ -23,6 +23,7 @@ __all__ = ["capability"]
 
 CAP = "freedrive"
 
+
 def _off_thread(fn: Callable[[], None], describe: str) -> Job:
     """Run a short blocking backend call in its own thread; the Job finishes with it."""
     job = Job()

@@ -14,6 +14,8 @@ __all__ = ["CameraDevice", "FrameLike", "MarkerLayout"]
 
 
 class FrameLike(Protocol):
+    """A camera frame: colour and depth images, intrinsics, the camera's pose, its time."""
+
     rgb: np.ndarray
     depth: np.ndarray | None
     K: np.ndarray

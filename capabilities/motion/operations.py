@@ -66,9 +66,7 @@ def scale(call: OperationCall, port: InPort[float]) -> float:
 
 
 def _joint_move(arm: ArmBackend, q: Sequence[float], call: OperationCall, describe: str) -> Any:
-    handle = arm.move_joints(
-        q, JOINT_SPEED * scale(call, SPEED), JOINT_ACCEL * scale(call, ACCEL)
-    )
+    handle = arm.move_joints(q, JOINT_SPEED * scale(call, SPEED), JOINT_ACCEL * scale(call, ACCEL))
     return job_from_handle(handle, describe)
 
 
