@@ -34,6 +34,7 @@ __all__ = [
     "Cell",
     "NullCell",
     "SuppliesSettings",
+    "OperationClass",
     "OperationDef",
     "ENTRY_POINT_GROUP",
     "load_entry_point_capabilities",
@@ -108,15 +109,25 @@ class CapabilityEnv:
         return interfaces[name]
 
 
-OperationFactoryFn = Callable[[CapabilityEnv], Operation]
+class OperationClass(Protocol):
+    """An operation's class: its manifest, and made per leaf from the env (``cls(env)``).
+
+    BehaviorTree.CPP's node class with its ``providedPorts()``: the class carries
+    ``MANIFEST`` (made with :func:`capabilities.kit.manifest`) and its ``__init__`` takes
+    the :class:`CapabilityEnv` (the cell's interfaces, ``env.state``, ``env.settings``).
+    """
+
+    MANIFEST: OperationManifest
+
+    def __call__(self, env: CapabilityEnv) -> Operation: ...
 
 
 @dataclass(frozen=True)
 class OperationDef:
-    """An operation's manifest and the factory that makes its code for one leaf."""
+    """An operation's manifest and the class that makes its code for one leaf."""
 
     manifest: OperationManifest
-    factory: OperationFactoryFn
+    factory: Callable[[CapabilityEnv], Operation]
 
 
 @dataclass
@@ -128,7 +139,8 @@ class Capability:
         doc: one line for the palette.
         requires: interfaces the cell must have for the operations to run.
         provides: interfaces this capability offers to others (documentation for now).
-        operations: the operations, each with a manifest whose ``capability`` is ``name``.
+        operations: the operations (added with :meth:`add`), each with a manifest whose
+            ``capability`` is ``name``.
         settings: the settings a cell file may give it (``capabilities.<name>`` block).
         setup: the per-cell hook: called once per registry (one registry per cell) before
             the first operation is made, with the env (cell, checked settings); what it
@@ -143,17 +155,19 @@ class Capability:
     settings: tuple[Setting, ...] = ()
     setup: Callable[[CapabilityEnv], Any] | None = None
 
-    def add(self, manifest: OperationManifest, factory: OperationFactoryFn) -> None:
-        """Add an operation: its manifest and the factory that makes its code per leaf."""
-        if manifest.capability != self.name:
-            raise CapabilityLoadError(
-                f"operation {manifest.id!r} says it belongs to {manifest.capability!r}, not {self.name!r}"
-            )
-        if not manifest.id.startswith(self.name + "."):
-            raise CapabilityLoadError(
-                f"operation id {manifest.id!r} must start with {self.name + '.'!r}"
-            )
-        self.operations.append(OperationDef(manifest, factory))
+    def add(self, *operations: OperationClass) -> None:
+        """Add operations: each a class with its ``MANIFEST``, made per leaf as ``cls(env)``."""
+        for operation in operations:
+            manifest = operation.MANIFEST
+            if manifest.capability != self.name:
+                raise CapabilityLoadError(
+                    f"operation {manifest.id!r} says it belongs to {manifest.capability!r}, not {self.name!r}"
+                )
+            if not manifest.id.startswith(self.name + "."):
+                raise CapabilityLoadError(
+                    f"operation id {manifest.id!r} must start with {self.name + '.'!r}"
+                )
+            self.operations.append(OperationDef(manifest, operation))
 
 
 def load_entry_point_capabilities(group: str = ENTRY_POINT_GROUP) -> list[Capability]:

@@ -1,25 +1,32 @@
 """The capability kit: the one way to declare a capability's operations and settings.
 
-A capability module declares each operation as a manifest (made with :func:`manifest`)
-next to the class that runs it, as BehaviorTree.CPP puts ``CreateManifest`` beside a node
-class, and one function ``capability() -> Capability`` adds them. Per-cell state and
-settings come through one hook, as py_trees' ``setup()``: a capability declares its
-settings as :class:`Setting` fields (typed, with defaults and docs) and a ``setup``
-function that makes its per-cell state object from them; the registry calls ``setup`` once
-per cell, and every operation factory finds that object as ``env.state`` and the checked
-settings as ``env.settings``. The cell file supplies the settings in its ``capabilities``
+A capability module declares each operation as a class that carries its manifest (made
+with :func:`manifest`) as ``MANIFEST``, as a BehaviorTree.CPP node class carries its
+``providedPorts()``, and one function ``capability() -> Capability`` adds the classes. The
+registry makes one instance per leaf as ``cls(env)``. Per-cell state and settings come
+through one hook, as py_trees' ``setup()``: a capability declares its settings as
+:class:`Setting` fields (typed, with defaults and docs) and a ``setup`` function that makes
+its per-cell state object from them; the registry calls ``setup`` once per cell, and every
+operation finds that object as ``env.state`` and the checked settings as ``env.settings``. The cell file supplies the settings in its ``capabilities``
 block; an unknown key or a wrong type is a :class:`CapabilitySettingsError` naming the file
 and the key, and an explicit 0 is 0.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from capabilities.errors import CapabilityError
-from engine.operations import OperationFailed, OperationKind, OperationManifest, PortSpec
+from engine.operations import (
+    InPort,
+    OperationFailed,
+    OperationKind,
+    OperationManifest,
+    PortSpec,
+    text,
+)
 from engine.types import ParamType, Pose, ValueShapeError, decode_value
 
 if TYPE_CHECKING:
@@ -27,16 +34,21 @@ if TYPE_CHECKING:
 
 __all__ = [
     "CAMERAS",
+    "camera_port",
     "CapabilitySettingsError",
     "Setting",
     "camera",
     "manifest",
     "parse_settings",
-    "stateful",
 ]
 
 CAMERAS = ("shoulder", "wrist")
 """The RGB-D cameras a cell may have (the choices of a ``camera`` port)."""
+
+
+def camera_port(doc: str = "which camera looks") -> InPort[str]:
+    """The ``camera`` input of an operation that looks through one (default: shoulder)."""
+    return text("camera", "shoulder", doc=doc, choices=CAMERAS)
 
 
 def camera(env: CapabilityEnv, name: str) -> Any:
@@ -67,19 +79,13 @@ def manifest(
 
     Example::
 
-        LAMP_IS_LIT = manifest("template", "lamp_is_lit", OperationKind.CONDITION,
-                               "True when the stack light shows the given colour.",
-                               PortSpec("colour", (ParamType.TEXT,), default="green"))
+        COLOUR = text("colour", "green", doc="which light")
+
+        class LampIsLit:
+            MANIFEST = manifest("template", "lamp_is_lit", OperationKind.CONDITION,
+                                "True when the stack light shows the given colour.", COLOUR)
     """
     return OperationManifest(f"{capability}.{name}", kind, doc, capability, ports, aliases)
-
-
-def stateful(cls: Callable[..., Any], *extra: Any) -> Callable[[CapabilityEnv], Any]:
-    """The factory of an operation class whose first argument is the per-cell state:
-    ``cap.add(IS_EMPTY, stateful(RegionCondition, False))`` makes
-    ``RegionCondition(env.state, False)`` for each leaf.
-    """
-    return lambda env: cls(env.state, *extra)
 
 
 _PY_TYPES: dict[type, str] = {

@@ -12,17 +12,34 @@ import enum
 import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Any, Generic, Protocol, TypeVar
 
 from engine.error_types import ErrorType
 from engine.errors import EngineError
 from engine.status import FAILURE, RUNNING, SUCCESS, Status
-from engine.types import ParamType, check_value, type_of_value
+from engine.types import (
+    JointConfig,
+    ObjectModel,
+    ParamType,
+    Pose,
+    Region,
+    check_value,
+    type_of_value,
+)
 
 __all__ = [
     "OperationKind",
     "Direction",
     "PortSpec",
+    "InPort",
+    "number",
+    "duration",
+    "text",
+    "flag",
+    "pose",
+    "joints",
+    "region",
+    "object_model",
     "OperationManifest",
     "OperationCall",
     "Operation",
@@ -87,6 +104,95 @@ class PortSpec:
         return self.direction is Direction.IN and self.default is None
 
 
+T = TypeVar("T")
+
+
+@dataclass(frozen=True, eq=False)
+class InPort(PortSpec, Generic[T]):
+    """An input port whose value the operation reads as a ``T`` (``call.input(SPEED)``).
+
+    BehaviorTree.CPP's ``InputPort<T>``: the manifest lists it, and the operation reads it
+    through the same object, so the type a reader gets is the port's. Made with the
+    constructors below (:func:`number` gives an ``InPort[float]``); a port of several
+    types says its union explicitly: ``InPort[Waypoint | Pose]("target", (...))``.
+    """
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, PortSpec) and _fields(self) == _fields(other)
+
+    def __hash__(self) -> int:
+        return hash(_fields(self))
+
+
+def _fields(port: PortSpec) -> tuple[Any, ...]:
+    return (
+        port.name,
+        port.types,
+        port.direction,
+        port.default,
+        port.unit,
+        port.doc,
+        port.choices,
+        port.names_kind,
+    )
+
+
+def number(
+    name: str, default: float | None = None, *, unit: str = "", doc: str = ""
+) -> InPort[float]:
+    """A Number input (SI units; an integer is read as a float)."""
+    return InPort(name, (ParamType.NUMBER,), default=default, unit=unit, doc=doc)
+
+
+def duration(name: str, default: float | None = None, *, doc: str = "") -> InPort[float]:
+    """A Duration input, in seconds."""
+    return InPort(name, (ParamType.DURATION,), default=default, unit="s", doc=doc)
+
+
+def text(
+    name: str,
+    default: str | None = None,
+    *,
+    doc: str = "",
+    choices: tuple[str, ...] = (),
+    names_kind: OperationKind | None = None,
+) -> InPort[str]:
+    """A Text input, one of ``choices`` when given."""
+    return InPort(
+        name,
+        (ParamType.TEXT,),
+        default=default,
+        doc=doc,
+        choices=choices,
+        names_kind=names_kind,
+    )
+
+
+def flag(name: str, default: bool | None = None, *, doc: str = "") -> InPort[bool]:
+    """A Bool input."""
+    return InPort(name, (ParamType.BOOL,), default=default, doc=doc)
+
+
+def pose(name: str, default: Pose | None = None, *, doc: str = "") -> InPort[Pose]:
+    """A Pose input (world frame)."""
+    return InPort(name, (ParamType.POSE,), default=default, doc=doc)
+
+
+def joints(name: str, *, unit: str = "rad", doc: str = "") -> InPort[JointConfig]:
+    """A JointConfig input."""
+    return InPort(name, (ParamType.JOINTS,), unit=unit, doc=doc)
+
+
+def region(name: str, *, doc: str = "") -> InPort[Region]:
+    """A Region input (a sphere of space)."""
+    return InPort(name, (ParamType.REGION,), doc=doc)
+
+
+def object_model(name: str, *, doc: str = "") -> InPort[ObjectModel]:
+    """An ObjectModel input (an object by its model name)."""
+    return InPort(name, (ParamType.OBJECT,), doc=doc)
+
+
 @dataclass(frozen=True)
 class OperationManifest:
     """What an operation is, for the palette, validation and ``costar ops``."""
@@ -116,7 +222,8 @@ class OperationManifest:
 class OperationCall:
     """What an operation gets when it starts: its typed inputs, a way to write outputs.
 
-    An operation reads each input with :meth:`input` (BehaviorTree.CPP's ``getInput<T>``):
+    An operation reads each input with :meth:`input`, given the :class:`InPort` of its
+    manifest (BehaviorTree.CPP's ``getInput<T>``; ``call.input(SPEED)`` is a float):
     the value is already of one of the port's types and in SI units (a Number or Duration
     is a float), fixed values were checked by validation and a reference's value was
     checked against the port's types when the leaf read it, so an operation does not
@@ -145,16 +252,17 @@ class OperationCall:
         self.wake = wake
         self.clock = clock
 
-    def input(self, port: str) -> Any:
+    def input(self, port: InPort[T]) -> T:
         """The typed value of an input port (its default when the plan leaves it unbound).
 
         Raises:
             OperationFailed: the operation asked for a port its manifest does not have.
         """
         try:
-            return self.args[port]
+            value: T = self.args[port.name]
         except KeyError:
-            raise OperationFailed(f"{self.node_name!r} has no input {port!r}") from None
+            raise OperationFailed(f"{self.node_name!r} has no input {port.name!r}") from None
+        return value
 
     def write(self, port: str, value: Any) -> None:
         """Write the value of an output port to the blackboard entry it is bound to.

@@ -21,31 +21,56 @@ from capabilities.collaboration.console import (
     Prompt,
     PromptState,
 )
-from capabilities.kit import CAMERAS, camera, manifest
+from capabilities.kit import camera, camera_port, manifest
 from capabilities.world_model import Detection, WorldModel
 from engine.error_types import ErrorType
 from engine.operations import (
     Direction,
+    InPort,
     Job,
     OperationCall,
     OperationFailed,
     OperationKind,
-    OperationManifest,
     PortSpec,
+    flag,
+    object_model,
+    region,
+    text,
 )
 from engine.status import RUNNING, Status
-from engine.types import ObjectModel, ParamType, Region
+from engine.types import ObjectModel, ParamType
 
 __all__ = ["CAP", "capability"]
 
 CAP = "collaboration"
 
 
-def _seconds(call: OperationCall, port: str) -> float:
-    value: float = call.input(port)  # a Duration (validation checked the type, not the sign)
+TIME = (ParamType.DURATION, ParamType.NUMBER)
+
+
+def _time(name: str, default: float, doc: str) -> InPort[float]:
+    """A time input in seconds (a Duration, or a Number)."""
+    return InPort(name, TIME, default=default, unit="s", doc=doc)
+
+
+TIMEOUT = _time("timeout", 0.0, "give up after this long (0: wait for ever)")
+BUTTON = text("button", "continue", doc="the operator button")
+OBJECT = object_model("object", doc="the object (by its model name)")
+REGION = region("region", doc="where it must be (a sphere)")
+
+
+def _seconds(call: OperationCall, port: InPort[float]) -> float:
+    value = call.input(port)  # a Duration (validation checked the type, not the sign)
     if not value >= 0:
-        raise OperationFailed(f"{port} must be a number of seconds, 0 or more, not {value!r}")
+        raise OperationFailed(f"{port.name} must be a number of seconds, 0 or more, not {value!r}")
     return value
+
+
+class _OperatorOp:
+    """An operation on the cell's operator console."""
+
+    def __init__(self, env: CapabilityEnv) -> None:
+        self._console: OperatorConsole = env.interface("operator")
 
 
 def _interface(env: CapabilityEnv, name: str, what: str) -> Any:
@@ -91,31 +116,43 @@ class _PromptJob(Job):
         return self._status
 
 
-class Confirm:
+class Confirm(_OperatorOp):
     """collaboration.confirm: asks the operator a yes/no question."""
 
-    def __init__(self, console: OperatorConsole) -> None:
-        self._console = console
+    PROMPT = text("prompt", doc="the question shown to the operator")
+    MANIFEST = manifest(
+        CAP,
+        "confirm",
+        OperationKind.ACTION,
+        "Asks the operator a yes/no question; succeeds on yes, fails on no.",
+        PROMPT,
+        TIMEOUT,
+    )
 
     def start(self, call: OperationCall) -> Job:
-        text = call.input("prompt").strip()
+        text = call.input(self.PROMPT).strip()
         if not text:
             raise OperationFailed("confirm needs the text of the question")
-        timeout = _seconds(call, "timeout")
+        timeout = _seconds(call, TIMEOUT)
         deadline = call.clock() + timeout if timeout > 0 else None  # counted from the asking
         prompt = self._console.ask(text, call.node_name)
         call.log(f"asked the operator: {text}")
         return _PromptJob(self._console, prompt, call, deadline)
 
 
-class ButtonPressed:
+class ButtonPressed(_OperatorOp):
     """collaboration.button_pressed: true once per latched press."""
 
-    def __init__(self, console: OperatorConsole) -> None:
-        self._console = console
+    MANIFEST = manifest(
+        CAP,
+        "button_pressed",
+        OperationKind.CONDITION,
+        "True when the operator pressed the button since it was last checked.",
+        BUTTON,
+    )
 
     def start(self, call: OperationCall) -> Job:
-        return Job.answer(self._console.consume(call.input("button")))
+        return Job.answer(self._console.consume(call.input(BUTTON)))
 
 
 class _ButtonJob(Job):
@@ -149,17 +186,27 @@ class _ButtonJob(Job):
         return self._status
 
 
-class WaitForButton:
+class WaitForButton(_OperatorOp):
     """collaboration.wait_for_button: RUNNING until the button is pressed."""
 
-    def __init__(self, console: OperatorConsole) -> None:
-        self._console = console
+    EARLIER = flag(
+        "earlier_press_counts", False, doc="a press made before this node started counts"
+    )
+    MANIFEST = manifest(
+        CAP,
+        "wait_for_button",
+        OperationKind.ACTION,
+        "Waits until the operator presses the button (or the foot pedal).",
+        BUTTON,
+        TIMEOUT,
+        EARLIER,
+    )
 
     def start(self, call: OperationCall) -> Job:
-        button = call.input("button")
-        if not call.input("earlier_press_counts"):
+        button = call.input(BUTTON)
+        if not call.input(self.EARLIER):
             self._console.clear(button)
-        return _ButtonJob(self._console, button, call, _seconds(call, "timeout"))
+        return _ButtonJob(self._console, button, call, _seconds(call, TIMEOUT))
 
 
 # ---------------------------------------------------------------------- handoff
@@ -167,6 +214,23 @@ class WaitForButton:
 
 class WaitForHandoff:
     """collaboration.wait_for_handoff: watches a camera until the object is put in the region."""
+
+    CAMERA = camera_port("which camera watches")
+    SETTLE = _time("settle", 0.0, "how long it must lie still first")
+    INTERVAL = _time("interval", 0.1, "time between camera frames")
+    MANIFEST = manifest(
+        CAP,
+        "wait_for_handoff",
+        OperationKind.ACTION,
+        "Waits until a person puts the object down in the region (seen by its markers).",
+        OBJECT,
+        REGION,
+        CAMERA,
+        TIMEOUT,
+        SETTLE,
+        INTERVAL,
+        PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where it was put"),
+    )
 
     def __init__(self, env: CapabilityEnv) -> None:
         self._env = env
@@ -177,22 +241,22 @@ class WaitForHandoff:
         from capabilities.collaboration.handoff import HandoffJob, HandoffSettings, object_markers
 
         what = "wait_for_handoff"
-        device = camera(self._env, call.input("camera"))
+        device = camera(self._env, call.input(self.CAMERA))
         world: WorldModel = _interface(self._env, "world", what)
         library = _interface(self._env, "objects", what)
-        name = _object_name(call.input("object"))
+        name = _object_name(call.input(OBJECT))
         if name not in library.names():
             raise OperationFailed(f"the object library has no model {name!r}")
         target = object_markers(library.get(name))
         if not target.markers:
             raise OperationFailed(f"{name} carries no marker: a handoff cannot be seen")
         settings = HandoffSettings(
-            interval=max(_seconds(call, "interval"), 0.01),
-            settle=_seconds(call, "settle"),
-            timeout=_seconds(call, "timeout"),
+            interval=max(_seconds(call, self.INTERVAL), 0.01),
+            settle=_seconds(call, self.SETTLE),
+            timeout=_seconds(call, TIMEOUT),
         )
-        region: Region = call.input("region")
-        return HandoffJob(device, target, region, world, call.clock, settings, call.log)
+        where = call.input(REGION)
+        return HandoffJob(device, target, where, world, call.clock, settings, call.log)
 
 
 def latest(world: WorldModel, name: str) -> Detection | None:
@@ -204,135 +268,31 @@ def latest(world: WorldModel, name: str) -> Detection | None:
 class ObjectInRegion:
     """collaboration.object_in_region: the newest detection of the object is inside."""
 
+    MAX_AGE = _time("max_age", 0.0, "ignore sightings older than this (0: any age)")
+    MANIFEST = manifest(
+        CAP,
+        "object_in_region",
+        OperationKind.CONDITION,
+        "True when the object was last seen inside the region.",
+        OBJECT,
+        REGION,
+        MAX_AGE,
+    )
+
     def __init__(self, env: CapabilityEnv) -> None:
         self._env = env
 
     def start(self, call: OperationCall) -> Job:
         world: WorldModel = _interface(self._env, "world", "object_in_region")
-        detection = latest(world, _object_name(call.input("object")))
+        detection = latest(world, _object_name(call.input(OBJECT)))
         if detection is None:
             return Job.answer(False)
-        max_age = _seconds(call, "max_age")
+        max_age = _seconds(call, self.MAX_AGE)
         if max_age > 0 and call.clock() - detection.stamp > max_age:
             return Job.answer(False)
         from capabilities.collaboration.handoff import in_region
 
-        return Job.answer(in_region(detection.pose, call.input("region")))
-
-
-# ---------------------------------------------------------------------- manifests
-
-
-def _port(name: str, types: tuple[ParamType, ...], doc: str, **kw: Any) -> PortSpec:
-    return PortSpec(name, types, doc=doc, **kw)
-
-
-TIME = (ParamType.DURATION, ParamType.NUMBER)
-
-
-def _manifests() -> list[tuple[OperationManifest, Any]]:
-    button = _port("button", (ParamType.TEXT,), "the operator button", default="continue")
-    obj = _port("object", (ParamType.OBJECT,), "the object (by its model name)")
-    region = _port("region", (ParamType.REGION,), "where it must be (a sphere)")
-    console = lambda env: env.interface("operator")  # noqa: E731
-    return [
-        (
-            manifest(
-                CAP,
-                "confirm",
-                OperationKind.ACTION,
-                "Asks the operator a yes/no question; succeeds on yes, fails on no.",
-                _port("prompt", (ParamType.TEXT,), "the question shown to the operator"),
-                _port(
-                    "timeout",
-                    TIME,
-                    "give up after this long (0: wait for ever)",
-                    default=0.0,
-                    unit="s",
-                ),
-            ),
-            lambda env: Confirm(console(env)),
-        ),
-        (
-            manifest(
-                CAP,
-                "button_pressed",
-                OperationKind.CONDITION,
-                "True when the operator pressed the button since it was last checked.",
-                button,
-            ),
-            lambda env: ButtonPressed(console(env)),
-        ),
-        (
-            manifest(
-                CAP,
-                "wait_for_button",
-                OperationKind.ACTION,
-                "Waits until the operator presses the button (or the foot pedal).",
-                button,
-                _port(
-                    "timeout",
-                    TIME,
-                    "give up after this long (0: wait for ever)",
-                    default=0.0,
-                    unit="s",
-                ),
-                _port(
-                    "earlier_press_counts",
-                    (ParamType.BOOL,),
-                    "a press made before this node started counts",
-                    default=False,
-                ),
-            ),
-            lambda env: WaitForButton(console(env)),
-        ),
-        (
-            manifest(
-                CAP,
-                "wait_for_handoff",
-                OperationKind.ACTION,
-                "Waits until a person puts the object down in the region (seen by its markers).",
-                obj,
-                region,
-                _port(
-                    "camera",
-                    (ParamType.TEXT,),
-                    "which camera watches",
-                    default="shoulder",
-                    choices=CAMERAS,
-                ),
-                _port(
-                    "timeout",
-                    TIME,
-                    "give up after this long (0: wait for ever)",
-                    default=0.0,
-                    unit="s",
-                ),
-                _port("settle", TIME, "how long it must lie still first", default=0.0, unit="s"),
-                _port("interval", TIME, "time between camera frames", default=0.1, unit="s"),
-                PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where it was put"),
-            ),
-            WaitForHandoff,
-        ),
-        (
-            manifest(
-                CAP,
-                "object_in_region",
-                OperationKind.CONDITION,
-                "True when the object was last seen inside the region.",
-                obj,
-                region,
-                _port(
-                    "max_age",
-                    TIME,
-                    "ignore sightings older than this (0: any age)",
-                    default=0.0,
-                    unit="s",
-                ),
-            ),
-            ObjectInRegion,
-        ),
-    ]
+        return Job.answer(in_region(detection.pose, call.input(REGION)))
 
 
 def capability() -> Capability:
@@ -342,6 +302,5 @@ def capability() -> Capability:
         "People and the robot: operator prompts and buttons, objects handed over.",
         requires=("operator",),
     )
-    for made, factory in _manifests():
-        cap.add(made, factory)
+    cap.add(Confirm, ButtonPressed, WaitForButton, WaitForHandoff, ObjectInRegion)
     return cap

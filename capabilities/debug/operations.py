@@ -13,32 +13,65 @@ from capabilities.kit import manifest
 from engine.error_types import ErrorType
 from engine.operations import (
     Direction,
+    InPort,
     Job,
     OperationCall,
     OperationFailed,
     OperationKind,
-    OperationManifest,
     PortSpec,
+    flag,
+    number,
+    text,
 )
 from engine.status import FAILURE, RUNNING, SUCCESS, Status
-from engine.types import ParamType
+from engine.types import ParamType, Pose, Waypoint
 
 __all__ = ["capability"]
 
 CAP = "debug"
 ANY = (ParamType.ANY,)
 ALL_TYPES = (*(t for t in ParamType if t is not ParamType.ANY), ParamType.ANY)
+TICKS = number("ticks", 3, doc="ticks spent RUNNING")
 
 
-class _Succeed:
+class _Debug:
+    """An operation that needs nothing from the cell."""
+
+    def __init__(self, env: CapabilityEnv) -> None:
+        pass
+
+
+class Succeed(_Debug):
+    """debug.succeed."""
+
+    MANIFEST = manifest(CAP, "succeed", OperationKind.ACTION, "Succeeds at once.")
+
     def start(self, call: OperationCall) -> Job:
         return Job.done()
 
 
-class _Fail:
+class Fail(_Debug):
+    """debug.fail: raises OperationFailed with the message and error type."""
+
+    MESSAGE = text("message", "failed on purpose", doc="why")
+    ERROR = text(
+        "error",
+        ErrorType.FAILED.value,
+        doc="the type of the failure",
+        choices=tuple(t.value for t in ErrorType),
+    )
+    MANIFEST = manifest(
+        CAP,
+        "fail",
+        OperationKind.ACTION,
+        "Fails at once with a message and an error type (a Catch can take it).",
+        MESSAGE,
+        ERROR,
+    )
+
     def start(self, call: OperationCall) -> Job:
-        error = ErrorType(str(call.input("error") or ErrorType.FAILED.value))
-        raise OperationFailed(str(call.input("message") or "failed on purpose"), error)
+        error = ErrorType(str(call.input(self.ERROR) or ErrorType.FAILED.value))
+        raise OperationFailed(str(call.input(self.MESSAGE) or "failed on purpose"), error)
 
 
 class _TickJob(Job):
@@ -63,182 +96,158 @@ def _then_status(value: str) -> Status:
     return SUCCESS if value == "SUCCESS" else FAILURE  # the port's choices
 
 
-class _Running:
+class Running(_Debug):
+    """debug.running: RUNNING for some ticks, then the chosen status."""
+
+    THEN = text("then", "SUCCESS", doc="status at the end", choices=("SUCCESS", "FAILURE"))
+    MESSAGE = text("message", "", doc="failure message")
+    MANIFEST = manifest(
+        CAP,
+        "running",
+        OperationKind.ACTION,
+        "Runs for a number of ticks, then succeeds or fails.",
+        TICKS,
+        THEN,
+        MESSAGE,
+    )
+
     def start(self, call: OperationCall) -> Job:
-        ticks = int(call.input("ticks"))
+        ticks = int(call.input(TICKS))
         if ticks < 0:
             raise OperationFailed(f"ticks must be 0 or more, not {ticks}")
-        return _TickJob(ticks, _then_status(call.input("then")), call.input("message"))
+        return _TickJob(ticks, _then_status(call.input(self.THEN)), call.input(self.MESSAGE))
 
 
-class _PretendMove:
+class PretendMove(_Debug):
+    """debug.pretend_move: logs the target and runs for some ticks."""
+
+    TARGET = InPort[Pose | Waypoint](
+        "target", (ParamType.POSE, ParamType.WAYPOINT), doc="where to go"
+    )
+    MANIFEST = manifest(
+        CAP,
+        "pretend_move",
+        OperationKind.ACTION,
+        "Pretends to move to a pose for some ticks.",
+        TARGET,
+        TICKS,
+    )
+
     def start(self, call: OperationCall) -> Job:
-        call.log(f"moving to {call.input('target')}")
-        return _TickJob(int(call.input("ticks")), SUCCESS, "")
+        call.log(f"moving to {call.input(self.TARGET)}")
+        return _TickJob(int(call.input(TICKS)), SUCCESS, "")
 
 
-class _SetParam:
+class SetParam(_Debug):
+    """debug.set_param: writes its value to the parameter bound to ``name``."""
+
+    VALUE = InPort[Any]("value", ALL_TYPES, doc="the value")
+    MANIFEST = manifest(
+        CAP,
+        "set_param",
+        OperationKind.ACTION,
+        "Writes a value to a named parameter.",
+        VALUE,
+        PortSpec("name", ANY, Direction.OUT, doc="the parameter written"),
+    )
+
     def start(self, call: OperationCall) -> Job:
-        call.write("name", call.input("value"))
+        call.write("name", call.input(self.VALUE))
         return Job.done()
 
 
-class _Query:
+class Query(_Debug):
+    """debug.query: answers with its value."""
+
+    VALUE = InPort[Any]("value", ALL_TYPES, doc="the answer")
+    MANIFEST = manifest(
+        CAP,
+        "query",
+        OperationKind.QUERY,
+        "Answers with a given value (a stand-in query).",
+        VALUE,
+        PortSpec("result", ANY, Direction.OUT, doc="where the answer goes"),
+    )
+
     def start(self, call: OperationCall) -> Job:
-        call.write("result", call.input("value"))
+        call.write("result", call.input(self.VALUE))
         return Job.done()
 
 
-class _CheckParam:
+class CheckParam(_Debug):
+    """debug.check_param: true when the value equals the expected one."""
+
+    VALUE = InPort[Any]("value", ALL_TYPES, doc="the parameter (a reference)")
+    EXPECTED = InPort[Any]("expected", ALL_TYPES, doc="the value it should have")
+    MANIFEST = manifest(
+        CAP,
+        "check_param",
+        OperationKind.CONDITION,
+        "True when a parameter equals a value.",
+        VALUE,
+        EXPECTED,
+    )
+
     def start(self, call: OperationCall) -> Job:
-        return Job.answer(bool(call.input("value") == call.input("expected")))
+        return Job.answer(bool(call.input(self.VALUE) == call.input(self.EXPECTED)))
 
 
-class _Condition:
+class Condition(_Debug):
+    """debug.condition: answers as set."""
+
+    RESULT = flag("result", True, doc="the answer")
+    MANIFEST = manifest(CAP, "condition", OperationKind.CONDITION, "True or false, as set.", RESULT)
+
     def start(self, call: OperationCall) -> Job:
-        return Job.answer(bool(call.input("result")))
+        return Job.answer(bool(call.input(self.RESULT)))
 
 
-class _SucceedAfter:
+class SucceedAfter(_Debug):
     """False the first N times it is evaluated, true afterwards (state kept per leaf)."""
 
-    def __init__(self) -> None:
+    FAILURES = number("failures", 2, doc="how many false answers")
+    MANIFEST = manifest(
+        CAP,
+        "succeed_after",
+        OperationKind.CONDITION,
+        "False the first N times it is checked, then true (e.g. an object that appears).",
+        FAILURES,
+    )
+
+    def __init__(self, env: CapabilityEnv) -> None:
         self.evaluations = 0
 
     def start(self, call: OperationCall) -> Job:
         self.evaluations += 1
-        return Job.answer(self.evaluations > int(call.input("failures")))
+        return Job.answer(self.evaluations > int(call.input(self.FAILURES)))
 
 
-class _Log:
+class Log(_Debug):
+    """debug.log: writes its message to the run's log."""
+
+    MESSAGE = text("message", doc="the message")
+    MANIFEST = manifest(
+        CAP, "log", OperationKind.ACTION, "Writes a message to the run's log.", MESSAGE
+    )
+
     def start(self, call: OperationCall) -> Job:
-        call.log(call.input("message"))
+        call.log(call.input(self.MESSAGE))
         return Job.done()
-
-
-def _maker(cls: type) -> Any:
-    def make(env: CapabilityEnv) -> Any:
-        return cls()
-
-    return make
 
 
 def capability() -> Capability:
     """The debug capability with all its operations."""
     cap = Capability(CAP, "Operations for trying plans without a robot.")
-    ticks = PortSpec("ticks", (ParamType.NUMBER,), default=3, doc="ticks spent RUNNING")
-    entries: list[tuple[OperationManifest, type]] = [
-        (manifest(CAP, "succeed", OperationKind.ACTION, "Succeeds at once."), _Succeed),
-        (
-            manifest(
-                CAP,
-                "fail",
-                OperationKind.ACTION,
-                "Fails at once with a message and an error type (a Catch can take it).",
-                PortSpec("message", (ParamType.TEXT,), default="failed on purpose", doc="why"),
-                PortSpec(
-                    "error",
-                    (ParamType.TEXT,),
-                    default=ErrorType.FAILED.value,
-                    doc="the type of the failure",
-                    choices=tuple(t.value for t in ErrorType),
-                ),
-            ),
-            _Fail,
-        ),
-        (
-            manifest(
-                CAP,
-                "running",
-                OperationKind.ACTION,
-                "Runs for a number of ticks, then succeeds or fails.",
-                ticks,
-                PortSpec(
-                    "then",
-                    (ParamType.TEXT,),
-                    default="SUCCESS",
-                    doc="status at the end",
-                    choices=("SUCCESS", "FAILURE"),
-                ),
-                PortSpec("message", (ParamType.TEXT,), default="", doc="failure message"),
-            ),
-            _Running,
-        ),
-        (
-            manifest(
-                CAP,
-                "pretend_move",
-                OperationKind.ACTION,
-                "Pretends to move to a pose for some ticks.",
-                PortSpec("target", (ParamType.POSE, ParamType.WAYPOINT), doc="where to go"),
-                ticks,
-            ),
-            _PretendMove,
-        ),
-        (
-            manifest(
-                CAP,
-                "set_param",
-                OperationKind.ACTION,
-                "Writes a value to a named parameter.",
-                PortSpec("value", ALL_TYPES, doc="the value"),
-                PortSpec("name", ANY, Direction.OUT, doc="the parameter written"),
-            ),
-            _SetParam,
-        ),
-        (
-            manifest(
-                CAP,
-                "query",
-                OperationKind.QUERY,
-                "Answers with a given value (a stand-in query).",
-                PortSpec("value", ALL_TYPES, doc="the answer"),
-                PortSpec("result", ANY, Direction.OUT, doc="where the answer goes"),
-            ),
-            _Query,
-        ),
-        (
-            manifest(
-                CAP,
-                "check_param",
-                OperationKind.CONDITION,
-                "True when a parameter equals a value.",
-                PortSpec("value", ALL_TYPES, doc="the parameter (a reference)"),
-                PortSpec("expected", ALL_TYPES, doc="the value it should have"),
-            ),
-            _CheckParam,
-        ),
-        (
-            manifest(
-                CAP,
-                "condition",
-                OperationKind.CONDITION,
-                "True or false, as set.",
-                PortSpec("result", (ParamType.BOOL,), default=True, doc="the answer"),
-            ),
-            _Condition,
-        ),
-        (
-            manifest(
-                CAP,
-                "succeed_after",
-                OperationKind.CONDITION,
-                "False the first N times it is checked, then true (e.g. an object that appears).",
-                PortSpec("failures", (ParamType.NUMBER,), default=2, doc="how many false answers"),
-            ),
-            _SucceedAfter,
-        ),
-        (
-            manifest(
-                CAP,
-                "log",
-                OperationKind.ACTION,
-                "Writes a message to the run's log.",
-                PortSpec("message", (ParamType.TEXT,), doc="the message"),
-            ),
-            _Log,
-        ),
-    ]
-    for made, cls in entries:
-        cap.add(made, _maker(cls))
+    cap.add(
+        Succeed,
+        Fail,
+        Running,
+        PretendMove,
+        SetParam,
+        Query,
+        CheckParam,
+        Condition,
+        SucceedAfter,
+        Log,
+    )
     return cap

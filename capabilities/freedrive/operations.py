@@ -15,30 +15,13 @@ from engine.operations import (
     OperationFailed,
     OperationKind,
     PortSpec,
+    text,
 )
 from engine.types import JointConfig, ParamType, Waypoint, WaypointFrame
 
 __all__ = ["capability"]
 
 CAP = "freedrive"
-
-START = manifest(CAP, "start", OperationKind.ACTION, "Lets the worker guide the arm by hand.")
-STOP = manifest(CAP, "stop", OperationKind.ACTION, "Ends hand guiding; the arm holds where it is.")
-RECORD_WAYPOINT = manifest(
-    CAP,
-    "record_waypoint",
-    OperationKind.QUERY,
-    "Records where the arm is now as a waypoint (typically after guiding it by hand).",
-    PortSpec("name", (ParamType.TEXT,), default="waypoint", doc="the waypoint's name"),
-    PortSpec(
-        "frame",
-        (ParamType.TEXT,),
-        default="world",
-        choices=("world", "joints"),
-        doc="world: the tool pose; joints: the joint positions",
-    ),
-    PortSpec("waypoint", (ParamType.WAYPOINT,), Direction.OUT, doc="the recorded waypoint"),
-)
 
 
 def _off_thread(fn: Callable[[], None], describe: str) -> Job:
@@ -57,29 +40,60 @@ def _off_thread(fn: Callable[[], None], describe: str) -> Job:
     return job
 
 
-class SetFreedrive:
-    """freedrive.start / freedrive.stop."""
+class _FreedriveOp:
+    """An operation on the cell's freedrive backend."""
 
-    def __init__(self, backend: FreedriveBackend, on: bool) -> None:
-        self._backend = backend
-        self._on = on
+    def __init__(self, env: CapabilityEnv) -> None:
+        self._backend: FreedriveBackend = env.interface(FREEDRIVE)
+
+
+class Start(_FreedriveOp):
+    """freedrive.start."""
+
+    MANIFEST = manifest(
+        CAP, "start", OperationKind.ACTION, "Lets the worker guide the arm by hand."
+    )
 
     def start(self, call: OperationCall) -> Job:
-        describe = "start freedrive" if self._on else "stop freedrive"
-        return _off_thread(lambda: self._backend.set_freedrive(self._on), describe)
+        return _off_thread(lambda: self._backend.set_freedrive(True), "start freedrive")
 
 
-class RecordWaypoint:
+class Stop(_FreedriveOp):
+    """freedrive.stop."""
+
+    MANIFEST = manifest(
+        CAP, "stop", OperationKind.ACTION, "Ends hand guiding; the arm holds where it is."
+    )
+
+    def start(self, call: OperationCall) -> Job:
+        return _off_thread(lambda: self._backend.set_freedrive(False), "stop freedrive")
+
+
+class RecordWaypoint(_FreedriveOp):
     """freedrive.record_waypoint: the tool pose or joints now, as a named waypoint."""
 
-    def __init__(self, backend: FreedriveBackend) -> None:
-        self._backend = backend
+    NAME = text("name", "waypoint", doc="the waypoint's name")
+    FRAME = text(
+        "frame",
+        "world",
+        choices=("world", "joints"),
+        doc="world: the tool pose; joints: the joint positions",
+    )
+    MANIFEST = manifest(
+        CAP,
+        "record_waypoint",
+        OperationKind.QUERY,
+        "Records where the arm is now as a waypoint (typically after guiding it by hand).",
+        NAME,
+        FRAME,
+        PortSpec("waypoint", (ParamType.WAYPOINT,), Direction.OUT, doc="the recorded waypoint"),
+    )
 
     def start(self, call: OperationCall) -> Job:
-        name = call.input("name").strip()
+        name = call.input(self.NAME).strip()
         if not name:
             raise OperationFailed("the waypoint needs a name")
-        frame = call.input("frame")
+        frame = call.input(self.FRAME)
         if frame == "world":
             waypoint = Waypoint(name, WaypointFrame.WORLD, pose=self._backend.tcp_pose())
         else:  # "joints" (the port's choices)
@@ -94,11 +108,5 @@ def capability() -> Capability:
     cap = Capability(
         CAP, "Hand guiding of the arm and recording where it is.", requires=(FREEDRIVE,)
     )
-
-    def backend(env: CapabilityEnv) -> FreedriveBackend:
-        return env.interface(FREEDRIVE)
-
-    cap.add(START, lambda env: SetFreedrive(backend(env), True))
-    cap.add(STOP, lambda env: SetFreedrive(backend(env), False))
-    cap.add(RECORD_WAYPOINT, lambda env: RecordWaypoint(backend(env)))
+    cap.add(Start, Stop, RecordWaypoint)
     return cap

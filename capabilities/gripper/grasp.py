@@ -14,12 +14,14 @@ tool pose.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import ClassVar
 
-from capabilities.gripper.backend import GripperBackend, HeldSuctionTool
+from capabilities.base import CapabilityEnv, CapabilityError
+from capabilities.gripper.backend import GRIPPER, SUCTION, GripperBackend, HeldSuctionTool
 from capabilities.jobs import chain_jobs, job_from_handle
 from capabilities.kit import manifest
-from capabilities.motion.backend import ArmBackend
+from capabilities.motion.backend import ARM, ArmBackend
 from capabilities.motion.geometry import format_pose_mm
 from capabilities.motion.operations import JOINT_ACCEL, JOINT_SPEED
 from capabilities.motion.symmetry import SymmetryTable
@@ -32,15 +34,24 @@ from engine.operations import (
     OperationFailed,
     OperationKind,
     OperationManifest,
-    PortSpec,
+    object_model,
+    pose,
+    text,
 )
-from engine.types import ObjectModel, ParamType, Pose
+from engine.types import Pose
 
-__all__ = ["FIRST", "Grasp", "GraspPlan", "grasp_manifest", "plan_grasp"]
+__all__ = ["FIRST", "GRASP", "OBJECT", "POSE", "Grasp", "GraspPlan", "grasp_manifest", "plan_grasp"]
 
 FIRST = "first"
 """The ``grasp`` port's value that means the model's first grasp (the default)."""
 _LINEAR_SPEED, _LINEAR_ACCEL = 0.15, 1.0  # m/s, m/s^2: gentle near the object
+
+
+OBJECT = object_model("object", doc="the object (by its model name)")
+POSE = pose("pose", doc="where the object is (from a markers or perception pose query)")
+GRASP = text(
+    "grasp", FIRST, doc="which grasp of the object's model ('first': the model's first grasp)"
+)
 
 
 def grasp_manifest(capability: str, grasp_names: tuple[str, ...]) -> OperationManifest:
@@ -51,19 +62,9 @@ def grasp_manifest(capability: str, grasp_names: tuple[str, ...]) -> OperationMa
         OperationKind.ACTION,
         "Takes an object at its pose with a grasp of its model: approach, straight down, "
         "close (or vacuum on), check it is held, lift back.",
-        PortSpec("object", (ParamType.OBJECT,), doc="the object (by its model name)"),
-        PortSpec(
-            "pose",
-            (ParamType.POSE,),
-            doc="where the object is (from a markers or perception pose query)",
-        ),
-        PortSpec(
-            "grasp",
-            (ParamType.TEXT,),
-            default=FIRST,
-            choices=(FIRST, *(n for n in grasp_names if n != FIRST)),
-            doc="which grasp of the object's model ('first': the model's first grasp)",
-        ),
+        OBJECT,
+        POSE,
+        replace(GRASP, choices=(FIRST, *(n for n in grasp_names if n != FIRST))),
     )
 
 
@@ -104,29 +105,38 @@ def plan_grasp(
 
 
 class Grasp:
-    """gripper.grasp: approach, descend, take (fingers or vacuum), check, lift."""
+    """gripper.grasp: approach, descend, take (fingers or vacuum), check, lift.
 
-    def __init__(
-        self,
-        arm: ArmBackend,
-        gripper: GripperBackend,
-        suction: HeldSuctionTool | None,
-        table: SymmetryTable,
-    ) -> None:
-        self._arm = arm
-        self._gripper = gripper
-        self._suction = suction
-        self._table = table
+    Its manifest lists the grasps of a library, so the capability adds the class that
+    :meth:`of_grasps` makes; ``env.state`` is the capability's symmetry table.
+    """
+
+    MANIFEST: ClassVar[OperationManifest]
+
+    @classmethod
+    def of_grasps(cls, capability: str, grasp_names: tuple[str, ...]) -> type[Grasp]:
+        """The operation whose ``grasp`` port offers ``grasp_names``."""
+        return type(cls.__name__, (cls,), {"MANIFEST": grasp_manifest(capability, grasp_names)})
+
+    def __init__(self, env: CapabilityEnv) -> None:
+        self._arm: ArmBackend = env.interface(ARM)
+        self._gripper: GripperBackend = env.interface(GRIPPER)
+        self._suction: HeldSuctionTool | None
+        try:
+            self._suction = env.interface(SUCTION)
+        except CapabilityError:
+            self._suction = None  # grasps made with the suction tool then say the cell has none
+        self._table: SymmetryTable = env.state
 
     def start(self, call: OperationCall) -> Job:
-        model: ObjectModel = call.input("object")
-        name: str = call.input("grasp")
+        model = call.input(OBJECT)
+        name = call.input(GRASP)
         try:
             grasp = self._table.grasp(model.name, "" if name == FIRST else name)
         except (ObjectLibraryError, OSError) as exc:
             raise OperationFailed(str(exc)) from exc
         take, held = self._tool_steps(grasp, model.name)
-        plan = plan_grasp(self._arm, grasp, call.input("pose"), self._table, model.name)
+        plan = plan_grasp(self._arm, grasp, call.input(POSE), self._table, model.name)
         turned = f" (symmetric equivalent {plan.equivalent})" if plan.equivalent else ""
         call.log(f"grasp {grasp.name!r} of the {model.name}{turned}")
         steps: list[tuple[str, Callable[[], Job]]] = []

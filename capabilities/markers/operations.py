@@ -12,7 +12,7 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 from capabilities.base import Capability, CapabilityEnv
-from capabilities.kit import CAMERAS, camera, manifest, stateful
+from capabilities.kit import camera, camera_port, manifest
 from capabilities.markers.backend import CameraDevice
 from capabilities.world_model import Detection, WorldModel
 from engine.error_types import ErrorType
@@ -23,6 +23,8 @@ from engine.operations import (
     OperationFailed,
     OperationKind,
     PortSpec,
+    number,
+    object_model,
 )
 from engine.types import ObjectModel, ParamType, Pose
 
@@ -39,14 +41,8 @@ CAP = "markers"
 MIN_CONFIDENCE = 0.05
 
 
-def _camera_port(default: str = "shoulder") -> PortSpec:
-    return PortSpec(
-        "camera", (ParamType.TEXT,), default=default, doc="which camera looks", choices=CAMERAS
-    )
-
-
-def _object_port() -> PortSpec:
-    return PortSpec("object", (ParamType.OBJECT,), doc="the object (by its model name)")
+CAMERA = camera_port()
+OBJECT = object_model("object", doc="the object (by its model name)")
 
 
 class _Env:
@@ -60,6 +56,7 @@ class _Env:
         self.library = env.interface("objects")
 
     def camera(self, name: str) -> CameraDevice:
+        """The cell's camera ``name``."""
         return camera(self.env, name)
 
     def markers_on_objects(self) -> dict[int, tuple[str, Pose]]:
@@ -94,15 +91,30 @@ def _object_detections(
     return list(best.values())
 
 
-class DetectMarkers:
-    def __init__(self, env: _Env) -> None:
-        self._env = env
+class _MarkersOp:
+    """An operation over the capability's per-cell state (:class:`_Env`)."""
+
+    def __init__(self, env: CapabilityEnv) -> None:
+        self._env: _Env = env.state
+
+
+class DetectMarkers(_MarkersOp):
+    """markers.detect_markers: one look, on a worker thread, into the world model."""
+
+    MANIFEST = manifest(
+        CAP,
+        "detect_markers",
+        OperationKind.ACTION,
+        "Looks through a camera and remembers every marker and marked object it sees.",
+        CAMERA,
+        PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="how many markers were seen"),
+    )
 
     def start(self, call: OperationCall) -> Job:
         from capabilities.markers.depth import refine_with_depth
         from capabilities.markers.detection import detect_markers, marker_pose_world
 
-        camera = self._env.camera(call.input("camera"))
+        camera = self._env.camera(call.input(CAMERA))
         env = self._env
 
         def look() -> dict[str, Any]:
@@ -128,12 +140,21 @@ class DetectMarkers:
         return job
 
 
-class MarkerPose:
-    def __init__(self, env: _Env) -> None:
-        self._env = env
+class MarkerPose(_MarkersOp):
+    """markers.marker_pose: where a marker was last seen."""
+
+    MARKER_ID = number("marker_id", doc="the marker's id")
+    MANIFEST = manifest(
+        CAP,
+        "marker_pose",
+        OperationKind.QUERY,
+        "The pose of a marker last seen.",
+        MARKER_ID,
+        PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where it is"),
+    )
 
     def start(self, call: OperationCall) -> Job:
-        marker_id = int(call.input("marker_id"))
+        marker_id = int(call.input(self.MARKER_ID))
         found = self._env.world.marker(marker_id)
         if found is None:
             raise OperationFailed(f"marker {marker_id} has not been seen", ErrorType.NOT_FOUND)
@@ -146,45 +167,69 @@ def _best(env: _Env, model: Any) -> Detection | None:
     return env.world.best(name)
 
 
-class ObjectPose:
-    def __init__(self, env: _Env) -> None:
-        self._env = env
+class ObjectPose(_MarkersOp):
+    """markers.object_pose: an object's pose from its marker."""
+
+    MANIFEST = manifest(
+        CAP,
+        "object_pose",
+        OperationKind.QUERY,
+        "The pose of an object, from its marker.",
+        OBJECT,
+        PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the object is"),
+    )
 
     def start(self, call: OperationCall) -> Job:
-        detection = _best(self._env, call.input("object"))
+        detection = _best(self._env, call.input(OBJECT))
         if detection is None:
             raise OperationFailed(
-                f"{call.input('object').name} has not been seen", ErrorType.NOT_FOUND
+                f"{call.input(OBJECT).name} has not been seen", ErrorType.NOT_FOUND
             )
         call.write("pose", detection.pose)
         return Job.done()
 
 
-class ObjectFound:
-    def __init__(self, env: _Env) -> None:
-        self._env = env
+class ObjectFound(_MarkersOp):
+    """markers.object_found."""
+
+    MANIFEST = manifest(
+        CAP,
+        "object_found",
+        OperationKind.CONDITION,
+        "True when the object's marker was seen.",
+        OBJECT,
+    )
 
     def start(self, call: OperationCall) -> Job:
-        return Job.answer(_best(self._env, call.input("object")) is not None)
+        return Job.answer(_best(self._env, call.input(OBJECT)) is not None)
 
 
-class CalibrateCamera:
+class CalibrateCamera(_MarkersOp):
     """Finds a fixed camera's pose from the markers of known pose (on the table, on fixtures)."""
 
-    def __init__(self, env: _Env) -> None:
-        self._env = env
+    MAX_ERROR_PX = number(
+        "max_error_px", 1.5, unit="px", doc="refuse a calibration worse than this"
+    )
+    MANIFEST = manifest(
+        CAP,
+        "calibrate_camera",
+        OperationKind.ACTION,
+        "Finds a fixed camera's pose from the markers of known pose (table, fixtures).",
+        CAMERA,
+        MAX_ERROR_PX,
+    )
 
     def start(self, call: OperationCall) -> Job:
         from capabilities.markers.calibration import calibrate_extrinsics
         from capabilities.markers.detection import detect_markers
 
-        camera = self._env.camera(call.input("camera"))
+        camera = self._env.camera(call.input(CAMERA))
         if camera.on_wrist:
             raise OperationFailed(
                 "the wrist camera is calibrated by hand-eye calibration, not here"
             )
         env = self._env
-        max_rms = call.input("max_error_px")
+        max_rms = call.input(self.MAX_ERROR_PX)
 
         def calibrate() -> dict[str, Any]:
             frame = camera.capture()
@@ -207,71 +252,12 @@ class CalibrateCamera:
 
 
 def capability() -> Capability:
+    """The markers capability; its per-cell state is the interfaces its operations use."""
     cap = Capability(
         CAP,
         "Finds ArUco markers in camera images; object poses and camera calibration from them.",
         requires=("world", "workers", "scene_layout", "objects", "rgbd:shoulder"),
         setup=_Env,  # the per-cell state: the interfaces every markers operation uses
     )
-
-    cap.add(
-        manifest(
-            CAP,
-            "detect_markers",
-            OperationKind.ACTION,
-            "Looks through a camera and remembers every marker and marked object it sees.",
-            _camera_port(),
-            PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="how many markers were seen"),
-        ),
-        stateful(DetectMarkers),
-    )
-    cap.add(
-        manifest(
-            CAP,
-            "marker_pose",
-            OperationKind.QUERY,
-            "The pose of a marker last seen.",
-            PortSpec("marker_id", (ParamType.NUMBER,), doc="the marker's id"),
-            PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where it is"),
-        ),
-        stateful(MarkerPose),
-    )
-    cap.add(
-        manifest(
-            CAP,
-            "object_pose",
-            OperationKind.QUERY,
-            "The pose of an object, from its marker.",
-            _object_port(),
-            PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the object is"),
-        ),
-        stateful(ObjectPose),
-    )
-    cap.add(
-        manifest(
-            CAP,
-            "object_found",
-            OperationKind.CONDITION,
-            "True when the object's marker was seen.",
-            _object_port(),
-        ),
-        stateful(ObjectFound),
-    )
-    cap.add(
-        manifest(
-            CAP,
-            "calibrate_camera",
-            OperationKind.ACTION,
-            "Finds a fixed camera's pose from the markers of known pose (table, fixtures).",
-            _camera_port(),
-            PortSpec(
-                "max_error_px",
-                (ParamType.NUMBER,),
-                default=1.5,
-                unit="px",
-                doc="refuse a calibration worse than this",
-            ),
-        ),
-        stateful(CalibrateCamera),
-    )
+    cap.add(DetectMarkers, MarkerPose, ObjectPose, ObjectFound, CalibrateCamera)
     return cap

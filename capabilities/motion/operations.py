@@ -22,13 +22,17 @@ from capabilities.motion.targets import TargetResolver
 from engine.error_types import ErrorType
 from engine.operations import (
     Direction,
+    InPort,
     Job,
     OperationCall,
     OperationFailed,
     OperationKind,
     PortSpec,
+    joints,
+    number,
+    text,
 )
-from engine.types import JointConfig, ParamType, Pose
+from engine.types import JointConfig, ParamType, Pose, Waypoint
 
 __all__ = ["capability", "scale"]
 
@@ -39,41 +43,36 @@ JOINT_ACCEL = 1.4  # rad/s^2
 LINEAR_SPEED = 0.25  # m/s
 LINEAR_ACCEL = 1.2  # m/s^2
 
-_N = (ParamType.NUMBER,)
-SPEED = PortSpec(
-    "speed",
-    _N,
-    default=1.0,
-    doc="fraction of the nominal speed (1.05 rad/s joint, 0.25 m/s linear), 0 to 2",
+SPEED = number(
+    "speed", 1.0, doc="fraction of the nominal speed (1.05 rad/s joint, 0.25 m/s linear), 0 to 2"
 )
-ACCEL = PortSpec(
+ACCEL = number(
     "accel",
-    _N,
-    default=1.0,
+    1.0,
     doc="fraction of the nominal acceleration (1.4 rad/s^2 joint, 1.2 m/s^2 linear), 0 to 2",
 )
 
 _MAX_SCALE = 2.0
 
 
-def scale(call: OperationCall, port: str) -> float:
+def scale(call: OperationCall, port: InPort[float]) -> float:
     """A speed or acceleration fraction from a port, checked to be in (0, 2]."""
-    value: float = call.input(port)  # a Number (validation checked the type, not the range)
+    value = call.input(port)  # a Number (validation checked the type, not the range)
     if not 0 < value <= _MAX_SCALE:
-        raise OperationFailed(f"{port} must be above 0 and at most {_MAX_SCALE:g}, not {value}")
+        raise OperationFailed(
+            f"{port.name} must be above 0 and at most {_MAX_SCALE:g}, not {value}"
+        )
     return value
 
 
 def _joint_move(arm: ArmBackend, q: Sequence[float], call: OperationCall, describe: str) -> Any:
-    handle = arm.move_joints(
-        q, JOINT_SPEED * scale(call, "speed"), JOINT_ACCEL * scale(call, "accel")
-    )
+    handle = arm.move_joints(q, JOINT_SPEED * scale(call, SPEED), JOINT_ACCEL * scale(call, ACCEL))
     return job_from_handle(handle, describe)
 
 
 def _linear_move(arm: ArmBackend, pose: Pose, call: OperationCall, describe: str) -> Any:
     handle = arm.move_linear(
-        pose, LINEAR_SPEED * scale(call, "speed"), LINEAR_ACCEL * scale(call, "accel")
+        pose, LINEAR_SPEED * scale(call, SPEED), LINEAR_ACCEL * scale(call, ACCEL)
     )
     return job_from_handle(handle, describe)
 
@@ -90,18 +89,22 @@ def _via_approach(
     )
 
 
-MOVE_TO = manifest(
-    CAP,
-    "move_to",
-    OperationKind.ACTION,
-    "Moves the tool to a pose or waypoint (relative waypoints follow the detected object; "
-    "an object's pose with a grasp reference goes to that grasp through its approach).",
-    PortSpec(
+class _ArmOp:
+    """An operation on the cell's arm."""
+
+    def __init__(self, env: CapabilityEnv) -> None:
+        self._arm: ArmBackend = env.interface(ARM)
+
+
+class MoveTo(_ArmOp):
+    """motion.move_to: a pose or a waypoint in any frame, by a joint or a linear move."""
+
+    TARGET = InPort[Waypoint | Pose](
         "target",
         (ParamType.WAYPOINT, ParamType.POSE),
         doc="where the tool goes (world pose, or a waypoint in any frame)",
-    ),
-    PortSpec(
+    )
+    REFERENCE = InPort[Pose | str](
         "reference",
         (ParamType.POSE, ParamType.TEXT),
         default="",
@@ -109,31 +112,37 @@ MOVE_TO = manifest(
         "to look up; empty: the waypoint's own reference in the world model. For a Pose "
         "target that is an object's pose: a grasp reference, 'cup' (its model's first grasp) "
         "or 'cup/rim'",
-    ),
-    PortSpec(
+    )
+    MODE = text(
         "mode",
-        (ParamType.TEXT,),
-        default="joint",
+        "joint",
         choices=("joint", "linear"),
         doc="joint: fastest path in joint space; linear: a straight line of the tool (a grasp "
         "reference: joint to the approach, then straight to the grasp)",
-    ),
-    SPEED,
-    ACCEL,
-)
+    )
+    MANIFEST = manifest(
+        CAP,
+        "move_to",
+        OperationKind.ACTION,
+        "Moves the tool to a pose or waypoint (relative waypoints follow the detected object; "
+        "an object's pose with a grasp reference goes to that grasp through its approach).",
+        TARGET,
+        REFERENCE,
+        MODE,
+        SPEED,
+        ACCEL,
+    )
 
-
-class MoveTo:
-    """motion.move_to: a pose or a waypoint in any frame, by a joint or a linear move."""
-
-    def __init__(self, arm: ArmBackend, resolver: TargetResolver) -> None:
-        self._arm = arm
-        self._resolver = resolver
+    def __init__(self, env: CapabilityEnv) -> None:
+        super().__init__(env)
+        self._resolver = TargetResolver(_world(env), env.state)
 
     def start(self, call: OperationCall) -> Job:
-        mode = call.input("mode")
+        mode = call.input(self.MODE)
         current = self._arm.tcp_pose()
-        target = self._resolver.resolve(call.input("target"), call.input("reference"), current)
+        target = self._resolver.resolve(
+            call.input(self.TARGET), call.input(self.REFERENCE), current
+        )
         if target.joints is not None:
             return _joint_move(
                 self._arm, target.joints.positions, call, f"move to {target.describe}"
@@ -159,217 +168,194 @@ class MoveTo:
         )
 
 
-MOVE_JOINTS = manifest(
-    CAP,
-    "move_joints",
-    OperationKind.ACTION,
-    "Moves the arm to joint positions.",
-    PortSpec("target", (ParamType.JOINTS,), unit="rad", doc="joint positions, base to wrist"),
-    SPEED,
-    ACCEL,
-)
-
-
-class MoveJoints:
+class MoveJoints(_ArmOp):
     """motion.move_joints: a joint move to a JointConfig."""
 
-    def __init__(self, arm: ArmBackend) -> None:
-        self._arm = arm
+    TARGET = joints("target", doc="joint positions, base to wrist")
+    MANIFEST = manifest(
+        CAP,
+        "move_joints",
+        OperationKind.ACTION,
+        "Moves the arm to joint positions.",
+        TARGET,
+        SPEED,
+        ACCEL,
+    )
 
     def start(self, call: OperationCall) -> Job:
-        target: JointConfig = call.input("target")
-        return _joint_move(self._arm, target.positions, call, "move_joints")
+        return _joint_move(self._arm, call.input(self.TARGET).positions, call, "move_joints")
 
 
-MOVE_RELATIVE = manifest(
-    CAP,
-    "move_relative",
-    OperationKind.ACTION,
-    "Moves the tool by an offset on a straight line.",
-    PortSpec("dx", _N, default=0.0, unit="m", doc="offset along x"),
-    PortSpec("dy", _N, default=0.0, unit="m", doc="offset along y"),
-    PortSpec("dz", _N, default=0.0, unit="m", doc="offset along z"),
-    PortSpec(
-        "frame",
-        (ParamType.TEXT,),
-        default="world",
-        choices=("world", "tool"),
-        doc="axes of the offset: the world's or the tool's",
-    ),
-    SPEED,
-    ACCEL,
-)
+def _reachable(arm: ArmBackend, target: Pose) -> Pose:
+    """``target``, or OperationFailed saying it is unreachable (with the pose in mm)."""
+    if arm.inverse_kinematics(target) is None:
+        raise OperationFailed(f"unreachable: pose {format_pose_mm(target)}")
+    return target
 
 
-class MoveRelative:
+class MoveRelative(_ArmOp):
     """motion.move_relative: a straight-line offset in the world or the tool frame."""
 
-    def __init__(self, arm: ArmBackend) -> None:
-        self._arm = arm
+    DX = number("dx", 0.0, unit="m", doc="offset along x")
+    DY = number("dy", 0.0, unit="m", doc="offset along y")
+    DZ = number("dz", 0.0, unit="m", doc="offset along z")
+    FRAME = text(
+        "frame",
+        "world",
+        choices=("world", "tool"),
+        doc="axes of the offset: the world's or the tool's",
+    )
+    MANIFEST = manifest(
+        CAP,
+        "move_relative",
+        OperationKind.ACTION,
+        "Moves the tool by an offset on a straight line.",
+        DX,
+        DY,
+        DZ,
+        FRAME,
+        SPEED,
+        ACCEL,
+    )
 
     def start(self, call: OperationCall) -> Job:
-        offset = (call.input("dx"), call.input("dy"), call.input("dz"))
-        frame = call.input("frame")
+        offset = (call.input(self.DX), call.input(self.DY), call.input(self.DZ))
+        frame = call.input(self.FRAME)
         now = self._arm.tcp_pose()
         if frame == "world":
             x, y, z = now.position
             target = Pose((x + offset[0], y + offset[1], z + offset[2]), now.orientation)
         else:  # "tool" (the port's choices)
             target = now.compose(Pose(offset))
-        if self._arm.inverse_kinematics(target) is None:
-            raise OperationFailed(f"unreachable: pose {format_pose_mm(target)}")
+        _reachable(self._arm, target)
         mm = ", ".join(f"{v * 1000:.1f}" for v in offset)
         return _linear_move(self._arm, target, call, f"move by ({mm}) mm in the {frame} frame")
 
 
-MOVE_RELATIVE_TOOL = manifest(
-    CAP,
-    "move_relative_tool",
-    OperationKind.ACTION,
-    "Moves the tool by an offset along its own axes, on a straight line.",
-    PortSpec("dz", _N, default=0.0, unit="m", doc="offset along the tool's z (its approach)"),
-    SPEED,
-    ACCEL,
-)
-
-
-class MoveRelativeTool:
+class MoveRelativeTool(_ArmOp):
     """motion.move_relative_tool: a straight-line move along the tool's own z axis."""
 
-    def __init__(self, arm: ArmBackend) -> None:
-        self._arm = arm
+    DZ = number("dz", 0.0, unit="m", doc="offset along the tool's z (its approach)")
+    MANIFEST = manifest(
+        CAP,
+        "move_relative_tool",
+        OperationKind.ACTION,
+        "Moves the tool by an offset along its own axes, on a straight line.",
+        DZ,
+        SPEED,
+        ACCEL,
+    )
 
     def start(self, call: OperationCall) -> Job:
-        target = self._arm.tcp_pose().compose(Pose((0.0, 0.0, call.input("dz"))))
-        if self._arm.inverse_kinematics(target) is None:
-            raise OperationFailed(f"unreachable: pose {format_pose_mm(target)}")
+        target = self._arm.tcp_pose().compose(Pose((0.0, 0.0, call.input(self.DZ))))
+        _reachable(self._arm, target)
         return _linear_move(self._arm, target, call, "move along the tool's z")
 
 
-GO_HOME = manifest(
-    CAP, "go_home", OperationKind.ACTION, "Moves the arm to its home joints.", SPEED, ACCEL
-)
-
-
-class GoHome:
+class GoHome(_ArmOp):
     """motion.go_home: a joint move to the configured home."""
 
-    def __init__(self, arm: ArmBackend) -> None:
-        self._arm = arm
+    MANIFEST = manifest(
+        CAP, "go_home", OperationKind.ACTION, "Moves the arm to its home joints.", SPEED, ACCEL
+    )
 
     def start(self, call: OperationCall) -> Job:
         return _joint_move(self._arm, self._arm.home_joints(), call, "go home")
 
 
-STOP = manifest(
-    CAP, "stop", OperationKind.ACTION, "Stops any arm motion; succeeds once the arm stands."
-)
-
-
-class Stop:
+class Stop(_ArmOp):
     """motion.stop: decelerate to a halt; SUCCESS when standing."""
 
-    def __init__(self, arm: ArmBackend) -> None:
-        self._arm = arm
+    MANIFEST = manifest(
+        CAP, "stop", OperationKind.ACTION, "Stops any arm motion; succeeds once the arm stands."
+    )
 
     def start(self, call: OperationCall) -> Job:
         return job_from_handle(self._arm.stop(), "stop")
 
 
-CURRENT_POSE = manifest(
-    CAP,
-    "current_pose",
-    OperationKind.QUERY,
-    "The tool's pose now (world frame).",
-    PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="the tool pose"),
-)
-
-
-class CurrentPose:
+class CurrentPose(_ArmOp):
     """motion.current_pose: writes the TCP pose."""
 
-    def __init__(self, arm: ArmBackend) -> None:
-        self._arm = arm
+    MANIFEST = manifest(
+        CAP,
+        "current_pose",
+        OperationKind.QUERY,
+        "The tool's pose now (world frame).",
+        PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="the tool pose"),
+    )
 
     def start(self, call: OperationCall) -> Job:
         call.write("pose", self._arm.tcp_pose())
         return Job.done()
 
 
-CURRENT_JOINTS = manifest(
-    CAP,
-    "current_joints",
-    OperationKind.QUERY,
-    "The arm's joint positions now.",
-    PortSpec("joints", (ParamType.JOINTS,), Direction.OUT, unit="rad", doc="joint positions"),
-)
-
-
-class CurrentJoints:
+class CurrentJoints(_ArmOp):
     """motion.current_joints: writes the joint positions."""
 
-    def __init__(self, arm: ArmBackend) -> None:
-        self._arm = arm
+    MANIFEST = manifest(
+        CAP,
+        "current_joints",
+        OperationKind.QUERY,
+        "The arm's joint positions now.",
+        PortSpec("joints", (ParamType.JOINTS,), Direction.OUT, unit="rad", doc="joint positions"),
+    )
 
     def start(self, call: OperationCall) -> Job:
         call.write("joints", JointConfig(self._arm.joint_positions()))
         return Job.done()
 
 
-IS_MOVING = manifest(CAP, "is_moving", OperationKind.CONDITION, "True while the arm moves.")
-IS_STOPPED = manifest(
-    CAP, "is_stopped", OperationKind.CONDITION, "True while the arm stands still."
-)
+class IsMoving(_ArmOp):
+    """motion.is_moving."""
 
-
-class IsMoving:
-    """motion.is_moving (or, with ``negate``, motion.is_stopped)."""
-
-    def __init__(self, arm: ArmBackend, negate: bool = False) -> None:
-        self._arm = arm
-        self._negate = negate
+    MANIFEST = manifest(CAP, "is_moving", OperationKind.CONDITION, "True while the arm moves.")
 
     def start(self, call: OperationCall) -> Job:
-        return Job.answer(self._arm.is_moving() != self._negate)
+        return Job.answer(self._arm.is_moving())
 
 
-IS_HOME = manifest(
-    CAP,
-    "is_home",
-    OperationKind.CONDITION,
-    "True when every joint is within a tolerance of the home position.",
-    PortSpec("tolerance", _N, default=0.01, unit="rad", doc="largest joint difference allowed"),
-)
+class IsStopped(_ArmOp):
+    """motion.is_stopped."""
+
+    MANIFEST = manifest(
+        CAP, "is_stopped", OperationKind.CONDITION, "True while the arm stands still."
+    )
+
+    def start(self, call: OperationCall) -> Job:
+        return Job.answer(not self._arm.is_moving())
 
 
-class IsHome:
+class IsHome(_ArmOp):
     """motion.is_home: every joint within ``tolerance`` rad of home."""
 
-    def __init__(self, arm: ArmBackend) -> None:
-        self._arm = arm
+    TOLERANCE = number("tolerance", 0.01, unit="rad", doc="largest joint difference allowed")
+    MANIFEST = manifest(
+        CAP,
+        "is_home",
+        OperationKind.CONDITION,
+        "True when every joint is within a tolerance of the home position.",
+        TOLERANCE,
+    )
 
     def start(self, call: OperationCall) -> Job:
-        tolerance = call.input("tolerance")
+        tolerance = call.input(self.TOLERANCE)
         now, home = self._arm.joint_positions(), self._arm.home_joints()
         return Job.answer(max(abs(a - b) for a, b in zip(now, home, strict=True)) <= tolerance)
 
 
-CLEAR_PROTECTIVE_STOP = manifest(
-    CAP,
-    "clear_protective_stop",
-    OperationKind.ACTION,
-    "Clears a protective stop (after a collision): waits until the robot allows it (5 s "
-    "after the stop on a UR), unlocks it and waits until the arm can move again. Succeeds at "
-    "once when the arm is not stopped. An emergency stop, power off or a lost connection "
-    "fails it with its type: those are for the operator.",
-)
-
-
-class ClearProtectiveStop:
+class ClearProtectiveStop(_ArmOp):
     """motion.clear_protective_stop."""
 
-    def __init__(self, arm: ArmBackend) -> None:
-        self._arm = arm
+    MANIFEST = manifest(
+        CAP,
+        "clear_protective_stop",
+        OperationKind.ACTION,
+        "Clears a protective stop (after a collision): waits until the robot allows it (5 s "
+        "after the stop on a UR), unlocks it and waits until the arm can move again. Succeeds "
+        "at once when the arm is not stopped. An emergency stop, power off or a lost connection "
+        "fails it with its type: those are for the operator.",
+    )
 
     def start(self, call: OperationCall) -> Job:
         handle = self._arm.clear_protective_stop()
@@ -395,23 +381,29 @@ def _world(env: CapabilityEnv) -> WorldBackend | None:
 
 
 def capability(symmetries: SymmetryTable | None = None) -> Capability:
-    """The motion capability (requires ``arm``; reads ``world`` when the cell has one)."""
+    """The motion capability (requires ``arm``; reads ``world`` when the cell has one).
+
+    Its per-cell state is the symmetry table targets on objects are resolved with.
+    """
     table = symmetries if symmetries is not None else SymmetryTable()
-    cap = Capability(CAP, "Moves the robot arm: poses, waypoints, joints, home.", requires=(ARM,))
-
-    def arm(env: CapabilityEnv) -> ArmBackend:
-        return env.interface(ARM)
-
-    cap.add(MOVE_TO, lambda env: MoveTo(arm(env), TargetResolver(_world(env), table)))
-    cap.add(MOVE_JOINTS, lambda env: MoveJoints(arm(env)))
-    cap.add(MOVE_RELATIVE, lambda env: MoveRelative(arm(env)))
-    cap.add(MOVE_RELATIVE_TOOL, lambda env: MoveRelativeTool(arm(env)))
-    cap.add(GO_HOME, lambda env: GoHome(arm(env)))
-    cap.add(STOP, lambda env: Stop(arm(env)))
-    cap.add(CLEAR_PROTECTIVE_STOP, lambda env: ClearProtectiveStop(arm(env)))
-    cap.add(CURRENT_POSE, lambda env: CurrentPose(arm(env)))
-    cap.add(CURRENT_JOINTS, lambda env: CurrentJoints(arm(env)))
-    cap.add(IS_MOVING, lambda env: IsMoving(arm(env)))
-    cap.add(IS_STOPPED, lambda env: IsMoving(arm(env), negate=True))
-    cap.add(IS_HOME, lambda env: IsHome(arm(env)))
+    cap = Capability(
+        CAP,
+        "Moves the robot arm: poses, waypoints, joints, home.",
+        requires=(ARM,),
+        setup=lambda env: table,
+    )
+    cap.add(
+        MoveTo,
+        MoveJoints,
+        MoveRelative,
+        MoveRelativeTool,
+        GoHome,
+        Stop,
+        ClearProtectiveStop,
+        CurrentPose,
+        CurrentJoints,
+        IsMoving,
+        IsStopped,
+        IsHome,
+    )
     return cap

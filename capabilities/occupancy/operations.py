@@ -13,10 +13,10 @@ of cell time passes. ``count_points`` always takes a fresh frame.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from capabilities.base import Capability, CapabilityEnv
-from capabilities.kit import CAMERAS, manifest
+from capabilities.kit import camera_port, manifest
 from capabilities.occupancy.settings import SETTINGS
 from engine.error_types import ErrorType
 from engine.operations import (
@@ -26,6 +26,10 @@ from engine.operations import (
     OperationKind,
     PortSpec,
     StartResult,
+    duration,
+    flag,
+    number,
+    region,
 )
 from engine.status import RUNNING, Status
 from engine.types import ParamType, Region
@@ -118,58 +122,34 @@ class FeedJob(Job):
         self._last = message
 
 
-def _region_port() -> PortSpec:
-    return PortSpec("region", (ParamType.REGION,), doc="the sphere of space (world frame)")
-
-
-def _common_ports() -> tuple[PortSpec, ...]:
-    return (
-        _region_port(),
-        PortSpec(
-            "camera",
-            (ParamType.TEXT,),
-            default="shoulder",
-            choices=CAMERAS,
-            doc="which camera's depth image looks",
-        ),
-        PortSpec(
-            "min_points",
-            (ParamType.NUMBER,),
-            default=30.0,
-            doc="this many points in the region make it occupied",
-        ),
-        PortSpec(
-            "mask_robot",
-            (ParamType.BOOL,),
-            default=True,
-            doc="leave the robot's own arm and tool out",
-        ),
-    )
-
-
-_MAX_AGE = PortSpec(
-    "max_age",
-    (ParamType.DURATION,),
-    default=1.0,
-    unit="s",
-    doc="answer from a frame up to this old; older: wait for a new one",
+REGION = region("region", doc="the sphere of space (world frame)")
+CAMERA = camera_port("which camera's depth image looks")
+MIN_POINTS = number("min_points", 30.0, doc="this many points in the region make it occupied")
+MASK_ROBOT = flag("mask_robot", True, doc="leave the robot's own arm and tool out")
+COMMON = (REGION, CAMERA, MIN_POINTS, MASK_ROBOT)
+MAX_AGE = duration(
+    "max_age", 1.0, doc="answer from a frame up to this old; older: wait for a new one"
 )
-_TIMEOUT = PortSpec(
-    "timeout", (ParamType.DURATION,), default=10.0, unit="s", doc="fail after this long (cell time)"
-)
-_PERIOD = PortSpec(
-    "period", (ParamType.DURATION,), default=0.1, unit="s", doc="look again this often"
-)
+TIMEOUT = duration("timeout", 10.0, doc="fail after this long (cell time)")
+PERIOD = duration("period", 0.1, doc="look again this often")
 
 
 class _Args:
     """The common ports of a call (typed by the engine)."""
 
     def __init__(self, call: OperationCall) -> None:
-        self.region: Region = call.input("region")
-        self.camera: str = call.input("camera")
-        self.min_points = max(1, round(call.input("min_points")))
-        self.mask_robot: bool = call.input("mask_robot")
+        self.region = call.input(REGION)
+        self.camera = call.input(CAMERA)
+        min_points = call.input(MIN_POINTS)
+        self.min_points = max(1, round(min_points))
+        self.mask_robot = call.input(MASK_ROBOT)
+
+
+class _OccupancyOp:
+    """An operation over the capability's per-cell state (the camera feeds)."""
+
+    def __init__(self, env: CapabilityEnv) -> None:
+        self._state: OccupancyState = env.state
 
 
 def _region_text(region: Region) -> str:
@@ -180,37 +160,17 @@ def _region_text(region: Region) -> str:
     )
 
 
-IS_OCCUPIED = manifest(
-    CAP,
-    "is_occupied",
-    OperationKind.CONDITION,
-    "True when something (not the table, not the robot) is in the region.",
-    *_common_ports(),
-    _MAX_AGE,
-)
-IS_EMPTY = manifest(
-    CAP,
-    "is_empty",
-    OperationKind.CONDITION,
-    "True when nothing (but the table or the robot) is in the region.",
-    *_common_ports(),
-    _MAX_AGE,
-)
+class _RegionCondition(_OccupancyOp):
+    """``is_occupied`` (WANT True) or ``is_empty`` (WANT False)."""
 
-
-class RegionCondition:
-    """``is_occupied`` (want True) or ``is_empty`` (want False)."""
-
-    def __init__(self, state: OccupancyState, want_occupied: bool) -> None:
-        self._state = state
-        self._want = want_occupied
+    WANT: ClassVar[bool]
 
     def start(self, call: OperationCall) -> StartResult:
         args = _Args(call)
-        max_age: float = call.input("max_age")
+        max_age = call.input(MAX_AGE)
         state = self._state
         feed = state.feed(args.camera)
-        want = self._want
+        want = self.WANT
 
         def decide(capture: Capture) -> Verdict:
             reading = state.read(capture, args.region, args.mask_robot)
@@ -221,40 +181,46 @@ class RegionCondition:
         return FeedJob(feed, state.clock, decide, state.clock() - max_age, state.refresh_period)
 
 
-WAIT_UNTIL_OCCUPIED = manifest(
-    CAP,
-    "wait_until_occupied",
-    OperationKind.ACTION,
-    "Waits until something is in the region; fails after the timeout.",
-    *_common_ports(),
-    _TIMEOUT,
-    _PERIOD,
-)
-WAIT_UNTIL_EMPTY = manifest(
-    CAP,
-    "wait_until_empty",
-    OperationKind.ACTION,
-    "Waits until the region is clear; fails after the timeout.",
-    *_common_ports(),
-    _TIMEOUT,
-    _PERIOD,
-)
+class IsOccupied(_RegionCondition):
+    """occupancy.is_occupied."""
+
+    WANT = True
+    MANIFEST = manifest(
+        CAP,
+        "is_occupied",
+        OperationKind.CONDITION,
+        "True when something (not the table, not the robot) is in the region.",
+        *COMMON,
+        MAX_AGE,
+    )
 
 
-class WaitForRegion:
+class IsEmpty(_RegionCondition):
+    """occupancy.is_empty."""
+
+    WANT = False
+    MANIFEST = manifest(
+        CAP,
+        "is_empty",
+        OperationKind.CONDITION,
+        "True when nothing (but the table or the robot) is in the region.",
+        *COMMON,
+        MAX_AGE,
+    )
+
+
+class _WaitForRegion(_OccupancyOp):
     """``wait_until_occupied`` / ``wait_until_empty``: poll frames until it turns so."""
 
-    def __init__(self, state: OccupancyState, want_occupied: bool) -> None:
-        self._state = state
-        self._want = want_occupied
+    WANT: ClassVar[bool]
 
     def start(self, call: OperationCall) -> StartResult:
         args = _Args(call)
-        timeout: float = call.input("timeout")
-        period: float = call.input("period")
+        timeout = call.input(TIMEOUT)
+        period = call.input(PERIOD)
         state = self._state
         feed = state.feed(args.camera)
-        want, now = self._want, state.clock()
+        want, now = self.WANT, state.clock()
         holder: list[FeedJob] = []
 
         def decide(capture: Capture) -> Verdict:
@@ -282,21 +248,47 @@ class WaitForRegion:
         return job
 
 
-COUNT_POINTS = manifest(
-    CAP,
-    "count_points",
-    OperationKind.QUERY,
-    "How many points of a fresh frame are in the region (table and robot left out).",
-    *_common_ports(),
-    PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="the occupant points counted"),
-)
+class WaitUntilOccupied(_WaitForRegion):
+    """occupancy.wait_until_occupied."""
+
+    WANT = True
+    MANIFEST = manifest(
+        CAP,
+        "wait_until_occupied",
+        OperationKind.ACTION,
+        "Waits until something is in the region; fails after the timeout.",
+        *COMMON,
+        TIMEOUT,
+        PERIOD,
+    )
 
 
-class CountPoints:
+class WaitUntilEmpty(_WaitForRegion):
+    """occupancy.wait_until_empty."""
+
+    WANT = False
+    MANIFEST = manifest(
+        CAP,
+        "wait_until_empty",
+        OperationKind.ACTION,
+        "Waits until the region is clear; fails after the timeout.",
+        *COMMON,
+        TIMEOUT,
+        PERIOD,
+    )
+
+
+class CountPoints(_OccupancyOp):
     """``count_points``: a fresh frame's occupant points in the region."""
 
-    def __init__(self, state: OccupancyState) -> None:
-        self._state = state
+    MANIFEST = manifest(
+        CAP,
+        "count_points",
+        OperationKind.QUERY,
+        "How many points of a fresh frame are in the region (table and robot left out).",
+        *COMMON,
+        PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="the occupant points counted"),
+    )
 
     def start(self, call: OperationCall) -> StartResult:
         args = _Args(call)
@@ -327,9 +319,5 @@ def capability() -> Capability:
         settings=SETTINGS,
         setup=setup,
     )
-    cap.add(IS_OCCUPIED, lambda env: RegionCondition(env.state, True))
-    cap.add(IS_EMPTY, lambda env: RegionCondition(env.state, False))
-    cap.add(WAIT_UNTIL_OCCUPIED, lambda env: WaitForRegion(env.state, True))
-    cap.add(WAIT_UNTIL_EMPTY, lambda env: WaitForRegion(env.state, False))
-    cap.add(COUNT_POINTS, lambda env: CountPoints(env.state))
+    cap.add(IsOccupied, IsEmpty, WaitUntilOccupied, WaitUntilEmpty, CountPoints)
     return cap

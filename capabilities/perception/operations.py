@@ -18,7 +18,7 @@ import weakref
 from typing import TYPE_CHECKING, Any
 
 from capabilities.base import Capability, CapabilityEnv
-from capabilities.kit import CAMERAS, camera, manifest, stateful
+from capabilities.kit import camera, camera_port, manifest
 from capabilities.perception.config import SETTINGS, RecognitionConfig
 from capabilities.perception.errors import PerceptionError
 from capabilities.world_model import Detection, WorldModel
@@ -30,6 +30,9 @@ from engine.operations import (
     OperationFailed,
     OperationKind,
     PortSpec,
+    number,
+    object_model,
+    pose,
 )
 from engine.types import ObjectModel, ParamType, Pose
 
@@ -87,6 +90,7 @@ class _Env:
         self.config = RecognitionConfig.from_settings(env.settings)
 
     def camera(self, name: str) -> Any:
+        """The cell's camera ``name``."""
         return camera(self.env, name)
 
     def seen(self, model: Any) -> list[Detection]:
@@ -95,13 +99,35 @@ class _Env:
         return [d for d in self.world.detections(name) if d.source.startswith(SOURCE_PREFIX)]
 
 
-class DetectObjects:
-    def __init__(self, env: _Env) -> None:
-        self._env = env
+CAMERA = camera_port()
+OBJECT = object_model("object", doc="the object class (a model name)")
+
+
+class _PerceptionOp:
+    """An operation over the capability's per-cell state (:class:`_Env`)."""
+
+    def __init__(self, env: CapabilityEnv) -> None:
+        self._env: _Env = env.state
+
+
+class DetectObjects(_PerceptionOp):
+    """perception.detect_objects: one look, recognised on a worker thread."""
+
+    MANIFEST = manifest(
+        CAP,
+        "detect_objects",
+        OperationKind.ACTION,
+        "Looks through a camera and recognises the known objects on the table "
+        "(point cloud matched to the object models).",
+        CAMERA,
+        PortSpec(
+            "count", (ParamType.NUMBER,), Direction.OUT, doc="how many objects were recognised"
+        ),
+    )
 
     def start(self, call: OperationCall) -> Job:
         env = self._env
-        camera = env.camera(call.input("camera"))
+        camera = env.camera(call.input(CAMERA))
         recognizer = env.shared.recognizer(env.library, env.config)
         tracker = env.shared.tracker(env.world, camera.name, env.library)
         source = f"{SOURCE_PREFIX}{camera.name}"
@@ -130,46 +156,82 @@ class DetectObjects:
         return job
 
 
-class ObjectFound:
-    def __init__(self, env: _Env) -> None:
-        self._env = env
+class ObjectFound(_PerceptionOp):
+    """perception.object_found."""
+
+    MANIFEST = manifest(
+        CAP,
+        "object_found",
+        OperationKind.CONDITION,
+        "True when the last look recognised an object of this class.",
+        OBJECT,
+    )
 
     def start(self, call: OperationCall) -> Job:
-        return Job.answer(bool(self._env.seen(call.input("object"))))
+        return Job.answer(bool(self._env.seen(call.input(OBJECT))))
 
 
-class ObjectPose:
-    def __init__(self, env: _Env) -> None:
-        self._env = env
+class ObjectPose(_PerceptionOp):
+    """perception.object_pose: the most confident detection's pose."""
+
+    MANIFEST = manifest(
+        CAP,
+        "object_pose",
+        OperationKind.QUERY,
+        "The pose of the most confidently recognised object of a class.",
+        OBJECT,
+        PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the object is"),
+    )
 
     def start(self, call: OperationCall) -> Job:
-        seen = self._env.seen(call.input("object"))
+        seen = self._env.seen(call.input(OBJECT))
         if not seen:
             raise OperationFailed(
-                f"{_name(call.input('object'))} has not been seen", ErrorType.NOT_FOUND
+                f"{_name(call.input(OBJECT))} has not been seen", ErrorType.NOT_FOUND
             )
         call.write("pose", seen[0].pose)
         return Job.done()
 
 
-class ObjectsOfClass:
-    def __init__(self, env: _Env) -> None:
-        self._env = env
+class ObjectsOfClass(_PerceptionOp):
+    """perception.objects_of_class: how many, and their poses."""
+
+    MANIFEST = manifest(
+        CAP,
+        "objects_of_class",
+        OperationKind.QUERY,
+        "How many objects of a class the last look recognised, and their poses.",
+        OBJECT,
+        PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="how many"),
+        PortSpec("poses", (ParamType.ANY,), Direction.OUT, doc="their poses, most confident first"),
+    )
 
     def start(self, call: OperationCall) -> Job:
-        seen = self._env.seen(call.input("object"))
+        seen = self._env.seen(call.input(OBJECT))
         call.write("count", float(len(seen)))
         call.write("poses", [d.pose for d in seen])
         return Job.done()
 
 
-class PlateType:
-    def __init__(self, env: _Env) -> None:
-        self._env = env
+class PlateType(_PerceptionOp):
+    """perception.plate_type: the plate model nearest a pose."""
+
+    NEAR = pose("near", Pose(), doc="the plate nearest this pose (default: nearest the robot base)")
+    WITHIN = number("within", 2.0, unit="m", doc="fail when the nearest plate is farther than this")
+    MANIFEST = manifest(
+        CAP,
+        "plate_type",
+        OperationKind.QUERY,
+        "Which plate (by its holes) lies nearest to a pose.",
+        NEAR,
+        WITHIN,
+        PortSpec("model", (ParamType.OBJECT,), Direction.OUT, doc="the plate's model"),
+        PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the plate is"),
+    )
 
     def start(self, call: OperationCall) -> Job:
-        near: Pose = call.input("near")
-        within = call.input("within")
+        near = call.input(self.NEAR)
+        within = call.input(self.WITHIN)
         plates = [
             d
             for name in self._env.library.names()
@@ -190,11 +252,8 @@ def _name(model: Any) -> str:
     return model.name if isinstance(model, ObjectModel) else str(model)
 
 
-def _object_port() -> PortSpec:
-    return PortSpec("object", (ParamType.OBJECT,), doc="the object class (a model name)")
-
-
 def capability() -> Capability:
+    """The perception capability; its per-cell state is the interfaces and the recognisers."""
     cap = Capability(
         CAP,
         "Recognises the library's objects on the table in RGB-D point clouds; plate types.",
@@ -202,84 +261,5 @@ def capability() -> Capability:
         settings=SETTINGS,
         setup=lambda env: _Env(env, _Shared()),
     )
-
-    cap.add(
-        manifest(
-            CAP,
-            "detect_objects",
-            OperationKind.ACTION,
-            "Looks through a camera and recognises the known objects on the table "
-            "(point cloud matched to the object models).",
-            PortSpec(
-                "camera",
-                (ParamType.TEXT,),
-                default="shoulder",
-                doc="which camera looks",
-                choices=CAMERAS,
-            ),
-            PortSpec(
-                "count", (ParamType.NUMBER,), Direction.OUT, doc="how many objects were recognised"
-            ),
-        ),
-        stateful(DetectObjects),
-    )
-    cap.add(
-        manifest(
-            CAP,
-            "object_found",
-            OperationKind.CONDITION,
-            "True when the last look recognised an object of this class.",
-            _object_port(),
-        ),
-        stateful(ObjectFound),
-    )
-    cap.add(
-        manifest(
-            CAP,
-            "object_pose",
-            OperationKind.QUERY,
-            "The pose of the most confidently recognised object of a class.",
-            _object_port(),
-            PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the object is"),
-        ),
-        stateful(ObjectPose),
-    )
-    cap.add(
-        manifest(
-            CAP,
-            "objects_of_class",
-            OperationKind.QUERY,
-            "How many objects of a class the last look recognised, and their poses.",
-            _object_port(),
-            PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="how many"),
-            PortSpec(
-                "poses", (ParamType.ANY,), Direction.OUT, doc="their poses, most confident first"
-            ),
-        ),
-        stateful(ObjectsOfClass),
-    )
-    cap.add(
-        manifest(
-            CAP,
-            "plate_type",
-            OperationKind.QUERY,
-            "Which plate (by its holes) lies nearest to a pose.",
-            PortSpec(
-                "near",
-                (ParamType.POSE,),
-                default=Pose(),
-                doc="the plate nearest this pose (default: nearest the robot base)",
-            ),
-            PortSpec(
-                "within",
-                (ParamType.NUMBER,),
-                default=2.0,
-                unit="m",
-                doc="fail when the nearest plate is farther than this",
-            ),
-            PortSpec("model", (ParamType.OBJECT,), Direction.OUT, doc="the plate's model"),
-            PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the plate is"),
-        ),
-        stateful(PlateType),
-    )
+    cap.add(DetectObjects, ObjectFound, ObjectPose, ObjectsOfClass, PlateType)
     return cap

@@ -8,22 +8,26 @@ capabilities); the tool is a box at the arm's TCP pose. Every predicate answers 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from capabilities.base import Capability, CapabilityEnv
-from capabilities.kit import manifest, stateful
+from capabilities.kit import manifest
 from capabilities.predicates.collision import TOOL, PredicateError
 from capabilities.predicates.settings import DIRECTIONS, SETTINGS
 from engine.operations import (
+    InPort,
     Job,
     OperationCall,
     OperationFailed,
     OperationKind,
-    PortSpec,
+    OperationManifest,
     StartResult,
+    duration,
+    number,
+    object_model,
+    text,
 )
-from engine.types import ObjectModel, ParamType, Pose
+from engine.types import ObjectModel, Pose
 
 if TYPE_CHECKING:  # the geometry (numpy) loads with the first cell's setup
     from capabilities.predicates.state import PredicatesState
@@ -50,80 +54,72 @@ def _name(model: Any) -> str:
     return model.name if isinstance(model, ObjectModel) else str(model)
 
 
-def _guarded(fn: Callable[[OperationCall], Job]) -> Callable[[OperationCall], StartResult]:
-    def start(call: OperationCall) -> StartResult:
+class _Predicate:
+    """A predicate over the per-cell state; a PredicateError fails the node with its text."""
+
+    def __init__(self, env: CapabilityEnv) -> None:
+        self._state: PredicatesState = env.state
+
+    def start(self, call: OperationCall) -> StartResult:
         try:
-            return fn(call)
+            return self._start(call)
         except PredicateError as exc:
             raise OperationFailed(str(exc)) from exc
 
-    return start
+    def _start(self, call: OperationCall) -> Job:
+        raise NotImplementedError
 
 
-def _object_port(name: str, doc: str) -> PortSpec:
-    return PortSpec(name, (ParamType.OBJECT,), doc=doc)
-
-
-_PAIR = (
-    _object_port("object_a", "the object the predicate is about"),
-    _object_port("object_b", "the object it is compared with"),
-)
-_ONE = _object_port("object", "the object")
-_FRAME = PortSpec(
+OBJECT_A = object_model("object_a", doc="the object the predicate is about")
+OBJECT_B = object_model("object_b", doc="the object it is compared with")
+OBJECT = object_model("object", doc="the object")
+FRAME = text(
     "frame",
-    (ParamType.TEXT,),
-    default="world",
+    "world",
     choices=FRAMES,
     doc="directions along the world's, the robot base's or object_b's axes",
 )
-_MARGIN = PortSpec(
-    "margin",
-    (ParamType.NUMBER,),
-    default=0.01,
-    unit="m",
-    doc="by more than this (a tie under sensor noise is neither)",
+MARGIN = number(
+    "margin", 0.01, unit="m", doc="by more than this (a tie under sensor noise is neither)"
 )
 
-RELATIONS = {
-    relation: manifest(
+
+def _relation_manifest(relation: str) -> OperationManifest:
+    return manifest(
         CAP,
         relation,
         CONDITION,
         f"True when object_a is {relation.replace('_', ' ')} object_b (centres, "
         "along the frame's axes: front +x, left +y, up +z).",
-        *_PAIR,
-        _FRAME,
-        _MARGIN,
+        OBJECT_A,
+        OBJECT_B,
+        FRAME,
+        MARGIN,
     )
-    for relation in DIRECTIONS
-}
 
 
-class Relation:
+class _Relation(_Predicate):
     """``left_of``, ``right_of``, ``in_front_of``, ``behind``, ``up_from``, ``down_from``."""
 
-    def __init__(self, state: PredicatesState, relation: str) -> None:
-        self._state = state
-        self._relation = relation
-        self.start = _guarded(self._start)
+    RELATION: ClassVar[str]
 
     def _start(self, call: OperationCall) -> Job:
         from capabilities.predicates.geometry import box_center, offset_in_frame
 
         state = self._state
         state.sample()
-        a, b = state.best(call.input("object_a")), state.best(call.input("object_b"))
-        frame_name: str = call.input("frame")
+        a, b = state.best(call.input(OBJECT_A)), state.best(call.input(OBJECT_B))
+        frame_name = call.input(FRAME)
         frame = self._frame(frame_name, b.pose)
-        margin: float = call.input("margin")
+        margin = call.input(MARGIN)
         offset = offset_in_frame(
             box_center(a.pose, state.height(a.object_class)),
             box_center(b.pose, state.height(b.object_class)),
             frame,
         )
-        axis, sign = DIRECTIONS[self._relation]
+        axis, sign = DIRECTIONS[self.RELATION]
         along = sign * float(offset[axis])
-        words = self._relation.replace("_", " ")
+        words = self.RELATION.replace("_", " ")
         return _verdict(
             along > margin,
             f"{a.object_class} is {along * 1000:.0f} mm {words} {b.object_class} "
@@ -140,51 +136,63 @@ class Relation:
         raise PredicateError(f"unknown frame {name!r}; frames: {', '.join(FRAMES)}")
 
 
-_WINDOW = PortSpec(
-    "window",
-    (ParamType.DURATION,),
-    default=0.5,
-    unit="s",
-    doc="judge the detections of this last stretch of time",
-)
-_SPEED = PortSpec(
-    "speed", (ParamType.NUMBER,), default=0.02, unit="m/s", doc="faster than this is moving"
-)
-IS_MOVING = manifest(
-    CAP,
-    "is_moving",
-    CONDITION,
-    "True when the object's detections moved faster than the speed.",
-    _ONE,
-    _WINDOW,
-    _SPEED,
-)
-IS_STATIONARY = manifest(
-    CAP,
-    "is_stationary",
-    CONDITION,
-    "True when the object's detections stayed (slower than the speed); "
-    "false when too few were seen.",
-    _ONE,
-    _WINDOW,
-    _SPEED,
-)
+class LeftOf(_Relation):
+    """predicates.left_of."""
+
+    RELATION = "left_of"
+    MANIFEST = _relation_manifest(RELATION)
 
 
-class Moving:
-    """``is_moving`` (want True) or ``is_stationary`` (want False) over a time window."""
+class RightOf(_Relation):
+    """predicates.right_of."""
 
-    def __init__(self, state: PredicatesState, want_moving: bool) -> None:
-        self._state = state
-        self._want = want_moving
-        self.start = _guarded(self._start)
+    RELATION = "right_of"
+    MANIFEST = _relation_manifest(RELATION)
+
+
+class InFrontOf(_Relation):
+    """predicates.in_front_of."""
+
+    RELATION = "in_front_of"
+    MANIFEST = _relation_manifest(RELATION)
+
+
+class Behind(_Relation):
+    """predicates.behind."""
+
+    RELATION = "behind"
+    MANIFEST = _relation_manifest(RELATION)
+
+
+class UpFrom(_Relation):
+    """predicates.up_from."""
+
+    RELATION = "up_from"
+    MANIFEST = _relation_manifest(RELATION)
+
+
+class DownFrom(_Relation):
+    """predicates.down_from."""
+
+    RELATION = "down_from"
+    MANIFEST = _relation_manifest(RELATION)
+
+
+WINDOW = duration("window", 0.5, doc="judge the detections of this last stretch of time")
+SPEED = number("speed", 0.02, unit="m/s", doc="faster than this is moving")
+
+
+class _Moving(_Predicate):
+    """``is_moving`` (WANT True) or ``is_stationary`` (WANT False) over a time window."""
+
+    WANT: ClassVar[bool]
 
     def _start(self, call: OperationCall) -> Job:
         state = self._state
         state.sample()
-        name = _name(call.input("object"))
-        window: float = call.input("window")
-        threshold: float = call.input("speed")
+        name = _name(call.input(OBJECT))
+        window = call.input(WINDOW)
+        threshold = call.input(SPEED)
         motion = state.track(name).motion(call.clock() - window)
         if motion.samples < 2 or motion.span < window / 4:
             return _verdict(
@@ -196,86 +204,128 @@ class Moving:
             f"{name} moves at {motion.speed * 1000:.0f} mm/s over {motion.samples} "
             f"detections in {motion.span:.2f} s (threshold {threshold * 1000:.0f} mm/s)"
         )
-        return _verdict(moving == self._want, text)
+        return _verdict(moving == self.WANT, text)
 
 
-_TOLERANCE = PortSpec(
-    "tolerance",
-    (ParamType.NUMBER,),
-    default=0.003,
-    unit="m",
-    doc="surfaces this close count as touching",
-)
-_DISTANCE = PortSpec(
-    "distance",
-    (ParamType.NUMBER,),
-    default=0.03,
-    unit="m",
-    doc="surfaces this close are a near collision",
-)
-TOUCHING = manifest(
-    CAP,
-    "touching",
-    CONDITION,
-    "True when the two objects' shapes touch or overlap.",
-    *_PAIR,
-    _TOLERANCE,
-)
-NEAR_COLLISION = manifest(
-    CAP,
-    "near_collision",
-    CONDITION,
-    "True when the two objects' shapes are closer than the distance (touching included).",
-    *_PAIR,
-    _DISTANCE,
-)
-TOOL_TOUCHING = manifest(
-    CAP,
-    "tool_touching",
-    CONDITION,
-    "True when the tool touches or overlaps the object.",
-    _ONE,
-    _TOLERANCE,
-)
-TOOL_NEAR_COLLISION = manifest(
-    CAP,
-    "tool_near_collision",
-    CONDITION,
-    "True when the tool is closer to the object than the distance (touching included).",
-    _ONE,
-    _DISTANCE,
-)
+class IsMoving(_Moving):
+    """predicates.is_moving."""
+
+    WANT = True
+    MANIFEST = manifest(
+        CAP,
+        "is_moving",
+        CONDITION,
+        "True when the object's detections moved faster than the speed.",
+        OBJECT,
+        WINDOW,
+        SPEED,
+    )
 
 
-class Contact:
+class IsStationary(_Moving):
+    """predicates.is_stationary."""
+
+    WANT = False
+    MANIFEST = manifest(
+        CAP,
+        "is_stationary",
+        CONDITION,
+        "True when the object's detections stayed (slower than the speed); "
+        "false when too few were seen.",
+        OBJECT,
+        WINDOW,
+        SPEED,
+    )
+
+
+TOLERANCE = number("tolerance", 0.003, unit="m", doc="surfaces this close count as touching")
+DISTANCE = number("distance", 0.03, unit="m", doc="surfaces this close are a near collision")
+
+
+class _Contact(_Predicate):
     """``touching`` / ``near_collision`` between two objects, or the tool and an object."""
 
-    def __init__(self, state: PredicatesState, port: str, tool: bool) -> None:
-        self._state = state
-        self._port = port  # "tolerance" (touching) or "distance" (near_collision)
-        self._tool = tool
-        self.start = _guarded(self._start)
+    LIMIT: ClassVar[InPort[float]]  # TOLERANCE (touching) or DISTANCE (near_collision)
+    TOOL: ClassVar[bool]
 
     def _start(self, call: OperationCall) -> Job:
         state = self._state
         state.sample()
-        limit: float = call.input(self._port)
-        if self._tool:
-            b = state.best(call.input("object"))
+        limit = call.input(self.LIMIT)
+        if self.TOOL:
+            b = state.best(call.input(OBJECT))
             first, second = (TOOL, state.tool_pose()), (b.object_class, b.pose)
             label = f"the tool and {b.object_class}"
         else:
-            a, b = state.best(call.input("object_a")), state.best(call.input("object_b"))
+            a, b = state.best(call.input(OBJECT_A)), state.best(call.input(OBJECT_B))
             if a is b:
                 raise PredicateError(f"object_a and object_b are both {a.object_class}")
             first, second = (a.object_class, a.pose), (b.object_class, b.pose)
             label = f"{a.object_class} and {b.object_class}"
         gap = state.collision().distance(first, second)
         gap_text = "over 1 m" if math.isinf(gap) else f"{gap * 1000:.1f} mm"
-        word = "touching" if self._port == "tolerance" else "near collision"
+        word = "touching" if self.LIMIT is TOLERANCE else "near collision"
         return _verdict(
             gap <= limit, f"{label}: {gap_text} apart ({word} at {limit * 1000:.1f} mm or less)"
         )
+
+
+class Touching(_Contact):
+    """predicates.touching."""
+
+    LIMIT, TOOL = TOLERANCE, False
+    MANIFEST = manifest(
+        CAP,
+        "touching",
+        CONDITION,
+        "True when the two objects' shapes touch or overlap.",
+        OBJECT_A,
+        OBJECT_B,
+        TOLERANCE,
+    )
+
+
+class NearCollision(_Contact):
+    """predicates.near_collision."""
+
+    LIMIT, TOOL = DISTANCE, False
+    MANIFEST = manifest(
+        CAP,
+        "near_collision",
+        CONDITION,
+        "True when the two objects' shapes are closer than the distance (touching included).",
+        OBJECT_A,
+        OBJECT_B,
+        DISTANCE,
+    )
+
+
+class ToolTouching(_Contact):
+    """predicates.tool_touching."""
+
+    LIMIT, TOOL = TOLERANCE, True
+    MANIFEST = manifest(
+        CAP,
+        "tool_touching",
+        CONDITION,
+        "True when the tool touches or overlaps the object.",
+        OBJECT,
+        TOLERANCE,
+    )
+
+
+class ToolNearCollision(_Contact):
+    """predicates.tool_near_collision."""
+
+    LIMIT, TOOL = DISTANCE, True
+    MANIFEST = manifest(
+        CAP,
+        "tool_near_collision",
+        CONDITION,
+        "True when the tool is closer to the object than the distance (touching included).",
+        OBJECT,
+        DISTANCE,
+    )
 
 
 def setup(env: CapabilityEnv) -> PredicatesState:
@@ -294,12 +344,18 @@ def capability() -> Capability:
         settings=SETTINGS,
         setup=setup,
     )
-    for relation, made in RELATIONS.items():
-        cap.add(made, stateful(Relation, relation))
-    cap.add(IS_MOVING, stateful(Moving, True))
-    cap.add(IS_STATIONARY, stateful(Moving, False))
-    cap.add(TOUCHING, stateful(Contact, "tolerance", False))
-    cap.add(NEAR_COLLISION, stateful(Contact, "distance", False))
-    cap.add(TOOL_TOUCHING, stateful(Contact, "tolerance", True))
-    cap.add(TOOL_NEAR_COLLISION, stateful(Contact, "distance", True))
+    cap.add(
+        LeftOf,
+        RightOf,
+        InFrontOf,
+        Behind,
+        UpFrom,
+        DownFrom,
+        IsMoving,
+        IsStationary,
+        Touching,
+        NearCollision,
+        ToolTouching,
+        ToolNearCollision,
+    )
     return cap

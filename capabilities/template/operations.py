@@ -6,10 +6,14 @@ The one shape of a capability module (copy it):
    and docs; a cell file gives them in its ``capabilities.<CAP>`` block);
 2. a per-cell state class and ``setup(env)`` that makes it (py_trees' ``setup()``): what
    the operations of one cell share, made once per cell from the checked settings;
-3. per operation: ``NAME = manifest(CAP, ...)`` and, right below it, the class whose
-   ``start(call)`` reads typed inputs with ``call.input(port)`` and returns a ``Job``
-   (``Job.done()``, ``Job.failed(why)``, ``Job.answer(flag)``, or a running job);
-4. ``capability()``: the capability with every operation added, ``env.state`` given to each.
+3. its input ports, made with the typed constructors of :mod:`engine.operations`
+   (``text``, ``number``, ``duration``, ``flag``, ``pose``...);
+4. per operation, one class: ``MANIFEST = manifest(CAP, ...)`` listing its ports,
+   ``__init__(env)`` (the registry makes one per leaf; ``env.state`` is what ``setup``
+   made) and ``start(call)``, which reads each input through its port (``call.input(COLOUR)``
+   is a ``str``) and returns a ``Job`` (``Job.done()``, ``Job.failed(why)``,
+   ``Job.answer(flag)``, or a running job);
+5. ``capability()``: the capability with every operation class added.
 """
 
 from __future__ import annotations
@@ -17,10 +21,9 @@ from __future__ import annotations
 from capabilities.base import Capability, CapabilityEnv
 from capabilities.kit import Setting, manifest
 from capabilities.template.backend import INTERFACE, LampBackend
-from engine.operations import Job, OperationCall, OperationKind, PortSpec
-from engine.types import ParamType
+from engine.operations import Job, OperationCall, OperationKind, text
 
-__all__ = ["LAMP_IS_LIT", "SETTINGS", "LampState", "capability", "setup"]
+__all__ = ["COLOUR", "SETTINGS", "LampIsLit", "LampState", "capability", "setup"]
 
 CAP = "template"
 
@@ -35,6 +38,7 @@ class LampState:
         self.inverted = inverted
 
     def is_lit(self, colour: str) -> bool:
+        """Whether the light of ``colour`` is lit (the setting ``inverted`` applied)."""
         return self.backend.is_lit(colour) != self.inverted
 
 
@@ -43,29 +47,25 @@ def setup(env: CapabilityEnv) -> LampState:
     return LampState(env.interface(INTERFACE), env.settings["inverted"])
 
 
-LAMP_IS_LIT = manifest(
-    CAP,
-    "lamp_is_lit",
-    OperationKind.CONDITION,
-    "True when the stack light shows the given colour.",
-    PortSpec(
-        "colour",
-        (ParamType.TEXT,),
-        default="green",
-        doc="which light",
-        choices=("green", "amber", "red"),
-    ),
-)
+COLOUR = text("colour", "green", doc="which light", choices=("green", "amber", "red"))
 
 
 class LampIsLit:
     """template.lamp_is_lit: reads the lamp through the cell's backend and answers at once."""
 
-    def __init__(self, state: LampState) -> None:
-        self._state = state
+    MANIFEST = manifest(
+        CAP,
+        "lamp_is_lit",
+        OperationKind.CONDITION,
+        "True when the stack light shows the given colour.",
+        COLOUR,
+    )
+
+    def __init__(self, env: CapabilityEnv) -> None:
+        self._state: LampState = env.state
 
     def start(self, call: OperationCall) -> Job:
-        return Job.answer(self._state.is_lit(call.input("colour")))
+        return Job.answer(self._state.is_lit(call.input(COLOUR)))
 
 
 def capability() -> Capability:
@@ -73,5 +73,5 @@ def capability() -> Capability:
     cap = Capability(
         CAP, "An example to copy.", requires=(INTERFACE,), settings=SETTINGS, setup=setup
     )
-    cap.add(LAMP_IS_LIT, lambda env: LampIsLit(env.state))
+    cap.add(LampIsLit)
     return cap

@@ -9,51 +9,53 @@ condition, can run on the cell and needs no inputs.
 
 from __future__ import annotations
 
-from capabilities.base import Capability
+from capabilities.base import Capability, CapabilityEnv
 from capabilities.kit import manifest
 from capabilities.timing.until import ConditionRunner, OperationsLookup, WaitUntilJob
-from engine.operations import Job, OperationCall, OperationKind, PortSpec
+from engine.operations import InPort, Job, OperationCall, OperationKind, text
 from engine.types import ParamType
 
-__all__ = ["WAIT_UNTIL", "capability"]
+__all__ = ["CONDITION", "TIMEOUT", "WaitUntil", "capability"]
 
 CAP = "timing"
 
-WAIT_UNTIL = manifest(
-    CAP,
-    "wait_until",
-    OperationKind.ACTION,
-    "Checks a condition every tick; succeeds when it holds, fails when the time is up.",
-    PortSpec(
-        "condition",
-        (ParamType.TEXT,),
-        names_kind=OperationKind.CONDITION,
-        doc="id of a condition operation (e.g. gripper.is_holding); its inputs take their defaults",
-    ),
-    PortSpec(
-        "timeout",
-        (ParamType.DURATION, ParamType.NUMBER),
-        default=10.0,
-        unit="s",
-        doc="how long to wait",
-    ),
+CONDITION = text(
+    "condition",
+    names_kind=OperationKind.CONDITION,
+    doc="id of a condition operation (e.g. gripper.is_holding); its inputs take their defaults",
+)
+TIMEOUT = InPort[float](
+    "timeout",
+    (ParamType.DURATION, ParamType.NUMBER),
+    default=10.0,
+    unit="s",
+    doc="how long to wait",
 )
 
 
 class WaitUntil:
     """timing.wait_until: polls a condition operation of the same registry."""
 
-    def __init__(self, lookup: OperationsLookup) -> None:
-        self._lookup = lookup
+    MANIFEST = manifest(
+        CAP,
+        "wait_until",
+        OperationKind.ACTION,
+        "Checks a condition every tick; succeeds when it holds, fails when the time is up.",
+        CONDITION,
+        TIMEOUT,
+    )
+
+    def __init__(self, env: CapabilityEnv) -> None:
+        self._lookup = OperationsLookup(env)
 
     def start(self, call: OperationCall) -> Job:
-        op_id = call.input("condition").strip()
+        op_id = call.input(CONDITION).strip()
         runner = ConditionRunner(self._lookup.source(), op_id, call)
-        return WaitUntilJob(runner, call.clock, call.input("timeout"))
+        return WaitUntilJob(runner, call.clock, call.input(TIMEOUT))
 
 
 def capability() -> Capability:
     """The timing capability (requires nothing)."""
     cap = Capability(CAP, "Waiting until a condition holds.")
-    cap.add(WAIT_UNTIL, lambda env: WaitUntil(OperationsLookup(env)))
+    cap.add(WaitUntil)
     return cap

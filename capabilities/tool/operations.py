@@ -16,11 +16,7 @@ from capabilities.jobs import chain_jobs, job_from_handle
 from capabilities.kit import manifest
 from capabilities.motion.backend import ARM, ArmBackend
 from capabilities.tool.backend import SuctionBackend
-from engine.operations import (
-    Job,
-    OperationCall,
-    OperationKind,
-)
+from engine.operations import Job, OperationCall, OperationKind
 from engine.types import Pose
 
 __all__ = ["capability", "APPROACH_HEIGHT", "LIFT_HEIGHT"]
@@ -30,29 +26,6 @@ APPROACH_HEIGHT = 0.10  # m above the handle (or holster) where the straight des
 LIFT_HEIGHT = 0.15  # m the tool is lifted straight out of the holster
 _JOINT_SPEED, _JOINT_ACCEL = 1.05, 1.4  # rad/s, rad/s^2
 _LINEAR_SPEED, _LINEAR_ACCEL = 0.15, 1.0  # m/s, m/s^2: gentle near the holster
-
-
-UNHOLSTER = manifest(
-    CAP,
-    "unholster",
-    OperationKind.ACTION,
-    "Takes the suction tool out of its holster with the gripper (nothing to do if held).",
-)
-HOLSTER = manifest(
-    CAP,
-    "holster",
-    OperationKind.ACTION,
-    "Puts the suction tool back in its holster and lets go of it (nothing to do if not held).",
-)
-SUCTION_ON = manifest(
-    CAP, "suction_on", OperationKind.ACTION, "Switches the vacuum on (the tool must be held)."
-)
-SUCTION_OFF = manifest(
-    CAP, "suction_off", OperationKind.ACTION, "Switches the vacuum off, dropping the part."
-)
-HAS_PART = manifest(
-    CAP, "has_part", OperationKind.CONDITION, "True when the vacuum sensor feels a part."
-)
 
 
 def _above(pose: Pose, dz: float) -> Pose:
@@ -72,10 +45,10 @@ def _check(test: Callable[[], bool], problem: str) -> Job:
 class _Scripted:
     """Shared by holster and unholster: the three devices and the move steps."""
 
-    def __init__(self, arm: ArmBackend, gripper: GripperBackend, suction: SuctionBackend) -> None:
-        self.arm = arm
-        self.gripper = gripper
-        self.suction = suction
+    def __init__(self, env: CapabilityEnv) -> None:
+        self.arm: ArmBackend = env.interface(ARM)
+        self.gripper: GripperBackend = env.interface(GRIPPER)
+        self.suction: SuctionBackend = env.interface(SUCTION)
 
     def approach(self, target: Callable[[], Pose]) -> Callable[[], Job]:
         def step() -> Job:
@@ -93,6 +66,13 @@ class _Scripted:
 
 class Unholster(_Scripted):
     """tool.unholster: open, approach above the handle, descend, close, lift out."""
+
+    MANIFEST = manifest(
+        CAP,
+        "unholster",
+        OperationKind.ACTION,
+        "Takes the suction tool out of its holster with the gripper (nothing to do if held).",
+    )
 
     def start(self, call: OperationCall) -> Job:
         if self.suction.in_hand():
@@ -122,6 +102,13 @@ class Unholster(_Scripted):
 class Holster(_Scripted):
     """tool.holster: vacuum off, approach above the holster, lower, open, move clear."""
 
+    MANIFEST = manifest(
+        CAP,
+        "holster",
+        OperationKind.ACTION,
+        "Puts the suction tool back in its holster and lets go of it (nothing to do if not held).",
+    )
+
     def start(self, call: OperationCall) -> Job:
         if not self.suction.in_hand():
             call.log("the suction tool is not in the gripper: nothing to put back")
@@ -147,31 +134,41 @@ class Holster(_Scripted):
         return job_from_handle(self.suction.suction_off())
 
 
-class SuctionOn:
+class _SuctionOp:
+    """An operation on the cell's suction tool."""
+
+    def __init__(self, env: CapabilityEnv) -> None:
+        self._suction: SuctionBackend = env.interface(SUCTION)
+
+
+class SuctionOn(_SuctionOp):
     """tool.suction_on."""
 
-    def __init__(self, suction: SuctionBackend) -> None:
-        self._suction = suction
+    MANIFEST = manifest(
+        CAP, "suction_on", OperationKind.ACTION, "Switches the vacuum on (the tool must be held)."
+    )
 
     def start(self, call: OperationCall) -> Job:
         return job_from_handle(self._suction.suction_on(), "suction on")
 
 
-class SuctionOff:
+class SuctionOff(_SuctionOp):
     """tool.suction_off."""
 
-    def __init__(self, suction: SuctionBackend) -> None:
-        self._suction = suction
+    MANIFEST = manifest(
+        CAP, "suction_off", OperationKind.ACTION, "Switches the vacuum off, dropping the part."
+    )
 
     def start(self, call: OperationCall) -> Job:
         return job_from_handle(self._suction.suction_off(), "suction off")
 
 
-class HasPart:
+class HasPart(_SuctionOp):
     """tool.has_part: the vacuum sensor."""
 
-    def __init__(self, suction: SuctionBackend) -> None:
-        self._suction = suction
+    MANIFEST = manifest(
+        CAP, "has_part", OperationKind.CONDITION, "True when the vacuum sensor feels a part."
+    )
 
     def start(self, call: OperationCall) -> Job:
         return Job.answer(self._suction.has_part())
@@ -184,13 +181,5 @@ def capability() -> Capability:
         "The suction tool: take it from its holster, vacuum on and off, put it back.",
         requires=(ARM, GRIPPER, SUCTION),
     )
-
-    def devices(env: CapabilityEnv) -> tuple[ArmBackend, GripperBackend, SuctionBackend]:
-        return env.interface(ARM), env.interface(GRIPPER), env.interface(SUCTION)
-
-    cap.add(UNHOLSTER, lambda env: Unholster(*devices(env)))
-    cap.add(HOLSTER, lambda env: Holster(*devices(env)))
-    cap.add(SUCTION_ON, lambda env: SuctionOn(env.interface(SUCTION)))
-    cap.add(SUCTION_OFF, lambda env: SuctionOff(env.interface(SUCTION)))
-    cap.add(HAS_PART, lambda env: HasPart(env.interface(SUCTION)))
+    cap.add(Unholster, Holster, SuctionOn, SuctionOff, HasPart)
     return cap

@@ -46,14 +46,16 @@ class Recorded:
         return Job.done()
 
 
-def manifest(op_id: str, cap: str, aliases: tuple[str, ...] = ()) -> OperationManifest:
-    return OperationManifest(op_id, OperationKind.ACTION, "an operation", cap, aliases=aliases)
+def manifest(op_id: str, cap: str, aliases: tuple[str, ...] = ()) -> type[Recorded]:
+    """An operation class of this manifest (the class a capability adds)."""
+    made = OperationManifest(op_id, OperationKind.ACTION, "an operation", cap, aliases=aliases)
+    return type("Recorded", (Recorded,), {"MANIFEST": made})
 
 
 def capability(name: str, *ops: str, requires: tuple[str, ...] = ()) -> Capability:
     cap = Capability(name, f"the {name} capability", requires=requires)
     for op_id in ops:
-        cap.add(manifest(op_id, name), Recorded)
+        cap.add(manifest(op_id, name))
     return cap
 
 
@@ -124,7 +126,7 @@ def test_duplicate_capability_names_are_refused() -> None:
 
 def test_an_operation_registered_twice_is_refused() -> None:
     cap = capability("motion", "motion.a")
-    cap.add(manifest("motion.a", "motion"), Recorded)
+    cap.add(manifest("motion.a", "motion"))
     with pytest.raises(CapabilityError, match=r"'motion\.a' is registered twice"):
         CapabilityRegistry([cap])
 
@@ -132,9 +134,9 @@ def test_an_operation_registered_twice_is_refused() -> None:
 def test_operations_must_belong_to_their_capability() -> None:
     cap = Capability("motion", "moves")
     with pytest.raises(CapabilityError, match="belongs to 'gripper', not 'motion'"):
-        cap.add(manifest("gripper.close", "gripper"), Recorded)
+        cap.add(manifest("gripper.close", "gripper"))
     with pytest.raises(CapabilityError, match=r"must start with 'motion\.'"):
-        cap.add(manifest("move_to", "motion"), Recorded)
+        cap.add(manifest("move_to", "motion"))
 
 
 def test_unknown_operations_raise_operation_not_found() -> None:
@@ -149,7 +151,7 @@ def test_unknown_operations_raise_operation_not_found() -> None:
 
 def test_aliases_resolve_to_the_current_operation() -> None:
     cap = Capability("motion", "moves")
-    cap.add(manifest("motion.move_to", "motion", aliases=("motion.goto", "motion.go")), Recorded)
+    cap.add(manifest("motion.move_to", "motion", aliases=("motion.goto", "motion.go")))
     registry = CapabilityRegistry([cap])
     assert registry.manifest("motion.goto").id == "motion.move_to"
     assert isinstance(registry.create("motion.go"), Recorded)

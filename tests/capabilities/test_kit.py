@@ -8,7 +8,7 @@ from typing import Any
 import pytest
 
 from capabilities.base import CapabilityEnv
-from capabilities.kit import CapabilitySettingsError, Setting, camera, manifest, stateful
+from capabilities.kit import CapabilitySettingsError, Setting, camera, manifest
 from engine.operations import OperationFailed, OperationKind, PortSpec
 from engine.types import ParamType, Pose
 
@@ -32,11 +32,6 @@ def test_manifest_makes_the_id_from_the_capability() -> None:
         (port,),
         ("lamp.lit",),
     )
-
-
-def test_stateful_gives_the_per_cell_state_first() -> None:
-    env = CapabilityEnv(_Cell(), "lamp", state="STATE")
-    assert stateful(lambda state, extra: (state, extra), 7)(env) == ("STATE", 7)
 
 
 def test_camera_finds_the_interface_or_says_which_is_missing() -> None:

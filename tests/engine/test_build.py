@@ -29,7 +29,14 @@ from engine.decorators import (
 )
 from engine.errors import EngineError
 from engine.leaves import OperationLeaf, Wait
-from engine.operations import Direction, Job, OperationKind, OperationManifest, PortSpec
+from engine.operations import (
+    Direction,
+    Job,
+    OperationCall,
+    OperationKind,
+    OperationManifest,
+    PortSpec,
+)
 from engine.spec import NodeKind, ParameterDecl, PlanSpec
 from engine.status import RUNNING, SUCCESS
 from engine.tree import Root, RunPolicy
@@ -129,21 +136,22 @@ def test_clock_and_blackboard_are_passed_in(registry: CapabilityRegistry, clock:
 
 def test_aliases_of_renamed_operations_build(clock: FakeClock) -> None:
     cap = Capability("demo", "a demo")
-    cap.add(
-        OperationManifest("demo.go", OperationKind.ACTION, "go", "demo", aliases=("demo.old_go",)),
-        lambda env: _Const(Job.done()),
-    )
+
+    class Go:
+        MANIFEST = OperationManifest(
+            "demo.go", OperationKind.ACTION, "go", "demo", aliases=("demo.old_go",)
+        )
+
+        def __init__(self, env: CapabilityEnv) -> None:
+            pass
+
+        def start(self, call: OperationCall) -> Job:
+            return Job.done()
+
+    cap.add(Go)
     spec = op("demo.old_go")
     tree = build_tree(plan(spec), CapabilityRegistry([cap]))
     assert tree.tick() is SUCCESS
-
-
-class _Const:
-    def __init__(self, value: Any) -> None:
-        self.value = value
-
-    def start(self, call: Any) -> Any:
-        return self.value
 
 
 # ---------------------------------------------------------------------- errors
@@ -215,10 +223,16 @@ def test_a_leaf_with_children_is_refused(registry: CapabilityRegistry) -> None:
 def test_a_failing_operation_factory_is_a_build_error() -> None:
     cap = Capability("arm", "needs an arm")
 
-    def factory(env: CapabilityEnv) -> Any:
-        return env.interface("arm")  # the null cell has none: CapabilityError
+    class Move:
+        MANIFEST = OperationManifest("arm.move", OperationKind.ACTION, "move", "arm")
 
-    cap.add(OperationManifest("arm.move", OperationKind.ACTION, "move", "arm"), factory)
+        def __init__(self, env: CapabilityEnv) -> None:
+            env.interface("arm")  # the null cell has none: CapabilityError
+
+        def start(self, call: OperationCall) -> Job:
+            return Job.done()
+
+    cap.add(Move)
     with pytest.raises(
         BuildError, match=r"cannot create operation 'arm\.move': CapabilityError: .*no 'arm'"
     ):

@@ -22,12 +22,14 @@ from engine.composites import Parallel, Selector, Sequence
 from engine.errors import EngineError
 from engine.leaves import OperationLeaf, Wait
 from engine.operations import (
+    InPort,
     Job,
     OperationCall,
     OperationFailed,
     OperationKind,
     OperationNotFound,
     PortSpec,
+    number,
 )
 from engine.status import FAILURE, IDLE, RUNNING, SUCCESS, Status
 from engine.types import ParamType, Pose
@@ -391,7 +393,7 @@ def test_a_leaf_in_a_sequence_with_a_job(ctx: Any) -> None:
 # ---------------------------------------------------------------------- typed inputs
 
 _TARGET = PortSpec("target", (ParamType.POSE, ParamType.WAYPOINT))
-_SPEED = PortSpec("speed", (ParamType.NUMBER,), default=0.25, unit="m/s")
+_SPEED = number("speed", 0.25, unit="m/s")
 
 
 def _typed_leaf(ctx: Any, work: Any) -> Any:
@@ -403,7 +405,7 @@ def test_inputs_are_read_typed_and_in_si(ctx: Any) -> None:
     seen: list[Any] = []
 
     def start(call: OperationCall) -> Job:
-        seen.extend([call.input("speed"), call.input("target")])
+        seen.extend([call.input(_SPEED), call.input(InPort[Any]("target", _TARGET.types))])
         return Job.done()
 
     ctx.blackboard.set("CUP_POSE", Pose((0.1, 0.2, 0.3)))
@@ -424,7 +426,7 @@ def test_a_reference_of_the_wrong_type_fails_naming_port_name_and_types(ctx: Any
 
 
 def test_asking_for_an_input_the_manifest_lacks_fails_the_node(ctx: Any) -> None:
-    node = leaf(ctx, FuncOperation(lambda call: call.input("nope")), "act")
+    node = leaf(ctx, FuncOperation(lambda call: call.input(number("nope"))), "act")
     assert node.tick() is FAILURE
     assert node.message == "'act' has no input 'nope'"
 

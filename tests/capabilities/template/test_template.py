@@ -7,13 +7,16 @@ from typing import Any
 
 import pytest
 
-from capabilities.base import CapabilityRegistry, NullCell
-from capabilities.kit import CapabilitySettingsError
+from capabilities.base import CapabilityEnv, CapabilityRegistry, NullCell
+from capabilities.kit import CapabilitySettingsError, manifest
 from capabilities.template import capability
+from capabilities.template.operations import CAP, COLOUR, LampState
 from engine.build import build_tree
+from engine.operations import Job, OperationCall, OperationKind
 from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
 from engine.status import Status
 from engine.types import ParamType
+from engine.validation import validate_plan
 
 
 class LampCell:
@@ -73,3 +76,44 @@ def test_a_wrong_setting_names_the_file_and_key() -> None:
     with pytest.raises(CapabilitySettingsError, match=r"template\.colour: unknown setting"):
         CapabilityRegistry([capability()], cell=LampCell(set()),
                            settings={"template": {"colour": "red"}}, settings_source="x")  # fmt: skip
+
+
+def test_a_new_operation_is_one_class_added_in_its_module() -> None:
+    """CONTRIBUTING.md's "A new operation": the class (manifest, ports, start) and its
+    ``cap.add`` are all it takes; the registry, validation and a built tree know it.
+    """
+
+    class LampIsDark:
+        """template.lamp_is_dark (what a new operation in the module looks like)."""
+
+        MANIFEST = manifest(
+            CAP,
+            "lamp_is_dark",
+            OperationKind.CONDITION,
+            "True when the light of the colour is off.",
+            COLOUR,
+        )
+
+        def __init__(self, env: CapabilityEnv) -> None:
+            self._state: LampState = env.state
+
+        def start(self, call: OperationCall) -> Job:
+            return Job.answer(not self._state.is_lit(call.input(COLOUR)))
+
+    cap = capability()
+    cap.add(LampIsDark)
+    registry = CapabilityRegistry([cap], cell=LampCell({"red"}))
+    assert registry.manifest("template.lamp_is_dark").port("colour") == COLOUR
+    node = NodeSpec(
+        NodeKind.OPERATION,
+        op="template.lamp_is_dark",
+        params={"colour": Binding.fixed("green", ParamType.TEXT)},
+    )
+    assert validate_plan(PlanSpec(node, "dark"), registry) == []
+    assert build_tree(PlanSpec(node, "dark"), registry).tick() is Status.SUCCESS
+    wrong = NodeSpec(
+        NodeKind.OPERATION,
+        op="template.lamp_is_dark",
+        params={"colour": Binding.fixed("blue", ParamType.TEXT)},
+    )
+    assert [p.severity for p in validate_plan(PlanSpec(wrong, "dark"), registry)] == ["error"]

@@ -7,7 +7,7 @@ from typing import Any
 
 import pytest
 
-from capabilities.base import Capability, CapabilityRegistry, NullCell
+from capabilities.base import Capability, CapabilityEnv, CapabilityRegistry, NullCell
 from capabilities.debug import capability as debug
 from capabilities.sim.session import SimCellSession
 from capabilities.sim.testing import down_at
@@ -40,16 +40,17 @@ class ProbeCell:
 
 def _probe() -> Capability:
     cap = Capability("probe", "a flag", requires=("probe",))
-    manifest = OperationManifest("probe.is_set", OperationKind.CONDITION, "the flag", "probe")
 
     class IsSet:
-        def __init__(self, cell: ProbeCell) -> None:
-            self.cell = cell
+        MANIFEST = OperationManifest("probe.is_set", OperationKind.CONDITION, "the flag", "probe")
+
+        def __init__(self, env: CapabilityEnv) -> None:
+            self.cell: ProbeCell = env.interface("probe")
 
         def start(self, call: object) -> Job:
             return Job.answer(self.cell.flag)
 
-    cap.add(manifest, lambda env: IsSet(env.interface("probe")))
+    cap.add(IsSet)
     return cap
 
 

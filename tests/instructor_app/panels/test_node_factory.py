@@ -46,8 +46,14 @@ def test_unavailable_operation_carries_the_reason(registry: CapabilityRegistry) 
 
 def test_a_new_capability_appears_without_gui_changes() -> None:
     cap = Capability("welding", "Welds.")
-    manifest = OperationManifest("welding.weld_seam", OperationKind.ACTION, "Welds.", "welding")
-    cap.add(manifest, lambda env: object())  # type: ignore[arg-type,return-value]  # a stand-in operation factory
+
+    class WeldSeam:  # a stand-in operation: the palette reads only its manifest
+        MANIFEST = OperationManifest("welding.weld_seam", OperationKind.ACTION, "Welds.", "welding")
+
+        def __init__(self, env: object) -> None:
+            pass
+
+    cap.add(WeldSeam)  # type: ignore[arg-type]  # no start(): never run
     items = palette_items(CapabilityRegistry([cap], cell=NullCell()))
     weld = [i for i in items if i.op == "welding.weld_seam"]
     assert len(weld) == 1 and weld[0].group == "welding" and weld[0].label == "Weld seam"
