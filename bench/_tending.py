@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from capabilities.sim.session import SimCellSession
+from capabilities.sim.session import PERCEPTION_S, SimCellSession
 from capabilities.sim.tending_score import TrialCounters
 from capabilities.sim.tending_trial import OperatorModel, TendingTrial
 
@@ -36,7 +36,6 @@ PAPER_PROJECTED = 93  # % the authors projected with better error handling
 RESET_S = 30.0  # simulated seconds the operator takes to reset the cell (see the README)
 SPEED: float | None = None  # as fast as lockstep and LEAD allow
 LEAD = 0.1  # simulated s the world may run ahead of the engine's last tick
-PERCEPTION_S = 0.1  # simulated s a perception job takes in lockstep (a frame and its cloud)
 
 
 @contextmanager

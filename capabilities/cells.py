@@ -82,12 +82,25 @@ def open_cell(
         except ImportError as exc:
             raise CellError(f"the simulated cell cannot load: {exc}") from exc
         try:
-            return SimCellSession(scene or "cup_to_bin", seed, speed)
+            return SimCellSession(scene or "cup_to_bin", seed, speed, lockstep=_lockstep(speed))
         except Exception as exc:  # scene or model errors: say which, do not crash the CLI/GUI
             raise CellError(f"the simulated cell did not start: {exc}") from exc
     raise CellError(
         f"unknown cell {name!r}; cells: {', '.join(CELL_NAMES)}, or a cell file (*.cell.json)"
     )
+
+
+def _lockstep(speed: float | None) -> float | None:
+    """The simulated cell's lockstep: a run as fast as possible (the CLI, tests) charges each
+    perception job a fixed simulated time, so what its plan sees does not depend on how busy
+    the machine is (else the world steps on while perception computes: a loaded machine
+    made kitting miss plates); a paced cell (the GUI) lets the world go on, as a real one.
+    """
+    if speed is not None:
+        return None
+    from capabilities.sim.session import PERCEPTION_S
+
+    return PERCEPTION_S
 
 
 def is_cell_file(name: str) -> bool:
@@ -116,6 +129,8 @@ def _open_cell_file(path: Path, seed: int, scene: str | None, speed: float | Non
     except ImportError as exc:
         raise CellError(f"the simulated cell cannot load: {exc}") from exc
     try:
-        return SimCellSession(scene or "cup_to_bin", seed, speed, config=config)
+        return SimCellSession(
+            scene or "cup_to_bin", seed, speed, config=config, lockstep=_lockstep(speed)
+        )
     except Exception as exc:
         raise CellError(f"{path}: the simulated cell did not start: {exc}") from exc

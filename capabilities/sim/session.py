@@ -50,7 +50,11 @@ from capabilities.sim.worker import SimWorker, install_scene_worker
 from capabilities.world_model import WorldModel
 from engine.types import Pose
 
-__all__ = ["SimCameraDevice", "SimCellSession"]
+__all__ = ["PERCEPTION_S", "SimCameraDevice", "SimCellSession"]
+
+PERCEPTION_S = 0.1
+"""Simulated seconds a perception job (a frame and its cloud) takes in lockstep: what a run
+as fast as possible charges for each look, whatever the machine's load."""
 
 
 class SimCameraDevice:

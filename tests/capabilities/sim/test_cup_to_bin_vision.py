@@ -15,7 +15,7 @@ from capabilities.base import CapabilityRegistry
 from capabilities.gripper import capability as gripper
 from capabilities.motion import capability as motion
 from capabilities.perception import capability as perception
-from capabilities.sim.session import SimCellSession
+from capabilities.sim.session import PERCEPTION_S, SimCellSession
 from capabilities.timing import capability as timing
 from engine.build import build_tree
 from engine.executor import run_to_end
@@ -41,7 +41,7 @@ def _run(session: SimCellSession, timeout: float = 60.0) -> tuple[Status, str]:
 
 @pytest.mark.parametrize("seed", range(20))
 def test_cup_ends_in_the_bin(seed: int) -> None:
-    with SimCellSession("cup_to_bin", seed=seed) as session:
+    with SimCellSession("cup_to_bin", seed=seed, lockstep=PERCEPTION_S) as session:
         status, messages = _run(session)
         assert status is Status.SUCCESS, messages
         session.sim.wait_sim(1.0)  # let the cup settle
