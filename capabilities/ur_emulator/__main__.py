@@ -50,6 +50,7 @@ def run_command(emulator: UREmulator, line: str) -> dict[str, Any]:
         else:
             emulator.protective_stop()
     elif name in (
+        "unlock",
         "emergency_stop",
         "release_emergency_stop",
         "power_off",
@@ -58,21 +59,7 @@ def run_command(emulator: UREmulator, line: str) -> dict[str, Any]:
     ):
         getattr(emulator, name)()
     elif name == "state":
-        snap = ctl.snapshot()
-        return {
-            "ok": True,
-            "robot_mode": snap["robot_mode"],
-            "safety_mode": snap["safety_mode"],
-            "program_running": ctl.program_running(),
-            "q": list(snap["actual_q"]),
-            "digital_outputs": ctl.digital_outputs(),
-            "freedrive": ctl.freedrive_on,
-            "speed_fraction": ctl.speed_fraction,
-            "sim_time": emulator.cell.time(),
-            "gripper_closed": emulator.cell.gripper.is_closed(),
-            "moving": ctl.arm_moving(),
-            "messages": ctl.messages[-5:],
-        }
+        return _state(emulator)
     elif name == "input":  # input BANK INDEX 0|1: a digital input (a foot pedal)
         shift = {"standard": 0, "configurable": 8, "tool": 16}[args[0]]
         ctl.set_digital_input(shift + int(args[1]), args[2] == "1")
@@ -86,6 +73,27 @@ def run_command(emulator: UREmulator, line: str) -> dict[str, Any]:
     elif name != "quit":
         return {"ok": False, "error": f"unknown command {name!r}"}
     return {"ok": True}
+
+
+def _state(emulator: UREmulator) -> dict[str, Any]:
+    """The answer to "state": the controller's modes, program, joints, I/O and popup."""
+    ctl = emulator.ctl
+    snap = ctl.snapshot()
+    return {
+        "ok": True,
+        "robot_mode": snap["robot_mode"],
+        "safety_mode": snap["safety_mode"],
+        "program_running": ctl.program_running(),
+        "q": list(snap["actual_q"]),
+        "digital_outputs": ctl.digital_outputs(),
+        "freedrive": ctl.freedrive_on,
+        "speed_fraction": ctl.speed_fraction,
+        "sim_time": emulator.cell.time(),
+        "gripper_closed": emulator.cell.gripper.is_closed(),
+        "moving": ctl.arm_moving(),
+        "messages": ctl.messages[-5:],
+        "popup": ctl.popup,
+    }
 
 
 def _serve_stdin(emulator: UREmulator, done: threading.Event) -> None:

@@ -141,6 +141,14 @@ class EmulatorProcess(ClosesOnExit):
         arg = " on_contact" if on_contact else (f" at={at}" if at is not None else "")
         self.command("protective_stop" + arg)
 
+    def unlock(self) -> None:
+        """Unlock a protective stop (the operator on the pendant; the dashboard's command).
+
+        Raises:
+            EmulatorError: refused: earlier than the unlock delay after the stop.
+        """
+        self.command("unlock")
+
     def emergency_stop(self) -> None:
         self.command("emergency_stop")
 
