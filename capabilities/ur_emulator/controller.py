@@ -434,6 +434,7 @@ class EmulatedController:
             self.cell.robot.unlock_protective_stop(delay=0.0)
             self.safety_mode = SafetyMode.NORMAL
             self.popup = ""
+            self._publish()
             return "Protective stop releasing"
 
     def _halt(self, reason: str) -> None:
