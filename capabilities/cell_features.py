@@ -46,6 +46,10 @@ class CellStatus:
         problem: why the robot cannot move ("" when it can).
         clear_action: the label of the operator's clear of that problem from here ("" when
             there is none now: it is cleared on the pendant, or not yet allowed).
+        clear_wait: whole seconds before that clear is allowed (0: now); a UR refuses to
+            unlock a protective stop in the first 5 s after it, so the button counts down.
+        hint: how the operator clears the problem, in words ("clear it on the pendant or
+            press Unlock protective stop"; "" when nothing is to be said).
     """
 
     connected: bool
@@ -54,6 +58,8 @@ class CellStatus:
     program: str
     problem: str
     clear_action: str = ""
+    clear_wait: int = 0
+    hint: str = ""
 
 
 @runtime_checkable

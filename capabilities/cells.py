@@ -16,9 +16,10 @@ from capabilities.cell_features import ClosableCell, ClosesOnExit
 from capabilities.collaboration.console import OperatorConsole
 from capabilities.errors import CapabilityError
 
-__all__ = ["CELL_NAMES", "CellError", "ManagedCell", "is_cell_file", "open_cell"]
+__all__ = ["CELL_NAMES", "DEFAULT_SCENE", "CellError", "ManagedCell", "is_cell_file", "open_cell"]
 
 CELL_NAMES: tuple[str, ...] = ("none", "sim")
+DEFAULT_SCENE = "cup_to_bin"  # the simulated cell's scene when none is named
 
 
 class CellError(CapabilityError):
@@ -82,7 +83,7 @@ def open_cell(
         except ImportError as exc:
             raise CellError(f"the simulated cell cannot load: {exc}") from exc
         try:
-            return SimCellSession(scene or "cup_to_bin", seed, speed, lockstep=_lockstep(speed))
+            return SimCellSession(scene or DEFAULT_SCENE, seed, speed, lockstep=_lockstep(speed))
         except Exception as exc:  # scene or model errors: say which, do not crash the CLI/GUI
             raise CellError(f"the simulated cell did not start: {exc}") from exc
     raise CellError(
@@ -130,7 +131,7 @@ def _open_cell_file(path: Path, seed: int, scene: str | None, speed: float | Non
         raise CellError(f"the simulated cell cannot load: {exc}") from exc
     try:
         return SimCellSession(
-            scene or "cup_to_bin", seed, speed, config=config, lockstep=_lockstep(speed)
+            scene or DEFAULT_SCENE, seed, speed, config=config, lockstep=_lockstep(speed)
         )
     except Exception as exc:
         raise CellError(f"{path}: the simulated cell did not start: {exc}") from exc

@@ -45,11 +45,21 @@ class HoldWatch:
             self._since = None
         self.reason = event.reason
         text = (
-            f"held: {event.reason} (the run goes on once the robot is ready; Ctrl-C stops it)"
+            f"held: {event.reason}{self._controller_says(event.reason)} (the run goes on once "
+            f"the robot is ready; gives up after {self._timeout:g} s; Ctrl-C stops it)"
             if event.reason
             else "the robot is ready: the run goes on"
         )
         print(f"tick {event.tick:>5}  {text}", file=self._out, flush=True)
+
+    def _controller_says(self, reason: str) -> str:
+        """What the robot's controller reports with the hold: its safety mode and how the
+        operator clears it ("; safety mode PROTECTIVE_STOP, clear it on the pendant ...").
+        """
+        robot = self._cell.status() if isinstance(self._cell, ReportsStatus) else None
+        if robot is None or not robot.connected or robot.problem != reason:
+            return ""
+        return f"; safety mode {robot.safety_mode}" + (f", {robot.hint}" if robot.hint else "")
 
     def expired(self) -> bool:
         """True once the hold under way has lasted longer than the timeout."""

@@ -289,6 +289,7 @@ class MainWindow(QMainWindow):
         controller.blackboard_written.connect(views.blackboard.set_value)
         controller.log_message.connect(views.log.append)
         controller.running_nodes_changed.connect(self.running_panel.set_nodes)
+        controller.hold_changed.connect(self.running_panel.set_held)
         controller.failure_changed.connect(self.failure_button.show_failure)
         controller.run_state_changed.connect(self.cells.follow_run_state)
         controller.run_state_changed.connect(

@@ -21,8 +21,10 @@ goes on from the node that was running.
 from __future__ import annotations
 
 import logging
+import math
 import time
 from collections.abc import Mapping
+from concurrent.futures import Future
 from typing import Any
 
 from capabilities.camera_source import CameraSource
@@ -30,13 +32,14 @@ from capabilities.camera_sources import open_source
 from capabilities.cell_features import CellStatus, ClosesOnExit
 from capabilities.collaboration.console import OperatorConsole
 from capabilities.collaboration.inputs import DigitalInputButton
-from capabilities.faults import CONNECTION_LOST
+from capabilities.faults import CONNECTION_LOST, PROTECTIVE_STOP
 from capabilities.jobs import WorkerPool
 from capabilities.object_library import ObjectLibrary
 from capabilities.robot.cell_file import CellConfig
-from capabilities.robot.cell_robot import TCP_OF_TOOL
+from capabilities.robot.cell_robot import TCP_OF_TOOL, UNLOCK_DELAY
 from capabilities.ur.arm import URArm
 from capabilities.ur.connection import NO_SCRIPT, URConnection, fault_reason
+from capabilities.ur.errors import ur_words
 from capabilities.ur.frames import URFrames
 from capabilities.ur.modes import RobotMode, SafetyMode
 from capabilities.ur.robotiq import RobotiqGripper
@@ -65,6 +68,9 @@ WATCHDOG_STOP = (
     "the control script is started again"
 )
 RESTART_SCRIPT = "Restart control script"  # the status bar's clear of a stopped script
+UNLOCK_STOP = "Unlock protective stop"  # the status bar's clear of a protective stop
+# A UR refuses to unlock a protective stop earlier than this after it (PolyScope's rule).
+STOP_UNLOCK_DELAY = UNLOCK_DELAY
 
 
 class URCellSession(ClosesOnExit):
@@ -177,11 +183,17 @@ class URCellSession(ClosesOnExit):
         return reason
 
     def clear(self) -> None:
-        """The operator's clear of a control script that ended on its own (stopped on the
-        pendant, a script error): upload it again. Returns at once (the I/O thread does it);
-        the hold lifts when the script runs.
+        """The operator's clear of what the status names: unlock a protective stop (through
+        the dashboard, as the pendant's Unlock does; the control script is uploaded again),
+        or upload again a control script that ended on its own (stopped on the pendant, a
+        script error). Returns at once (the I/O thread does it); the hold lifts when the
+        script runs. A refused unlock (too early) goes to the log; the stop stays shown.
         """
-        self.connection.submit(self.connection.start_control)
+        if self.connection.fault() == PROTECTIVE_STOP:
+            future = self.connection.submit(self.connection.clear_protective_stop)
+        else:
+            future = self.connection.submit(self.connection.start_control)
+        future.add_done_callback(_log_refusal)
 
     def clear_protective_stop(self) -> None:
         """Unlock a protective stop through the dashboard and upload the control script
@@ -197,13 +209,25 @@ class URCellSession(ClosesOnExit):
         state, fault = self.connection.state, self.connection.fault()
         if not state.connected or fault.startswith(CONNECTION_LOST):
             return CellStatus(False, "DISCONNECTED", "-", "-", fault + _last_heard(self.connection))
+        action, wait, hint = "", 0, ""
+        if fault == NO_SCRIPT:
+            action = RESTART_SCRIPT
+            hint = f"start it on the pendant or press {RESTART_SCRIPT}"
+        elif fault == PROTECTIVE_STOP:
+            action = UNLOCK_STOP
+            since = self._recovery.stopped_at
+            left = STOP_UNLOCK_DELAY - (time.monotonic() - since if since is not None else 0.0)
+            wait = max(0, math.ceil(left))
+            hint = f"clear it on the pendant or press {UNLOCK_STOP}"
         return CellStatus(
             True,
             RobotMode(state.robot_mode).name,
             SafetyMode(state.safety_mode).name,
             "PLAYING" if state.program_running else "STOPPED",
             fault,
-            RESTART_SCRIPT if fault == NO_SCRIPT else "",
+            action,
+            wait,
+            hint,
         )
 
     # ---------------------------------------------------------------- lifetime
@@ -213,6 +237,13 @@ class URCellSession(ClosesOnExit):
             button.stop()
         self.connection.close()
         self.workers.close()
+
+
+def _log_refusal(future: Future[None]) -> None:
+    """The operator's clear failed (a refused unlock): say so in the log."""
+    exc = future.exception()
+    if exc is not None:
+        _log.warning("UR: the operator's clear failed: %s", ur_words(exc))
 
 
 def _last_heard(connection: URConnection) -> str:
@@ -244,6 +275,7 @@ class _Recovery:
         self._lost_since: float | None = None
         self._well_since: float | None = None  # the robot can move, the watchdog unarmed
         self.clearing = ""  # the stop or power loss being cleared ("" when none)
+        self.stopped_at: float | None = None  # when the protective stop under way was seen
 
     def __call__(self, conn: URConnection) -> bool:
         now = time.monotonic()
@@ -253,6 +285,7 @@ class _Recovery:
         elif self._lost_since is None:
             self._lost_since = now
         problem = fault_reason(state)
+        self._time_stop(problem, now)
         if problem and problem != NO_SCRIPT:
             self.clearing = problem
         elif not problem:
@@ -282,6 +315,13 @@ class _Recovery:
         except Exception as exc:  # the controller is not back yet: try again later
             _log.debug("UR recovery: %s", exc)
         return False
+
+    def _time_stop(self, problem: str, now: float) -> None:
+        """Note when a protective stop was first seen (the unlock's delay counts from it)."""
+        if problem != PROTECTIVE_STOP:
+            self.stopped_at = None
+        elif self.stopped_at is None:
+            self.stopped_at = now
 
     def _rearm_watchdog(self, conn: URConnection, now: float, problem: str) -> None:
         """A connection that came back by ur_rtde's own reconnect, with its script running

@@ -21,6 +21,7 @@ from capabilities.cell_features import ClosesOnExit
 from capabilities.sim.cell import SimCell
 from capabilities.stream_camera import FRAME_PORT, serve_frames
 from capabilities.ur_emulator.controller import VERSIONS, EmulatedController
+from capabilities.ur_emulator.errors import EmulatorError
 from capabilities.ur_emulator.robotiq import ROBOTIQ_PORT, robotiq_client
 from capabilities.ur_emulator.servers import (
     Server,
@@ -130,6 +131,16 @@ class UREmulator(ClosesOnExit):
             self.ctl.faults.stop_at(at)
         else:
             self.ctl.protective_stop("injected")
+
+    def unlock(self) -> None:
+        """The operator unlocks a protective stop on the pendant (the dashboard's command).
+
+        Raises:
+            EmulatorError: refused: earlier than the unlock delay after the stop.
+        """
+        reply = self.ctl.unlock_protective_stop()
+        if reply.startswith("Cannot"):
+            raise EmulatorError(reply)
 
     def emergency_stop(self) -> None:
         self.ctl.emergency_stop()

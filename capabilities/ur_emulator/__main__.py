@@ -1,8 +1,11 @@
 """``costar ur-emulator`` (or ``python -m capabilities.ur_emulator``): run the emulator.
 
-``--scene NAME --seed N`` loads a scene of the simulated cell around the emulated arm;
-``--write-cell FILE`` writes a cell file whose robot is this emulator, so that
-``costar run PLAN --cell FILE`` takes the real-robot path without a robot.
+``--scene NAME --seed N`` loads a scene of the simulated cell around the emulated arm (the
+simulated cell's default, cup_to_bin, unless named; ``--scene none``: the arm alone, no
+cameras); ``--write-cell FILE`` writes a cell file whose robot is this emulator, so that
+``costar run PLAN --cell FILE`` takes the real-robot path without a robot. Its cameras are
+the frame streams the emulator serves (with ``--scene none`` they keep the source "sim",
+which a UR cell has not: a plan that looks is refused by validation).
 
 With ``--control stdin`` it reads fault commands from standard input, one a line, and answers
 each with one JSON line (see :mod:`capabilities.ur_emulator.process`, which drives it so).
@@ -21,12 +24,15 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+from capabilities.cells import DEFAULT_SCENE
 from capabilities.stream_camera import FRAME_PORT
 from capabilities.ur_emulator import VERSIONS, UREmulator
 from capabilities.ur_emulator.errors import EmulatorError
 from capabilities.ur_emulator.servers import check_loopback
 
-__all__ = ["main", "run_command"]
+__all__ = ["NO_SCENE", "main", "run_command"]
+
+NO_SCENE = "none"  # --scene none: the arm alone (no objects, no cameras)
 
 
 def run_command(emulator: UREmulator, line: str) -> dict[str, Any]:
@@ -44,6 +50,7 @@ def run_command(emulator: UREmulator, line: str) -> dict[str, Any]:
         else:
             emulator.protective_stop()
     elif name in (
+        "unlock",
         "emergency_stop",
         "release_emergency_stop",
         "power_off",
@@ -52,21 +59,7 @@ def run_command(emulator: UREmulator, line: str) -> dict[str, Any]:
     ):
         getattr(emulator, name)()
     elif name == "state":
-        snap = ctl.snapshot()
-        return {
-            "ok": True,
-            "robot_mode": snap["robot_mode"],
-            "safety_mode": snap["safety_mode"],
-            "program_running": ctl.program_running(),
-            "q": list(snap["actual_q"]),
-            "digital_outputs": ctl.digital_outputs(),
-            "freedrive": ctl.freedrive_on,
-            "speed_fraction": ctl.speed_fraction,
-            "sim_time": emulator.cell.time(),
-            "gripper_closed": emulator.cell.gripper.is_closed(),
-            "moving": ctl.arm_moving(),
-            "messages": ctl.messages[-5:],
-        }
+        return _state(emulator)
     elif name == "input":  # input BANK INDEX 0|1: a digital input (a foot pedal)
         shift = {"standard": 0, "configurable": 8, "tool": 16}[args[0]]
         ctl.set_digital_input(shift + int(args[1]), args[2] == "1")
@@ -80,6 +73,27 @@ def run_command(emulator: UREmulator, line: str) -> dict[str, Any]:
     elif name != "quit":
         return {"ok": False, "error": f"unknown command {name!r}"}
     return {"ok": True}
+
+
+def _state(emulator: UREmulator) -> dict[str, Any]:
+    """The answer to "state": the controller's modes, program, joints, I/O and popup."""
+    ctl = emulator.ctl
+    snap = ctl.snapshot()
+    return {
+        "ok": True,
+        "robot_mode": snap["robot_mode"],
+        "safety_mode": snap["safety_mode"],
+        "program_running": ctl.program_running(),
+        "q": list(snap["actual_q"]),
+        "digital_outputs": ctl.digital_outputs(),
+        "freedrive": ctl.freedrive_on,
+        "speed_fraction": ctl.speed_fraction,
+        "sim_time": emulator.cell.time(),
+        "gripper_closed": emulator.cell.gripper.is_closed(),
+        "moving": ctl.arm_moving(),
+        "messages": ctl.messages[-5:],
+        "popup": ctl.popup,
+    }
 
 
 def _serve_stdin(emulator: UREmulator, done: threading.Event) -> None:
@@ -114,7 +128,8 @@ def write_cell_file(
     path: str | Path, host: str, version: str, config: Any, cameras: bool = False
 ) -> None:
     """Write a cell file (atomically) whose robot is the emulator at ``host``; with
-    ``cameras``, its cameras are the emulator's frame streams.
+    ``cameras``, its cameras are the emulator's frame streams (else their source stays
+    "sim", which a UR cell leaves out).
 
     Raises:
         EmulatorError: the file cannot be written.
@@ -140,7 +155,7 @@ def write_cell_file(
 
 def _emulator(args: argparse.Namespace, stack: contextlib.ExitStack) -> UREmulator:
     """The emulator the arguments ask for; a scene's session is closed by ``stack``."""
-    if args.scene is None:
+    if args.scene == NO_SCENE:
         return UREmulator(args.host, args.version, speed=args.speed, unlock_delay=args.unlock_delay)
     from capabilities.sim.session import SimCellSession
 
@@ -186,7 +201,12 @@ def main(argv: list[str] | None = None, prog: str = "python -m capabilities.ur_e
         action="store_true",
         help="a protective stop when the arm touches something",
     )
-    parser.add_argument("--scene", help="a scene of the simulated cell around the arm")
+    parser.add_argument(
+        "--scene",
+        default=DEFAULT_SCENE,
+        help=f"a scene of the simulated cell around the arm (default {DEFAULT_SCENE}, as the "
+        f"simulated cell's; {NO_SCENE}: the arm alone, without cameras)",
+    )
     parser.add_argument("--seed", type=int, default=0, help="scene seed (default 0)")
     parser.add_argument(
         "--write-cell", metavar="FILE", help="write a cell file whose robot is this emulator"
@@ -209,7 +229,7 @@ def main(argv: list[str] | None = None, prog: str = "python -m capabilities.ur_e
                     args.host,
                     args.version,
                     emulator.cell.config,
-                    cameras=args.scene is not None,
+                    cameras=args.scene != NO_SCENE,
                 )
             _serve(emulator, args, done)
     except EmulatorError as exc:

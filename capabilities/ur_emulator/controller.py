@@ -53,6 +53,8 @@ _SAFETY_BIT = {
     SafetyMode.FAULT: 9,
 }
 _EMERGENCY = (SafetyMode.ROBOT_EMERGENCY_STOP, SafetyMode.SYSTEM_EMERGENCY_STOP)
+BLOCKED = "blocked"  # how the simulated arm's move that could not reach its target ends
+DEVIATES = "position deviates from path"  # PolyScope's popup for a blocked move
 
 
 class EmulatedController:
@@ -89,6 +91,7 @@ class EmulatedController:
         self.teach_button = False
         self.speed_fraction = 1.0
         self.messages: list[str] = []
+        self.popup = ""  # the safety popup shown on the pendant ("" when none)
         self._started = time.monotonic()
         self._base = pose_to_matrix(cell.config.robot_base)
         self._base_inv = np.linalg.inv(self._base)
@@ -344,10 +347,16 @@ class EmulatedController:
 
         def finished(h: CommandHandle) -> None:
             collided = self.cell.robot.protective_stop() is not None
-            if not h.ok and not h.cancel_requested and not collided:
-                threading.Thread(
-                    target=self.end_program, args=(f"script error: {h.message}",), daemon=True
-                ).start()
+            if h.ok or h.cancel_requested or collided:
+                return
+            if h.message.startswith(BLOCKED):
+                # Held back short of its target: a UR's joints then deviate from the path it
+                # planned, and its safety system makes a protective stop of it (a script
+                # error would leave the arm pressing on whatever holds it).
+                fault, why = self.protective_stop, f"{DEVIATES} ({h.message})"
+            else:
+                fault, why = self.end_program, f"script error: {h.message}"
+            threading.Thread(target=fault, args=(why,), daemon=True).start()
 
         handle.add_done_callback(finished)
         return handle
@@ -370,6 +379,10 @@ class EmulatedController:
             if self.safety_mode == SafetyMode.PROTECTIVE_STOP:
                 return
             self._halt(f"protective stop: {reason}")
+            # PolyScope's safety popup and log line; the dashboard's safetystatus says
+            # PROTECTIVE_STOP until it is unlocked.
+            self.popup = f"Protective stop: {reason}"
+            self.text(self.popup)
             self.safety_mode = SafetyMode.PROTECTIVE_STOP
             self._stopped_at = time.monotonic()
             self._publish()
@@ -420,6 +433,8 @@ class EmulatedController:
             # The simulated arm's own stop (a collision) goes with it: this delay is the rule.
             self.cell.robot.unlock_protective_stop(delay=0.0)
             self.safety_mode = SafetyMode.NORMAL
+            self.popup = ""
+            self._publish()
             return "Protective stop releasing"
 
     def _halt(self, reason: str) -> None:

@@ -34,7 +34,8 @@ class EmulatorProcess(ClosesOnExit):
         speed: real-time factor of the simulated cell.
         unlock_delay: seconds before a protective stop can be unlocked.
         timeout: seconds to wait for the child to start and for each answer.
-        scene: a scene of the simulated cell around the arm (None: the arm alone).
+        scene: a scene of the simulated cell around the arm (None: the arm alone, which
+            the command line calls ``--scene none``).
         seed: the scene's seed.
         write_cell: write a cell file whose robot is this emulator.
     """
@@ -57,8 +58,7 @@ class EmulatorProcess(ClosesOnExit):
             "--version", version, "--speed", str(speed), "--unlock-delay", str(unlock_delay),
             "--control", "stdin",
         ]  # fmt: skip  # a command line: each flag beside its value
-        if scene is not None:
-            self._args += ["--scene", scene, "--seed", str(seed)]
+        self._args += ["--scene", scene or "none", "--seed", str(seed)]
         if write_cell is not None:
             self._args += ["--write-cell", str(write_cell)]
         self._timeout = timeout
@@ -140,6 +140,14 @@ class EmulatorProcess(ClosesOnExit):
     def protective_stop(self, at: float | None = None, on_contact: bool = False) -> None:
         arg = " on_contact" if on_contact else (f" at={at}" if at is not None else "")
         self.command("protective_stop" + arg)
+
+    def unlock(self) -> None:
+        """Unlock a protective stop (the operator on the pendant; the dashboard's command).
+
+        Raises:
+            EmulatorError: refused: earlier than the unlock delay after the stop.
+        """
+        self.command("unlock")
 
     def emergency_stop(self) -> None:
         self.command("emergency_stop")

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 from PySide6.QtCore import QObject, QTimer, Signal
 
+from capabilities.cell_features import ReportsStatus
 from capabilities.faults import hold_check
 from engine.blackboard import Blackboard, BlackboardError
 from engine.build import BuildError, build_tree
@@ -21,7 +22,7 @@ from engine.error_types import ErrorType
 from engine.events import RunFinished
 from engine.executor import Executor, ExecutorState
 from engine.spec import PlanSpec
-from engine.status import Status
+from engine.status import RUNNING, Status
 from engine.tree import BehaviorTree
 from engine.validation import ERROR, Problem, has_errors, validate_plan
 from instructor_app.document.editing import PlanDocument
@@ -71,6 +72,9 @@ class RunController(QObject):
         run_refused(list): the validation problems (or a build error) that kept it from starting.
         failure_changed(str, str): the deepest failing node and its message ("" "": none).
         failures_described(object): node id -> "error type: message" of the nodes that failed.
+        hold_changed(str, str): the cell held the run (why, and what to show: "held: protective
+            stop, clear it on the pendant or press Unlock protective stop") or let it go on
+            ("" ""). The nodes that were running stay shown RUNNING while it is held.
         inner_statuses_changed(object): runtime id ("instance/inner") -> Status inside subtree
             instances; None when a new run starts.
     """
@@ -87,6 +91,7 @@ class RunController(QObject):
     inner_statuses_changed = Signal(object)
     failure_changed = Signal(str, str)
     failures_described = Signal(object)
+    hold_changed = Signal(str, str)
 
     def __init__(
         self,
@@ -114,6 +119,8 @@ class RunController(QObject):
         self._running: list[str] = []
         self._failure: tuple[str, str] = ("", "")
         self._stopping = False  # a stop was asked: the halt's IDLE resets are not shown
+        self._held = ""  # why the cell holds the run ("" when it does not)
+        self._idled: set[str] = set()  # nodes that went RUNNING -> IDLE at the last drain
 
     # ------------------------------------------------------------------ state
 
@@ -125,6 +132,11 @@ class RunController(QObject):
     def is_running(self) -> bool:
         """True from start until the RunFinished event was handled (paused counts)."""
         return self._state in (ExecutorState.RUNNING, ExecutorState.PAUSED)
+
+    @property
+    def held(self) -> str:
+        """Why the cell holds the run now ("" when it does not)."""
+        return self._held
 
     @property
     def statuses(self) -> dict[str, Status]:
@@ -277,6 +289,7 @@ class RunController(QObject):
         self._pump.drain()  # leftovers of an earlier run must not colour this one
         self._statuses, self._messages, self._running = {}, {}, []
         self._stopping = False
+        self._held, self._idled = "", set()
         self._set_failure("", "")
         self._statuses.update({node_id: Status.IDLE for node_id in self._order})
         self.inner_statuses_changed.emit(None)
@@ -292,6 +305,7 @@ class RunController(QObject):
             for k, v in batch.statuses.items()
             if k in self._order and not (self._stopping and v is Status.IDLE)
         }
+        self._keep_held_nodes(changed, batch)
         self._statuses.update(changed)
         inside = {k: v for k, v in batch.statuses.items() if "/" in k}  # inside instances
         if inside:
@@ -308,12 +322,42 @@ class RunController(QObject):
         if batch.finished is not None:
             self._finish(batch.finished)
 
+    def _keep_held_nodes(self, changed: dict[str, Status], batch: Batch) -> None:
+        """A hold halts the running leaves (the engine resets them to IDLE) but the run is not
+        over: they go on once the cell is clear, so they stay shown RUNNING (amber) while it
+        is held. Their resets may have come with the drain before the hold's event.
+        """
+        holding = any(batch.holds)
+        idled = {k for k in batch.idled if changed.get(k) is Status.IDLE}
+        if holding or self._held:
+            changed.update(dict.fromkeys(idled, RUNNING))
+            if holding and not self._held:
+                changed.update(
+                    {k: RUNNING for k in self._idled if self._statuses.get(k) is Status.IDLE}
+                )
+            idled = set()
+        self._idled = idled
+
+    def _hold_text(self, reason: str) -> str:
+        """What the Instructor says of a hold: why, and how the operator clears it."""
+        cell = self.session.cell
+        status = cell.status() if isinstance(cell, ReportsStatus) else None
+        hint = status.hint if status is not None and status.problem == reason else ""
+        return f"held: {reason}" + (f", {hint}" if hint else "")
+
     def _emit_logs(self, batch: Batch) -> None:
         for reason in batch.holds:
             if reason:
-                self.log_message.emit(f"The robot stopped the run: {reason}", "error")
+                text = self._hold_text(reason)
+                self.log_message.emit(
+                    f"The run is {text} (it goes on once the robot is ready)", "warning"
+                )
             else:
+                text = ""
                 self.log_message.emit("The robot is ready again: the run goes on", "info")
+            if reason != self._held:
+                self._held = reason
+                self.hold_changed.emit(reason, text)
         for node_id, message in batch.logs:
             self.log_message.emit(f"{self._label(node_id)}: {message}", "info")
         described: dict[str, str] = {}
@@ -357,6 +401,9 @@ class RunController(QObject):
     def _finish(self, event: RunFinished) -> None:
         self._timer.stop()
         self._executor = None
+        if self._held:
+            self._held = ""
+            self.hold_changed.emit("", "")
         failed, message = ("", "")
         if event.status is Status.FAILURE:
             failed, message = self._deepest_failure()

@@ -52,6 +52,7 @@ class Batch:
         finished: the RunFinished event, if the run ended.
         started: whether a RunStarted event arrived.
         holds: why the cell held the run, in order ("" when it went on again).
+        idled: nodes that went from RUNNING to IDLE (halted: by a hold, a stop, a parent).
     """
 
     statuses: dict[str, Status] = field(default_factory=dict)
@@ -62,6 +63,7 @@ class Batch:
     finished: RunFinished | None = None
     started: bool = False
     holds: list[str] = field(default_factory=list)
+    idled: set[str] = field(default_factory=set)
 
     @property
     def empty(self) -> bool:
@@ -98,6 +100,10 @@ def _merge(batch: Batch, event: Event) -> None:
     if isinstance(event, StatusChanged):
         batch.statuses[event.node_id] = event.new
         batch.messages[event.node_id] = event.message
+        if event.old is Status.RUNNING and event.new is Status.IDLE:
+            batch.idled.add(event.node_id)
+        elif event.new is not Status.IDLE:
+            batch.idled.discard(event.node_id)
         if event.new is Status.FAILURE:
             batch.failures.append((event.node_id, event.message, event.error))
     elif isinstance(event, BlackboardWritten):

@@ -6,7 +6,9 @@ GUI thread never waits on the robot. A cell without a robot controller (none) ha
 ``status()``, and the simulated cell answers None while its arm can move: the widget hides.
 Next to it, the cell's clear button does the operator's clear of the problem shown
 (``cell.clear()``) when the cell names one (``CellStatus.clear_action``: "Restart control
-script" on a UR, "Unlock protective stop" on the simulated cell once the delay has passed).
+script" or "Unlock protective stop" on a UR, "Unlock protective stop" on the simulated cell
+once the delay has passed). While the clear is not yet allowed (a UR refuses to unlock a
+protective stop in the first 5 s) the button is shown greyed with the seconds left.
 """
 
 from __future__ import annotations
@@ -35,11 +37,14 @@ class RobotStatusLabel(QLabel):
             window shows or hides the label on it.
         fault_changed(str): the problem shown changed ("" when the robot can move).
         clear_action_changed(str): the operator's clear offered changed ("" for none).
+        clear_changed(str, int): the clear offered or the seconds before it is allowed
+            changed.
     """
 
     presence_changed = Signal(bool)
     fault_changed = Signal(str)
     clear_action_changed = Signal(str)
+    clear_changed = Signal(str, int)
 
     def __init__(
         self, session: CellSession, interval_ms: int = 100, parent: QWidget | None = None
@@ -63,12 +68,14 @@ class RobotStatusLabel(QLabel):
             return
         if (status is None) != (self._shown is None):
             self.presence_changed.emit(status is not None)
-        fault_before, action_before = self.fault, self.clear_action
+        fault_before, action_before, wait_before = self.fault, self.clear_action, self.clear_wait
         self._shown = status
         if self.fault != fault_before:
             self.fault_changed.emit(self.fault)
         if self.clear_action != action_before:
             self.clear_action_changed.emit(self.clear_action)
+        if (self.clear_action, self.clear_wait) != (action_before, wait_before):
+            self.clear_changed.emit(self.clear_action, self.clear_wait)
         if status is None:
             self.setText("")
             return
@@ -79,7 +86,8 @@ class RobotStatusLabel(QLabel):
                 f"Robot: {status.robot_mode} · safety {status.safety_mode} · "
                 f"program {status.program}"
             )
-            self.setText(text + (f" — {status.problem}" if status.problem else ""))
+            problem = status.problem + (f", {status.hint}" if status.hint else "")
+            self.setText(text + (f" — {problem}" if problem else ""))
         self.setStyleSheet(_FAULT_STYLE if status.problem else _OK_STYLE)
         self.setToolTip(
             "What the robot's controller reports: connection, robot mode, safety mode and "
@@ -101,10 +109,21 @@ class RobotStatusLabel(QLabel):
         """The operator's clear the cell offers now ("" for none)."""
         return self._shown.clear_action if self._shown is not None else ""
 
+    @property
+    def clear_wait(self) -> int:
+        """Whole seconds before that clear is allowed (0: now, or no clear offered)."""
+        return self._shown.clear_wait if self._shown is not None else 0
+
+    @property
+    def hint(self) -> str:
+        """How the operator clears the problem shown ("" when nothing is to be said)."""
+        return self._shown.hint if self._shown is not None else ""
+
 
 class CellClearButton(QToolButton):
     """The operator's clear of the robot's problem, labelled as the cell names it ("Restart
-    control script", "Unlock protective stop"). Shown only while the cell offers one; the
+    control script", "Unlock protective stop"). Shown only while the cell offers one, and
+    greyed with the seconds left ("Unlock protective stop (4 s)") until it is allowed; the
     cell does the work on its own thread, so the click returns at once and a held run goes on
     when the robot is ready.
     """
@@ -117,11 +136,12 @@ class CellClearButton(QToolButton):
         self.setToolTip("Clear the robot's stop; a held run then goes on")
         self._session = session
         self.setVisible(False)
-        status.clear_action_changed.connect(self._on_action)
+        status.clear_changed.connect(self._on_action)
         self.clicked.connect(self._clear)
 
-    def _on_action(self, action: str) -> None:
-        self.setText(action)
+    def _on_action(self, action: str, wait: int = 0) -> None:
+        self.setText(f"{action} ({wait} s)" if action and wait else action)
+        self.setEnabled(not wait)
         self.setVisible(bool(action))
 
     def _clear(self) -> None:

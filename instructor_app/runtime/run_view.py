@@ -82,6 +82,7 @@ class RunningNodesPanel(QListWidget):
     def __init__(self, label: LabelFn, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self._label = label
+        self._held = ""
         self.setObjectName("RunningNodesPanel")
         self.itemActivated.connect(self._picked)
         self.itemClicked.connect(self._picked)
@@ -92,6 +93,20 @@ class RunningNodesPanel(QListWidget):
             item = QListWidgetItem(self._label(node_id))
             item.setData(Qt.ItemDataRole.UserRole, node_id)
             self.addItem(item)
+        self._mark_held()
+
+    def set_held(self, reason: str, text: str = "") -> None:
+        """The run is held (why; "" when it goes on): the running nodes say so."""
+        self._held = text or (f"held: {reason}" if reason else "")
+        self._mark_held()
+
+    def _mark_held(self) -> None:
+        held = self._held
+        for i in range(self.count()):
+            item = self.item(i)
+            label = self._label(item.data(Qt.ItemDataRole.UserRole))
+            item.setText(f"{label} ({held})" if held else label)
+            item.setToolTip(held)
 
     def node_ids(self) -> list[str]:
         return [self.item(i).data(Qt.ItemDataRole.UserRole) for i in range(self.count())]
@@ -166,6 +181,13 @@ class RunPresenter(QObject):
         controller.run_state_changed.connect(self._on_state)
         controller.run_refused.connect(self._on_refused)
         controller.run_finished.connect(self._on_finished)
+        controller.hold_changed.connect(self._on_hold)
+
+    def _on_hold(self, reason: str, text: str) -> None:
+        if reason:
+            self._show(f"Running, {text}")
+        elif self._active:
+            self._show("Running…")
 
     def _on_state(self, state: object) -> None:
         if state in (ExecutorState.RUNNING, ExecutorState.PAUSED) and not self._active:

@@ -211,3 +211,29 @@ def test_a_refused_unlock_is_said_in_our_words(start_emulator, connect) -> None:
     pendant = dashboard_client.DashboardClient(emulator.host)
     pendant.connect()
     pendant.disconnect()
+
+
+@pytest.mark.sim
+def test_costar_run_says_a_protective_stop_and_how_to_clear_it_then_gives_up(
+    tmp_path: Path, start_emulator
+) -> None:
+    cell = tmp_path / "emulated.cell.json"
+    emulator = start_emulator(write_cell=cell)
+    out, err = io.StringIO(), io.StringIO()
+    plan = _plan_file(tmp_path, (0.9,), 0.3)
+
+    def stop_it() -> None:
+        assert wait_for(lambda: emulator.state()["moving"], 30)
+        emulator.protective_stop()
+
+    import threading
+
+    threading.Thread(target=stop_it, daemon=True).start()
+    args = ["run", str(plan), "--cell", str(cell), "--hold-timeout", "1.5", "--timeout", "60"]
+    code = main(args, out, err)
+    text = out.getvalue()
+    assert code == 3, text + err.getvalue()
+    held = next(line for line in text.splitlines() if "held: protective stop" in line)
+    assert "safety mode PROTECTIVE_STOP" in held and "clear it on the pendant" in held, held
+    assert "gives up after 1.5 s" in held
+    assert "gave up after 2 s held: protective stop" in text

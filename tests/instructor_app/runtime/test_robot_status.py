@@ -104,7 +104,7 @@ def test_a_protective_stop_during_a_run_is_said_in_words_and_the_run_goes_on(
             assert wait_for(lambda: emulator.state()["moving"], 20)
             emulator.protective_stop()
             qtbot.waitUntil(
-                lambda: ("The robot stopped the run: protective stop", "error") in logs,
+                lambda: any(t.startswith("The run is held: protective stop") for t, _ in logs),
                 timeout=WAIT_MS,
             )
             pendant = dashboard_client.DashboardClient(emulator.host)
@@ -112,5 +112,59 @@ def test_a_protective_stop_during_a_run_is_said_in_words_and_the_run_goes_on(
             pendant.unlockProtectiveStop()
         assert finished.args[0].status is Status.SUCCESS
         assert ("The robot is ready again: the run goes on", "info") in logs
+    finally:
+        session.close()
+
+
+def test_a_held_run_keeps_its_node_running_and_offers_the_unlock_counted_down(
+    qtbot, tmp_path: Path, emulator, monkeypatch
+) -> None:
+    """A protective stop outside a Catch holds the run: the log and the status bar say so and
+    how to clear it, the moving node stays RUNNING (amber) and held, and the status bar's
+    Unlock is greyed with the seconds left until the controller allows it; pressing it then
+    unlocks the stop and the run goes on to its end.
+    """
+    import capabilities.ur.cell as ur_cell
+    from engine.files import dump_plan
+    from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
+    from engine.status import Status
+    from engine.types import JointConfig, ParamType
+    from tests.capabilities.ur.emulators import HOME, wait_for
+
+    monkeypatch.setattr(ur_cell, "STOP_UNLOCK_DELAY", 2.0)  # a UR's is 5 s
+    target = JointConfig((HOME[0] + 1.2, *HOME[1:]))
+    move = NodeSpec(NodeKind.OPERATION, "turn", op="motion.move_joints", params={
+        "target": Binding.fixed(target, ParamType.JOINTS),
+        "speed": Binding.fixed(0.4, ParamType.NUMBER),
+    })  # fmt: skip
+    session = CellSession(str(tmp_path / "emulated.cell.json"))
+    assert session.open()
+    try:
+        window = make_window(qtbot, session, tmp_path)
+        window.document.load_text(dump_plan(PlanSpec(move, "turn")), None)
+        turn = window.document.plan.tree.id
+        controller, clear = window.controller, window.robot_clear
+        held = "held: protective stop, clear it on the pendant or press Unlock protective stop"
+        with qtbot.waitSignal(controller.run_finished, timeout=60_000) as finished:
+            controller.run()
+            assert wait_for(lambda: emulator.state()["moving"], 20)
+            emulator.protective_stop()
+            qtbot.waitUntil(lambda: controller.held == "protective stop", timeout=WAIT_MS)
+            lines = window.views.log.lines()
+            assert any(f"The run is {held}" in line for line in lines), lines
+            assert held in window.statusBar().currentMessage()
+            assert held.removeprefix("held: ") in window.robot_status.text()
+            qtbot.wait(300)  # several drains while held: the node stays running
+            assert controller.statuses[turn] is Status.RUNNING
+            panel = window.running_panel
+            assert panel.node_ids() == [turn] and held in panel.item(0).text()
+            # The unlock is offered at once, greyed and counted down, then allowed.
+            qtbot.waitUntil(lambda: clear.isVisibleTo(window), timeout=WAIT_MS)
+            assert not clear.isEnabled() and clear.text().endswith(" s)"), clear.text()
+            qtbot.waitUntil(clear.isEnabled, timeout=WAIT_MS)
+            assert clear.text() == "Unlock protective stop"
+            qtbot.mouseClick(clear, Qt.MouseButton.LeftButton)
+        assert finished.args[0].status is Status.SUCCESS
+        assert emulator.state()["safety_mode"] == 1  # NORMAL: unlocked through the dashboard
     finally:
         session.close()
