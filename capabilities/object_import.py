@@ -95,7 +95,7 @@ def _check(model: NewModel, mesh_file: Path, library: Path) -> None:
 
 def _read_mesh(mesh_file: Path, model: NewModel) -> tuple[object, np.ndarray, bool]:
     """The mesh in metres in the object frame, its vertices, and whether they changed."""
-    import open3d as o3d  # only when a model is added (a large import)
+    from capabilities.open3d_lib import o3d  # only when a model is added (a large import)
 
     mesh = o3d.io.read_triangle_mesh(str(mesh_file))  # type: ignore[arg-type]  # str works
     vertices = np.asarray(mesh.vertices, dtype=float) * _UNITS[model.units]
@@ -144,7 +144,7 @@ def import_mesh_model(
 
 
 def _write_mesh(path: Path, mesh: object) -> None:
-    import open3d as o3d
+    from capabilities.open3d_lib import o3d
 
     if not o3d.io.write_triangle_mesh(str(path), mesh):  # type: ignore[arg-type]  # str works
         raise OSError(f"the mesh could not be written to {path}")

@@ -9,9 +9,9 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-import open3d as o3d
 
 from capabilities.object_library import ObjectLibrary, ObjectLibraryError, ObjectModelSpec
+from capabilities.open3d_lib import o3d
 from capabilities.perception.errors import PerceptionError
 
 __all__ = ["ModelCloud", "ModelSet"]

@@ -20,8 +20,8 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
-import open3d as o3d
 
+from capabilities.open3d_lib import o3d
 from capabilities.perception.config import RecognitionConfig
 from capabilities.perception.geometry import upright_matrix, yaw_of
 from capabilities.perception.models import ModelCloud, fpfh

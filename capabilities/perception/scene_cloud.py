@@ -12,8 +12,8 @@ from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
-import open3d as o3d
 
+from capabilities.open3d_lib import o3d
 from capabilities.perception.config import RecognitionConfig
 from capabilities.perception.errors import PerceptionError
 from capabilities.perception.geometry import pose_to_matrix, table_frame

@@ -106,7 +106,9 @@ def _light_meshes(urdf: Path, folder: Path) -> Path:
         target = folder / f"{stl.stem}.obj"
         if target.is_file():
             continue
-        import open3d  # only here: the physics cell never needs it
+        from capabilities.open3d_lib import (
+            o3d as open3d,
+        )  # only here: the physics cell never needs it
 
         mesh = open3d.io.read_triangle_mesh(stl)
         if len(mesh.triangles) == 0:

@@ -64,7 +64,7 @@ def render_mesh(
 
 def render_thumbnail(spec: ObjectModelSpec, size: int = 96) -> np.ndarray:
     """The RGBA thumbnail of a model's mesh (read with Open3D)."""
-    import open3d as o3d  # a large import: only on the worker thread that draws
+    from capabilities.open3d_lib import o3d  # a large import: only on the worker thread that draws
 
     mesh = o3d.io.read_triangle_mesh(str(spec.mesh_file))  # type: ignore[arg-type]  # str works
     vertices = np.asarray(mesh.vertices, dtype=float)

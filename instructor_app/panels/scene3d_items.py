@@ -55,7 +55,7 @@ def _ur5_mesh_dir() -> Path:
 @functools.lru_cache(maxsize=64)
 def mesh_data(path: str) -> gl.MeshData:
     """The triangles of a mesh file as MeshData (read once per file)."""
-    import open3d as o3d
+    from capabilities.open3d_lib import o3d
 
     mesh = o3d.io.read_triangle_mesh(path)  # type: ignore[arg-type]  # open3d stubs want os.PathLike; str works
     if len(mesh.triangles) == 0:

@@ -66,7 +66,7 @@ def unproject(frame: Any, u: float, v: float, depth: float) -> tuple[float, floa
 
 
 def _mesh_vertices(path: Any) -> np.ndarray:
-    import open3d as o3d
+    from capabilities.open3d_lib import o3d
 
     mesh = o3d.io.read_triangle_mesh(str(path))  # type: ignore[arg-type]  # open3d stubs want os.PathLike; str works
     vertices = np.asarray(mesh.vertices, dtype=float)

@@ -39,7 +39,7 @@ def make_panel(qtbot: Any, folders: tuple[Path, Path], **kw: Any) -> ObjectLibra
 
 def box_mesh_file(folder: Path, size_mm: tuple[float, float, float]) -> Path:
     """An STL box in millimetres, its corner at the origin (as CAD exports often are)."""
-    import open3d as o3d
+    from capabilities.open3d_lib import o3d
 
     box = o3d.geometry.TriangleMesh.create_box(*size_mm)
     box.compute_triangle_normals()
