@@ -18,7 +18,7 @@ import weakref
 from typing import TYPE_CHECKING, Any
 
 from capabilities.base import Capability, CapabilityEnv
-from capabilities.kit import camera, camera_port, manifest
+from capabilities.kit import StatefulOperation, camera, camera_port, manifest
 from capabilities.perception.config import SETTINGS, RecognitionConfig
 from capabilities.perception.errors import PerceptionError
 from capabilities.world_model import Detection, WorldModel
@@ -103,14 +103,7 @@ CAMERA = camera_port()
 OBJECT = object_model("object", doc="the object class (a model name)")
 
 
-class _PerceptionOp:
-    """An operation over the capability's per-cell state (:class:`_Env`)."""
-
-    def __init__(self, env: CapabilityEnv) -> None:
-        self._env: _Env = env.state
-
-
-class DetectObjects(_PerceptionOp):
+class DetectObjects(StatefulOperation[_Env]):
     """perception.detect_objects: one look, recognised on a worker thread."""
 
     MANIFEST = manifest(
@@ -126,7 +119,7 @@ class DetectObjects(_PerceptionOp):
     )
 
     def start(self, call: OperationCall) -> Job:
-        env = self._env
+        env = self._state
         camera = env.camera(call.input(CAMERA))
         recognizer = env.shared.recognizer(env.library, env.config)
         tracker = env.shared.tracker(env.world, camera.name, env.library)
@@ -156,7 +149,7 @@ class DetectObjects(_PerceptionOp):
         return job
 
 
-class ObjectFound(_PerceptionOp):
+class ObjectFound(StatefulOperation[_Env]):
     """perception.object_found."""
 
     MANIFEST = manifest(
@@ -168,10 +161,10 @@ class ObjectFound(_PerceptionOp):
     )
 
     def start(self, call: OperationCall) -> Job:
-        return Job.answer(bool(self._env.seen(call.input(OBJECT))))
+        return Job.answer(bool(self._state.seen(call.input(OBJECT))))
 
 
-class ObjectPose(_PerceptionOp):
+class ObjectPose(StatefulOperation[_Env]):
     """perception.object_pose: the most confident detection's pose."""
 
     MANIFEST = manifest(
@@ -184,7 +177,7 @@ class ObjectPose(_PerceptionOp):
     )
 
     def start(self, call: OperationCall) -> Job:
-        seen = self._env.seen(call.input(OBJECT))
+        seen = self._state.seen(call.input(OBJECT))
         if not seen:
             raise OperationFailed(
                 f"{_name(call.input(OBJECT))} has not been seen", ErrorType.NOT_FOUND
@@ -193,7 +186,7 @@ class ObjectPose(_PerceptionOp):
         return Job.done()
 
 
-class ObjectsOfClass(_PerceptionOp):
+class ObjectsOfClass(StatefulOperation[_Env]):
     """perception.objects_of_class: how many, and their poses."""
 
     MANIFEST = manifest(
@@ -207,13 +200,13 @@ class ObjectsOfClass(_PerceptionOp):
     )
 
     def start(self, call: OperationCall) -> Job:
-        seen = self._env.seen(call.input(OBJECT))
+        seen = self._state.seen(call.input(OBJECT))
         call.write("count", float(len(seen)))
         call.write("poses", [d.pose for d in seen])
         return Job.done()
 
 
-class PlateType(_PerceptionOp):
+class PlateType(StatefulOperation[_Env]):
     """perception.plate_type: the plate model nearest a pose."""
 
     NEAR = pose("near", Pose(), doc="the plate nearest this pose (default: nearest the robot base)")
@@ -234,9 +227,9 @@ class PlateType(_PerceptionOp):
         within = call.input(self.WITHIN)
         plates = [
             d
-            for name in self._env.library.names()
-            if self._env.library.get(name).extra.get("holes")
-            for d in self._env.seen(name)
+            for name in self._state.library.names()
+            if self._state.library.get(name).extra.get("holes")
+            for d in self._state.seen(name)
         ]
         ranked = sorted(plates, key=lambda d: math.dist(d.pose.position, near.position))
         if not ranked or math.dist(ranked[0].pose.position, near.position) > within:

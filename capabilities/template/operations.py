@@ -10,7 +10,8 @@ The one shape of a capability module (copy it):
    (``text``, ``number``, ``duration``, ``flag``, ``pose``...);
 4. per operation, one class: ``MANIFEST = manifest(CAP, ...)`` listing its ports,
    ``__init__(env)`` (the registry makes one per leaf; ``env.state`` is what ``setup``
-   made) and ``start(call)``, which reads each input through its port (``call.input(COLOUR)``
+   made, kept as ``self._state`` by the base ``StatefulOperation[LampState]``) and
+   ``start(call)``, which reads each input through its port (``call.input(COLOUR)``
    is a ``str``) and returns a ``Job`` (``Job.done()``, ``Job.failed(why)``,
    ``Job.answer(flag)``, or a running job);
 5. ``capability()``: the capability with every operation class added.
@@ -19,7 +20,7 @@ The one shape of a capability module (copy it):
 from __future__ import annotations
 
 from capabilities.base import Capability, CapabilityEnv
-from capabilities.kit import Setting, manifest
+from capabilities.kit import Setting, StatefulOperation, manifest
 from capabilities.template.backend import INTERFACE, LampBackend
 from engine.operations import Job, OperationCall, OperationKind, text
 
@@ -50,7 +51,7 @@ def setup(env: CapabilityEnv) -> LampState:
 COLOUR = text("colour", "green", doc="which light", choices=("green", "amber", "red"))
 
 
-class LampIsLit:
+class LampIsLit(StatefulOperation[LampState]):
     """template.lamp_is_lit: reads the lamp through the cell's backend and answers at once."""
 
     MANIFEST = manifest(
@@ -60,9 +61,6 @@ class LampIsLit:
         "True when the stack light shows the given colour.",
         COLOUR,
     )
-
-    def __init__(self, env: CapabilityEnv) -> None:
-        self._state: LampState = env.state
 
     def start(self, call: OperationCall) -> Job:
         return Job.answer(self._state.is_lit(call.input(COLOUR)))
