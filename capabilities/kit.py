@@ -26,6 +26,13 @@ from engine.operations import (
     OperationKind,
     OperationManifest,
     PortSpec,
+    duration,
+    flag,
+    joints,
+    number,
+    object_model,
+    pose,
+    region,
     text,
 )
 from engine.types import ParamType, Pose, ValueShapeError, decode_value
@@ -33,8 +40,20 @@ from engine.types import ParamType, Pose, ValueShapeError, decode_value
 if TYPE_CHECKING:
     from capabilities.base import CapabilityEnv, OperationClass
 
+# The declaration side of engine.operations, so that an operation module takes what its
+# manifests are made of from here: the kinds and the typed input ports.
 __all__ = [
     "CAMERAS",
+    "InPort",
+    "OperationKind",
+    "duration",
+    "flag",
+    "joints",
+    "number",
+    "object_model",
+    "pose",
+    "region",
+    "text",
     "camera_port",
     "CapabilitySettingsError",
     "Setting",

@@ -12,20 +12,20 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 from capabilities.base import Capability, CapabilityEnv
-from capabilities.kit import StatefulOperation, camera, camera_port, manifest
+from capabilities.kit import (
+    OperationKind,
+    StatefulOperation,
+    camera,
+    camera_port,
+    manifest,
+    number,
+    object_model,
+    output,
+)
 from capabilities.markers.backend import CameraDevice
 from capabilities.world_model import Detection, WorldModel
 from engine.error_types import ErrorType
-from engine.operations import (
-    Direction,
-    Job,
-    OperationCall,
-    OperationFailed,
-    OperationKind,
-    PortSpec,
-    number,
-    object_model,
-)
+from engine.operations import Job, OperationCall, OperationFailed
 from engine.types import ObjectModel, ParamType, Pose
 
 if TYPE_CHECKING:
@@ -100,7 +100,7 @@ class DetectMarkers(StatefulOperation[_Env]):
         OperationKind.ACTION,
         "Looks through a camera and remembers every marker and marked object it sees.",
         CAMERA,
-        PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="how many markers were seen"),
+        output("count", ParamType.NUMBER, doc="how many markers were seen"),
     )
 
     def start(self, call: OperationCall) -> Job:
@@ -143,7 +143,7 @@ class MarkerPose(StatefulOperation[_Env]):
         OperationKind.QUERY,
         "The pose of a marker last seen.",
         MARKER_ID,
-        PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where it is"),
+        output("pose", ParamType.POSE, doc="where it is"),
     )
 
     def start(self, call: OperationCall) -> Job:
@@ -169,7 +169,7 @@ class ObjectPose(StatefulOperation[_Env]):
         OperationKind.QUERY,
         "The pose of an object, from its marker.",
         OBJECT,
-        PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the object is"),
+        output("pose", ParamType.POSE, doc="where the object is"),
     )
 
     def start(self, call: OperationCall) -> Job:

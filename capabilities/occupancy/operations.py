@@ -16,21 +16,21 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from capabilities.base import Capability, CapabilityEnv, OperationClass
-from capabilities.kit import StatefulOperation, camera_port, manifest, variant
-from capabilities.occupancy.settings import SETTINGS
-from engine.error_types import ErrorType
-from engine.operations import (
-    Direction,
-    Job,
-    OperationCall,
+from capabilities.kit import (
     OperationKind,
-    PortSpec,
-    StartResult,
+    StatefulOperation,
+    camera_port,
     duration,
     flag,
+    manifest,
     number,
+    output,
     region,
+    variant,
 )
+from capabilities.occupancy.settings import SETTINGS
+from engine.error_types import ErrorType
+from engine.operations import Job, OperationCall, StartResult
 from engine.status import RUNNING, Status
 from engine.types import ParamType, Region
 
@@ -250,7 +250,7 @@ class CountPoints(StatefulOperation["OccupancyState"]):
         OperationKind.QUERY,
         "How many points of a fresh frame are in the region (table and robot left out).",
         *COMMON,
-        PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="the occupant points counted"),
+        output("count", ParamType.NUMBER, doc="the occupant points counted"),
     )
 
     def start(self, call: OperationCall) -> StartResult:

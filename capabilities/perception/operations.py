@@ -18,22 +18,22 @@ import weakref
 from typing import TYPE_CHECKING, Any
 
 from capabilities.base import Capability, CapabilityEnv
-from capabilities.kit import StatefulOperation, camera, camera_port, manifest
+from capabilities.kit import (
+    OperationKind,
+    StatefulOperation,
+    camera,
+    camera_port,
+    manifest,
+    number,
+    object_model,
+    output,
+    pose,
+)
 from capabilities.perception.config import SETTINGS, RecognitionConfig
 from capabilities.perception.errors import PerceptionError
 from capabilities.world_model import Detection, WorldModel
 from engine.error_types import ErrorType
-from engine.operations import (
-    Direction,
-    Job,
-    OperationCall,
-    OperationFailed,
-    OperationKind,
-    PortSpec,
-    number,
-    object_model,
-    pose,
-)
+from engine.operations import Job, OperationCall, OperationFailed
 from engine.types import ObjectModel, ParamType, Pose
 
 __all__ = ["SOURCE_PREFIX", "capability"]
@@ -113,9 +113,7 @@ class DetectObjects(StatefulOperation[_Env]):
         "Looks through a camera and recognises the known objects on the table "
         "(point cloud matched to the object models).",
         CAMERA,
-        PortSpec(
-            "count", (ParamType.NUMBER,), Direction.OUT, doc="how many objects were recognised"
-        ),
+        output("count", ParamType.NUMBER, doc="how many objects were recognised"),
     )
 
     def start(self, call: OperationCall) -> Job:
@@ -173,7 +171,7 @@ class ObjectPose(StatefulOperation[_Env]):
         OperationKind.QUERY,
         "The pose of the most confidently recognised object of a class.",
         OBJECT,
-        PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the object is"),
+        output("pose", ParamType.POSE, doc="where the object is"),
     )
 
     def start(self, call: OperationCall) -> Job:
@@ -195,8 +193,8 @@ class ObjectsOfClass(StatefulOperation[_Env]):
         OperationKind.QUERY,
         "How many objects of a class the last look recognised, and their poses.",
         OBJECT,
-        PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="how many"),
-        PortSpec("poses", (ParamType.ANY,), Direction.OUT, doc="their poses, most confident first"),
+        output("count", ParamType.NUMBER, doc="how many"),
+        output("poses", ParamType.ANY, doc="their poses, most confident first"),
     )
 
     def start(self, call: OperationCall) -> Job:
@@ -218,8 +216,8 @@ class PlateType(StatefulOperation[_Env]):
         "Which plate (by its holes) lies nearest to a pose.",
         NEAR,
         WITHIN,
-        PortSpec("model", (ParamType.OBJECT,), Direction.OUT, doc="the plate's model"),
-        PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the plate is"),
+        output("model", ParamType.OBJECT, doc="the plate's model"),
+        output("pose", ParamType.POSE, doc="where the plate is"),
     )
 
     def start(self, call: OperationCall) -> Job:

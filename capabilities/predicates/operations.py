@@ -11,21 +11,20 @@ import math
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from capabilities.base import Capability, CapabilityEnv, OperationClass
-from capabilities.kit import StatefulOperation, manifest, variant
-from capabilities.predicates.collision import TOOL, PredicateError
-from capabilities.predicates.settings import DIRECTIONS, SETTINGS
-from engine.operations import (
+from capabilities.kit import (
     InPort,
-    Job,
-    OperationCall,
-    OperationFailed,
     OperationKind,
-    StartResult,
+    StatefulOperation,
     duration,
+    manifest,
     number,
     object_model,
     text,
+    variant,
 )
+from capabilities.predicates.collision import TOOL, PredicateError
+from capabilities.predicates.settings import DIRECTIONS, SETTINGS
+from engine.operations import Job, OperationCall, OperationFailed, StartResult
 from engine.types import ObjectModel, Pose
 
 if TYPE_CHECKING:  # the geometry (numpy) loads with the first cell's setup

@@ -6,8 +6,9 @@ The one shape of a capability module (copy it):
    and docs; a cell file gives them in its ``capabilities.<CAP>`` block);
 2. a per-cell state class and ``setup(env)`` that makes it (py_trees' ``setup()``): what
    the operations of one cell share, made once per cell from the checked settings;
-3. its input ports, made with the typed constructors of :mod:`engine.operations`
-   (``text``, ``number``, ``duration``, ``flag``, ``pose``...);
+3. its input ports, made with the typed constructors :mod:`capabilities.kit` re-exports
+   (``text``, ``number``, ``duration``, ``flag``, ``pose``...), output ports with
+   ``output``;
 4. per operation, one class: ``MANIFEST = manifest(CAP, ...)`` listing its ports,
    ``__init__(env)`` (the registry makes one per leaf; ``env.state`` is what ``setup``
    made, kept as ``self._state`` by the base ``StatefulOperation[LampState]``) and
@@ -20,9 +21,9 @@ The one shape of a capability module (copy it):
 from __future__ import annotations
 
 from capabilities.base import Capability, CapabilityEnv
-from capabilities.kit import Setting, StatefulOperation, manifest
+from capabilities.kit import OperationKind, Setting, StatefulOperation, manifest, text
 from capabilities.template.backend import INTERFACE, LampBackend
-from engine.operations import Job, OperationCall, OperationKind, text
+from engine.operations import Job, OperationCall
 
 __all__ = ["COLOUR", "SETTINGS", "LampIsLit", "LampState", "capability", "setup"]
 
