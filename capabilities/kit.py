@@ -16,30 +16,53 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Generic, TypeVar, cast
 
 from capabilities.errors import CapabilityError
 from engine.operations import (
+    Direction,
     InPort,
     OperationFailed,
     OperationKind,
     OperationManifest,
     PortSpec,
+    duration,
+    flag,
+    joints,
+    number,
+    object_model,
+    pose,
+    region,
     text,
 )
 from engine.types import ParamType, Pose, ValueShapeError, decode_value
 
 if TYPE_CHECKING:
-    from capabilities.base import CapabilityEnv
+    from capabilities.base import CapabilityEnv, OperationClass
 
+# The declaration side of engine.operations, so that an operation module takes what its
+# manifests are made of from here: the kinds and the typed input ports.
 __all__ = [
     "CAMERAS",
+    "InPort",
+    "OperationKind",
+    "duration",
+    "flag",
+    "joints",
+    "number",
+    "object_model",
+    "pose",
+    "region",
+    "text",
     "camera_port",
     "CapabilitySettingsError",
     "Setting",
+    "StatefulOperation",
     "camera",
     "manifest",
+    "output",
     "parse_settings",
+    "variant",
 ]
 
 CAMERAS = ("shoulder", "wrist")
@@ -86,6 +109,42 @@ def manifest(
                                 "True when the stack light shows the given colour.", COLOUR)
     """
     return OperationManifest(f"{capability}.{name}", kind, doc, capability, ports, aliases)
+
+
+def output(name: str, *types: ParamType, unit: str = "", doc: str = "") -> PortSpec:
+    """The output port ``name`` of a manifest: the entry the operation writes (``call.write``).
+
+    Example: ``output("pose", ParamType.POSE, doc="where the object is")``.
+    """
+    return PortSpec(name, types, Direction.OUT, unit=unit, doc=doc)
+
+
+S = TypeVar("S")
+
+
+class StatefulOperation(Generic[S]):
+    """An operation over its capability's per-cell state: ``self._state`` is ``env.state``.
+
+    The type parameter is the state's class (what the capability's ``setup`` returns):
+    ``class _Op(StatefulOperation[LampState])`` gives ``self._state`` that type; a state
+    class imported only for type checking is named as a string.
+    """
+
+    def __init__(self, env: CapabilityEnv) -> None:
+        self._state: S = env.state
+
+
+def variant(base: type, manifest: OperationManifest, **values: Any) -> OperationClass:
+    """The class of one operation of a family that differs only in values.
+
+    A subclass of ``base`` with ``MANIFEST`` and the class attributes in ``values``, named
+    after the operation: ``variant(_Relation, _relation_manifest("left_of"),
+    RELATION="left_of")`` is ``LeftOf``, documented as ``predicates.left_of``.
+    """
+    words = manifest.id.split(".", 1)[1].split("_")
+    attributes = {"MANIFEST": manifest, "__doc__": f"{manifest.id}.", "__module__": base.__module__}
+    made = type("".join(w.title() for w in words), (base,), {**attributes, **values})
+    return cast("OperationClass", made)
 
 
 _PY_TYPES: dict[type, str] = {

@@ -21,22 +21,21 @@ from capabilities.collaboration.console import (
     Prompt,
     PromptState,
 )
-from capabilities.kit import camera, camera_port, manifest
-from capabilities.world_model import Detection, WorldModel
-from engine.error_types import ErrorType
-from engine.operations import (
-    Direction,
+from capabilities.kit import (
     InPort,
-    Job,
-    OperationCall,
-    OperationFailed,
     OperationKind,
-    PortSpec,
+    camera,
+    camera_port,
     flag,
+    manifest,
     object_model,
+    output,
     region,
     text,
 )
+from capabilities.world_model import Detection, WorldModel
+from engine.error_types import ErrorType
+from engine.operations import Job, OperationCall, OperationFailed
 from engine.status import RUNNING, Status
 from engine.types import ObjectModel, ParamType
 
@@ -229,7 +228,7 @@ class WaitForHandoff:
         TIMEOUT,
         SETTLE,
         INTERVAL,
-        PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where it was put"),
+        output("pose", ParamType.POSE, doc="where it was put"),
     )
 
     def __init__(self, env: CapabilityEnv) -> None:

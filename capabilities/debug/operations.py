@@ -9,27 +9,15 @@ from __future__ import annotations
 from typing import Any
 
 from capabilities.base import Capability, CapabilityEnv
-from capabilities.kit import manifest
+from capabilities.kit import InPort, OperationKind, flag, manifest, number, output, text
 from engine.error_types import ErrorType
-from engine.operations import (
-    Direction,
-    InPort,
-    Job,
-    OperationCall,
-    OperationFailed,
-    OperationKind,
-    PortSpec,
-    flag,
-    number,
-    text,
-)
+from engine.operations import Job, OperationCall, OperationFailed
 from engine.status import FAILURE, RUNNING, SUCCESS, Status
 from engine.types import ParamType, Pose, Waypoint
 
 __all__ = ["capability"]
 
 CAP = "debug"
-ANY = (ParamType.ANY,)
 ALL_TYPES = (*(t for t in ParamType if t is not ParamType.ANY), ParamType.ANY)
 TICKS = number("ticks", 3, doc="ticks spent RUNNING")
 
@@ -148,7 +136,7 @@ class SetParam(_Debug):
         OperationKind.ACTION,
         "Writes a value to a named parameter.",
         VALUE,
-        PortSpec("name", ANY, Direction.OUT, doc="the parameter written"),
+        output("name", ParamType.ANY, doc="the parameter written"),
     )
 
     def start(self, call: OperationCall) -> Job:
@@ -166,7 +154,7 @@ class Query(_Debug):
         OperationKind.QUERY,
         "Answers with a given value (a stand-in query).",
         VALUE,
-        PortSpec("result", ANY, Direction.OUT, doc="where the answer goes"),
+        output("result", ParamType.ANY, doc="where the answer goes"),
     )
 
     def start(self, call: OperationCall) -> Job:

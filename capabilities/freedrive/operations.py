@@ -7,16 +7,8 @@ from collections.abc import Callable
 
 from capabilities.base import Capability, CapabilityEnv
 from capabilities.freedrive.backend import FREEDRIVE, FreedriveBackend
-from capabilities.kit import manifest
-from engine.operations import (
-    Direction,
-    Job,
-    OperationCall,
-    OperationFailed,
-    OperationKind,
-    PortSpec,
-    text,
-)
+from capabilities.kit import OperationKind, manifest, output, text
+from engine.operations import Job, OperationCall, OperationFailed
 from engine.types import JointConfig, ParamType, Waypoint, WaypointFrame
 
 __all__ = ["capability"]
@@ -86,7 +78,7 @@ class RecordWaypoint(_FreedriveOp):
         "Records where the arm is now as a waypoint (typically after guiding it by hand).",
         NAME,
         FRAME,
-        PortSpec("waypoint", (ParamType.WAYPOINT,), Direction.OUT, doc="the recorded waypoint"),
+        output("waypoint", ParamType.WAYPOINT, doc="the recorded waypoint"),
     )
 
     def start(self, call: OperationCall) -> Job:

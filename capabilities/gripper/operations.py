@@ -8,10 +8,10 @@ from capabilities.base import Capability, CapabilityEnv
 from capabilities.gripper.backend import GRIPPER, GripperBackend
 from capabilities.gripper.grasp import Grasp
 from capabilities.jobs import job_from_handle
-from capabilities.kit import manifest
+from capabilities.kit import OperationKind, manifest
 from capabilities.motion.backend import ARM
 from capabilities.motion.symmetry import SymmetryTable
-from engine.operations import Job, OperationCall, OperationKind
+from engine.operations import Job, OperationCall
 
 __all__ = ["capability"]
 

@@ -12,20 +12,20 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 from capabilities.base import Capability, CapabilityEnv
-from capabilities.kit import camera, camera_port, manifest
+from capabilities.kit import (
+    OperationKind,
+    StatefulOperation,
+    camera,
+    camera_port,
+    manifest,
+    number,
+    object_model,
+    output,
+)
 from capabilities.markers.backend import CameraDevice
 from capabilities.world_model import Detection, WorldModel
 from engine.error_types import ErrorType
-from engine.operations import (
-    Direction,
-    Job,
-    OperationCall,
-    OperationFailed,
-    OperationKind,
-    PortSpec,
-    number,
-    object_model,
-)
+from engine.operations import Job, OperationCall, OperationFailed
 from engine.types import ObjectModel, ParamType, Pose
 
 if TYPE_CHECKING:
@@ -91,14 +91,7 @@ def _object_detections(
     return list(best.values())
 
 
-class _MarkersOp:
-    """An operation over the capability's per-cell state (:class:`_Env`)."""
-
-    def __init__(self, env: CapabilityEnv) -> None:
-        self._env: _Env = env.state
-
-
-class DetectMarkers(_MarkersOp):
+class DetectMarkers(StatefulOperation[_Env]):
     """markers.detect_markers: one look, on a worker thread, into the world model."""
 
     MANIFEST = manifest(
@@ -107,15 +100,15 @@ class DetectMarkers(_MarkersOp):
         OperationKind.ACTION,
         "Looks through a camera and remembers every marker and marked object it sees.",
         CAMERA,
-        PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="how many markers were seen"),
+        output("count", ParamType.NUMBER, doc="how many markers were seen"),
     )
 
     def start(self, call: OperationCall) -> Job:
         from capabilities.markers.depth import refine_with_depth
         from capabilities.markers.detection import detect_markers, marker_pose_world
 
-        camera = self._env.camera(call.input(CAMERA))
-        env = self._env
+        camera = self._state.camera(call.input(CAMERA))
+        env = self._state
 
         def look() -> dict[str, Any]:
             frame = camera.capture()
@@ -140,7 +133,7 @@ class DetectMarkers(_MarkersOp):
         return job
 
 
-class MarkerPose(_MarkersOp):
+class MarkerPose(StatefulOperation[_Env]):
     """markers.marker_pose: where a marker was last seen."""
 
     MARKER_ID = number("marker_id", doc="the marker's id")
@@ -150,12 +143,12 @@ class MarkerPose(_MarkersOp):
         OperationKind.QUERY,
         "The pose of a marker last seen.",
         MARKER_ID,
-        PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where it is"),
+        output("pose", ParamType.POSE, doc="where it is"),
     )
 
     def start(self, call: OperationCall) -> Job:
         marker_id = int(call.input(self.MARKER_ID))
-        found = self._env.world.marker(marker_id)
+        found = self._state.world.marker(marker_id)
         if found is None:
             raise OperationFailed(f"marker {marker_id} has not been seen", ErrorType.NOT_FOUND)
         call.write("pose", found[0])
@@ -167,7 +160,7 @@ def _best(env: _Env, model: Any) -> Detection | None:
     return env.world.best(name)
 
 
-class ObjectPose(_MarkersOp):
+class ObjectPose(StatefulOperation[_Env]):
     """markers.object_pose: an object's pose from its marker."""
 
     MANIFEST = manifest(
@@ -176,11 +169,11 @@ class ObjectPose(_MarkersOp):
         OperationKind.QUERY,
         "The pose of an object, from its marker.",
         OBJECT,
-        PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the object is"),
+        output("pose", ParamType.POSE, doc="where the object is"),
     )
 
     def start(self, call: OperationCall) -> Job:
-        detection = _best(self._env, call.input(OBJECT))
+        detection = _best(self._state, call.input(OBJECT))
         if detection is None:
             raise OperationFailed(
                 f"{call.input(OBJECT).name} has not been seen", ErrorType.NOT_FOUND
@@ -189,7 +182,7 @@ class ObjectPose(_MarkersOp):
         return Job.done()
 
 
-class ObjectFound(_MarkersOp):
+class ObjectFound(StatefulOperation[_Env]):
     """markers.object_found."""
 
     MANIFEST = manifest(
@@ -201,10 +194,10 @@ class ObjectFound(_MarkersOp):
     )
 
     def start(self, call: OperationCall) -> Job:
-        return Job.answer(_best(self._env, call.input(OBJECT)) is not None)
+        return Job.answer(_best(self._state, call.input(OBJECT)) is not None)
 
 
-class CalibrateCamera(_MarkersOp):
+class CalibrateCamera(StatefulOperation[_Env]):
     """Finds a fixed camera's pose from the markers of known pose (on the table, on fixtures)."""
 
     MAX_ERROR_PX = number(
@@ -223,12 +216,12 @@ class CalibrateCamera(_MarkersOp):
         from capabilities.markers.calibration import calibrate_extrinsics
         from capabilities.markers.detection import detect_markers
 
-        camera = self._env.camera(call.input(CAMERA))
+        camera = self._state.camera(call.input(CAMERA))
         if camera.on_wrist:
             raise OperationFailed(
                 "the wrist camera is calibrated by hand-eye calibration, not here"
             )
-        env = self._env
+        env = self._state
         max_rms = call.input(self.MAX_ERROR_PX)
 
         def calibrate() -> dict[str, Any]:

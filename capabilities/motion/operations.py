@@ -14,24 +14,13 @@ from typing import Any
 from capabilities.base import Capability, CapabilityEnv, CapabilityError
 from capabilities.faults import fault_error
 from capabilities.jobs import chain_jobs, job_from_handle
-from capabilities.kit import manifest
+from capabilities.kit import InPort, OperationKind, joints, manifest, number, output, text
 from capabilities.motion.backend import ARM, WORLD, ArmBackend, WorldBackend
 from capabilities.motion.geometry import format_pose_mm
 from capabilities.motion.symmetry import SymmetryTable
 from capabilities.motion.targets import TargetResolver
 from engine.error_types import ErrorType
-from engine.operations import (
-    Direction,
-    InPort,
-    Job,
-    OperationCall,
-    OperationFailed,
-    OperationKind,
-    PortSpec,
-    joints,
-    number,
-    text,
-)
+from engine.operations import Job, OperationCall, OperationFailed
 from engine.types import JointConfig, ParamType, Pose, Waypoint
 
 __all__ = ["capability", "scale"]
@@ -282,7 +271,7 @@ class CurrentPose(_ArmOp):
         "current_pose",
         OperationKind.QUERY,
         "The tool's pose now (world frame).",
-        PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="the tool pose"),
+        output("pose", ParamType.POSE, doc="the tool pose"),
     )
 
     def start(self, call: OperationCall) -> Job:
@@ -298,7 +287,7 @@ class CurrentJoints(_ArmOp):
         "current_joints",
         OperationKind.QUERY,
         "The arm's joint positions now.",
-        PortSpec("joints", (ParamType.JOINTS,), Direction.OUT, unit="rad", doc="joint positions"),
+        output("joints", ParamType.JOINTS, unit="rad", doc="joint positions"),
     )
 
     def start(self, call: OperationCall) -> Job:

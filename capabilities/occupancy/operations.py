@@ -15,22 +15,22 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, ClassVar
 
-from capabilities.base import Capability, CapabilityEnv
-from capabilities.kit import camera_port, manifest
-from capabilities.occupancy.settings import SETTINGS
-from engine.error_types import ErrorType
-from engine.operations import (
-    Direction,
-    Job,
-    OperationCall,
+from capabilities.base import Capability, CapabilityEnv, OperationClass
+from capabilities.kit import (
     OperationKind,
-    PortSpec,
-    StartResult,
+    StatefulOperation,
+    camera_port,
     duration,
     flag,
+    manifest,
     number,
+    output,
     region,
+    variant,
 )
+from capabilities.occupancy.settings import SETTINGS
+from engine.error_types import ErrorType
+from engine.operations import Job, OperationCall, StartResult
 from engine.status import RUNNING, Status
 from engine.types import ParamType, Region
 
@@ -145,13 +145,6 @@ class _Args:
         self.mask_robot = call.input(MASK_ROBOT)
 
 
-class _OccupancyOp:
-    """An operation over the capability's per-cell state (the camera feeds)."""
-
-    def __init__(self, env: CapabilityEnv) -> None:
-        self._state: OccupancyState = env.state
-
-
 def _region_text(region: Region) -> str:
     c = region.center
     return (
@@ -160,10 +153,16 @@ def _region_text(region: Region) -> str:
     )
 
 
-class _RegionCondition(_OccupancyOp):
+class _RegionCondition(StatefulOperation["OccupancyState"]):
     """``is_occupied`` (WANT True) or ``is_empty`` (WANT False)."""
 
     WANT: ClassVar[bool]
+
+    @classmethod
+    def of(cls, name: str, want: bool, doc: str) -> OperationClass:
+        """The condition ``name``: true when the region is occupied (``want``) or empty."""
+        ports = (*COMMON, MAX_AGE)
+        return variant(cls, manifest(CAP, name, OperationKind.CONDITION, doc, *ports), WANT=want)
 
     def start(self, call: OperationCall) -> StartResult:
         args = _Args(call)
@@ -181,38 +180,24 @@ class _RegionCondition(_OccupancyOp):
         return FeedJob(feed, state.clock, decide, state.clock() - max_age, state.refresh_period)
 
 
-class IsOccupied(_RegionCondition):
-    """occupancy.is_occupied."""
-
-    WANT = True
-    MANIFEST = manifest(
-        CAP,
-        "is_occupied",
-        OperationKind.CONDITION,
-        "True when something (not the table, not the robot) is in the region.",
-        *COMMON,
-        MAX_AGE,
-    )
+IsOccupied = _RegionCondition.of(
+    "is_occupied", True, "True when something (not the table, not the robot) is in the region."
+)
+IsEmpty = _RegionCondition.of(
+    "is_empty", False, "True when nothing (but the table or the robot) is in the region."
+)
 
 
-class IsEmpty(_RegionCondition):
-    """occupancy.is_empty."""
-
-    WANT = False
-    MANIFEST = manifest(
-        CAP,
-        "is_empty",
-        OperationKind.CONDITION,
-        "True when nothing (but the table or the robot) is in the region.",
-        *COMMON,
-        MAX_AGE,
-    )
-
-
-class _WaitForRegion(_OccupancyOp):
+class _WaitForRegion(StatefulOperation["OccupancyState"]):
     """``wait_until_occupied`` / ``wait_until_empty``: poll frames until it turns so."""
 
     WANT: ClassVar[bool]
+
+    @classmethod
+    def of(cls, name: str, want: bool, doc: str) -> OperationClass:
+        """The action ``name``: waits until the region is occupied (``want``) or empty."""
+        ports = (*COMMON, TIMEOUT, PERIOD)
+        return variant(cls, manifest(CAP, name, OperationKind.ACTION, doc, *ports), WANT=want)
 
     def start(self, call: OperationCall) -> StartResult:
         args = _Args(call)
@@ -248,37 +233,15 @@ class _WaitForRegion(_OccupancyOp):
         return job
 
 
-class WaitUntilOccupied(_WaitForRegion):
-    """occupancy.wait_until_occupied."""
-
-    WANT = True
-    MANIFEST = manifest(
-        CAP,
-        "wait_until_occupied",
-        OperationKind.ACTION,
-        "Waits until something is in the region; fails after the timeout.",
-        *COMMON,
-        TIMEOUT,
-        PERIOD,
-    )
+WaitUntilOccupied = _WaitForRegion.of(
+    "wait_until_occupied", True, "Waits until something is in the region; fails after the timeout."
+)
+WaitUntilEmpty = _WaitForRegion.of(
+    "wait_until_empty", False, "Waits until the region is clear; fails after the timeout."
+)
 
 
-class WaitUntilEmpty(_WaitForRegion):
-    """occupancy.wait_until_empty."""
-
-    WANT = False
-    MANIFEST = manifest(
-        CAP,
-        "wait_until_empty",
-        OperationKind.ACTION,
-        "Waits until the region is clear; fails after the timeout.",
-        *COMMON,
-        TIMEOUT,
-        PERIOD,
-    )
-
-
-class CountPoints(_OccupancyOp):
+class CountPoints(StatefulOperation["OccupancyState"]):
     """``count_points``: a fresh frame's occupant points in the region."""
 
     MANIFEST = manifest(
@@ -287,7 +250,7 @@ class CountPoints(_OccupancyOp):
         OperationKind.QUERY,
         "How many points of a fresh frame are in the region (table and robot left out).",
         *COMMON,
-        PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="the occupant points counted"),
+        output("count", ParamType.NUMBER, doc="the occupant points counted"),
     )
 
     def start(self, call: OperationCall) -> StartResult:

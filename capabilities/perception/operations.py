@@ -18,22 +18,22 @@ import weakref
 from typing import TYPE_CHECKING, Any
 
 from capabilities.base import Capability, CapabilityEnv
-from capabilities.kit import camera, camera_port, manifest
+from capabilities.kit import (
+    OperationKind,
+    StatefulOperation,
+    camera,
+    camera_port,
+    manifest,
+    number,
+    object_model,
+    output,
+    pose,
+)
 from capabilities.perception.config import SETTINGS, RecognitionConfig
 from capabilities.perception.errors import PerceptionError
 from capabilities.world_model import Detection, WorldModel
 from engine.error_types import ErrorType
-from engine.operations import (
-    Direction,
-    Job,
-    OperationCall,
-    OperationFailed,
-    OperationKind,
-    PortSpec,
-    number,
-    object_model,
-    pose,
-)
+from engine.operations import Job, OperationCall, OperationFailed
 from engine.types import ObjectModel, ParamType, Pose
 
 __all__ = ["SOURCE_PREFIX", "capability"]
@@ -103,14 +103,7 @@ CAMERA = camera_port()
 OBJECT = object_model("object", doc="the object class (a model name)")
 
 
-class _PerceptionOp:
-    """An operation over the capability's per-cell state (:class:`_Env`)."""
-
-    def __init__(self, env: CapabilityEnv) -> None:
-        self._env: _Env = env.state
-
-
-class DetectObjects(_PerceptionOp):
+class DetectObjects(StatefulOperation[_Env]):
     """perception.detect_objects: one look, recognised on a worker thread."""
 
     MANIFEST = manifest(
@@ -120,13 +113,11 @@ class DetectObjects(_PerceptionOp):
         "Looks through a camera and recognises the known objects on the table "
         "(point cloud matched to the object models).",
         CAMERA,
-        PortSpec(
-            "count", (ParamType.NUMBER,), Direction.OUT, doc="how many objects were recognised"
-        ),
+        output("count", ParamType.NUMBER, doc="how many objects were recognised"),
     )
 
     def start(self, call: OperationCall) -> Job:
-        env = self._env
+        env = self._state
         camera = env.camera(call.input(CAMERA))
         recognizer = env.shared.recognizer(env.library, env.config)
         tracker = env.shared.tracker(env.world, camera.name, env.library)
@@ -156,7 +147,7 @@ class DetectObjects(_PerceptionOp):
         return job
 
 
-class ObjectFound(_PerceptionOp):
+class ObjectFound(StatefulOperation[_Env]):
     """perception.object_found."""
 
     MANIFEST = manifest(
@@ -168,10 +159,10 @@ class ObjectFound(_PerceptionOp):
     )
 
     def start(self, call: OperationCall) -> Job:
-        return Job.answer(bool(self._env.seen(call.input(OBJECT))))
+        return Job.answer(bool(self._state.seen(call.input(OBJECT))))
 
 
-class ObjectPose(_PerceptionOp):
+class ObjectPose(StatefulOperation[_Env]):
     """perception.object_pose: the most confident detection's pose."""
 
     MANIFEST = manifest(
@@ -180,11 +171,11 @@ class ObjectPose(_PerceptionOp):
         OperationKind.QUERY,
         "The pose of the most confidently recognised object of a class.",
         OBJECT,
-        PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the object is"),
+        output("pose", ParamType.POSE, doc="where the object is"),
     )
 
     def start(self, call: OperationCall) -> Job:
-        seen = self._env.seen(call.input(OBJECT))
+        seen = self._state.seen(call.input(OBJECT))
         if not seen:
             raise OperationFailed(
                 f"{_name(call.input(OBJECT))} has not been seen", ErrorType.NOT_FOUND
@@ -193,7 +184,7 @@ class ObjectPose(_PerceptionOp):
         return Job.done()
 
 
-class ObjectsOfClass(_PerceptionOp):
+class ObjectsOfClass(StatefulOperation[_Env]):
     """perception.objects_of_class: how many, and their poses."""
 
     MANIFEST = manifest(
@@ -202,18 +193,18 @@ class ObjectsOfClass(_PerceptionOp):
         OperationKind.QUERY,
         "How many objects of a class the last look recognised, and their poses.",
         OBJECT,
-        PortSpec("count", (ParamType.NUMBER,), Direction.OUT, doc="how many"),
-        PortSpec("poses", (ParamType.ANY,), Direction.OUT, doc="their poses, most confident first"),
+        output("count", ParamType.NUMBER, doc="how many"),
+        output("poses", ParamType.ANY, doc="their poses, most confident first"),
     )
 
     def start(self, call: OperationCall) -> Job:
-        seen = self._env.seen(call.input(OBJECT))
+        seen = self._state.seen(call.input(OBJECT))
         call.write("count", float(len(seen)))
         call.write("poses", [d.pose for d in seen])
         return Job.done()
 
 
-class PlateType(_PerceptionOp):
+class PlateType(StatefulOperation[_Env]):
     """perception.plate_type: the plate model nearest a pose."""
 
     NEAR = pose("near", Pose(), doc="the plate nearest this pose (default: nearest the robot base)")
@@ -225,8 +216,8 @@ class PlateType(_PerceptionOp):
         "Which plate (by its holes) lies nearest to a pose.",
         NEAR,
         WITHIN,
-        PortSpec("model", (ParamType.OBJECT,), Direction.OUT, doc="the plate's model"),
-        PortSpec("pose", (ParamType.POSE,), Direction.OUT, doc="where the plate is"),
+        output("model", ParamType.OBJECT, doc="the plate's model"),
+        output("pose", ParamType.POSE, doc="where the plate is"),
     )
 
     def start(self, call: OperationCall) -> Job:
@@ -234,9 +225,9 @@ class PlateType(_PerceptionOp):
         within = call.input(self.WITHIN)
         plates = [
             d
-            for name in self._env.library.names()
-            if self._env.library.get(name).extra.get("holes")
-            for d in self._env.seen(name)
+            for name in self._state.library.names()
+            if self._state.library.get(name).extra.get("holes")
+            for d in self._state.seen(name)
         ]
         ranked = sorted(plates, key=lambda d: math.dist(d.pose.position, near.position))
         if not ranked or math.dist(ranked[0].pose.position, near.position) > within:

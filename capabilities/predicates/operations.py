@@ -10,23 +10,21 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any, ClassVar
 
-from capabilities.base import Capability, CapabilityEnv
-from capabilities.kit import manifest
-from capabilities.predicates.collision import TOOL, PredicateError
-from capabilities.predicates.settings import DIRECTIONS, SETTINGS
-from engine.operations import (
+from capabilities.base import Capability, CapabilityEnv, OperationClass
+from capabilities.kit import (
     InPort,
-    Job,
-    OperationCall,
-    OperationFailed,
     OperationKind,
-    OperationManifest,
-    StartResult,
+    StatefulOperation,
     duration,
+    manifest,
     number,
     object_model,
     text,
+    variant,
 )
+from capabilities.predicates.collision import TOOL, PredicateError
+from capabilities.predicates.settings import DIRECTIONS, SETTINGS
+from engine.operations import Job, OperationCall, OperationFailed, StartResult
 from engine.types import ObjectModel, Pose
 
 if TYPE_CHECKING:  # the geometry (numpy) loads with the first cell's setup
@@ -54,11 +52,8 @@ def _name(model: Any) -> str:
     return model.name if isinstance(model, ObjectModel) else str(model)
 
 
-class _Predicate:
+class _Predicate(StatefulOperation["PredicatesState"]):
     """A predicate over the per-cell state; a PredicateError fails the node with its text."""
-
-    def __init__(self, env: CapabilityEnv) -> None:
-        self._state: PredicatesState = env.state
 
     def start(self, call: OperationCall) -> StartResult:
         try:
@@ -84,24 +79,20 @@ MARGIN = number(
 )
 
 
-def _relation_manifest(relation: str) -> OperationManifest:
-    return manifest(
-        CAP,
-        relation,
-        CONDITION,
-        f"True when object_a is {relation.replace('_', ' ')} object_b (centres, "
-        "along the frame's axes: front +x, left +y, up +z).",
-        OBJECT_A,
-        OBJECT_B,
-        FRAME,
-        MARGIN,
-    )
-
-
 class _Relation(_Predicate):
     """``left_of``, ``right_of``, ``in_front_of``, ``behind``, ``up_from``, ``down_from``."""
 
     RELATION: ClassVar[str]
+
+    @classmethod
+    def of(cls, relation: str) -> OperationClass:
+        """The operation ``relation`` (a key of ``DIRECTIONS``)."""
+        doc = (
+            f"True when object_a is {relation.replace('_', ' ')} object_b (centres, "
+            "along the frame's axes: front +x, left +y, up +z)."
+        )
+        ports = (OBJECT_A, OBJECT_B, FRAME, MARGIN)
+        return variant(cls, manifest(CAP, relation, CONDITION, doc, *ports), RELATION=relation)
 
     def _start(self, call: OperationCall) -> Job:
         from capabilities.predicates.geometry import box_center, offset_in_frame
@@ -136,46 +127,8 @@ class _Relation(_Predicate):
         raise PredicateError(f"unknown frame {name!r}; frames: {', '.join(FRAMES)}")
 
 
-class LeftOf(_Relation):
-    """predicates.left_of."""
-
-    RELATION = "left_of"
-    MANIFEST = _relation_manifest(RELATION)
-
-
-class RightOf(_Relation):
-    """predicates.right_of."""
-
-    RELATION = "right_of"
-    MANIFEST = _relation_manifest(RELATION)
-
-
-class InFrontOf(_Relation):
-    """predicates.in_front_of."""
-
-    RELATION = "in_front_of"
-    MANIFEST = _relation_manifest(RELATION)
-
-
-class Behind(_Relation):
-    """predicates.behind."""
-
-    RELATION = "behind"
-    MANIFEST = _relation_manifest(RELATION)
-
-
-class UpFrom(_Relation):
-    """predicates.up_from."""
-
-    RELATION = "up_from"
-    MANIFEST = _relation_manifest(RELATION)
-
-
-class DownFrom(_Relation):
-    """predicates.down_from."""
-
-    RELATION = "down_from"
-    MANIFEST = _relation_manifest(RELATION)
+RELATIONS = tuple(_Relation.of(relation) for relation in DIRECTIONS)
+"""``left_of``, ``right_of``, ``in_front_of``, ``behind``, ``up_from``, ``down_from``."""
 
 
 WINDOW = duration("window", 0.5, doc="judge the detections of this last stretch of time")
@@ -186,6 +139,11 @@ class _Moving(_Predicate):
     """``is_moving`` (WANT True) or ``is_stationary`` (WANT False) over a time window."""
 
     WANT: ClassVar[bool]
+
+    @classmethod
+    def of(cls, name: str, want: bool, doc: str) -> OperationClass:
+        """The operation ``name``, true when the object moves (``want``) or stays."""
+        return variant(cls, manifest(CAP, name, CONDITION, doc, OBJECT, WINDOW, SPEED), WANT=want)
 
     def _start(self, call: OperationCall) -> Job:
         state = self._state
@@ -207,35 +165,15 @@ class _Moving(_Predicate):
         return _verdict(moving == self.WANT, text)
 
 
-class IsMoving(_Moving):
-    """predicates.is_moving."""
-
-    WANT = True
-    MANIFEST = manifest(
-        CAP,
-        "is_moving",
-        CONDITION,
-        "True when the object's detections moved faster than the speed.",
-        OBJECT,
-        WINDOW,
-        SPEED,
-    )
-
-
-class IsStationary(_Moving):
-    """predicates.is_stationary."""
-
-    WANT = False
-    MANIFEST = manifest(
-        CAP,
-        "is_stationary",
-        CONDITION,
-        "True when the object's detections stayed (slower than the speed); "
-        "false when too few were seen.",
-        OBJECT,
-        WINDOW,
-        SPEED,
-    )
+IsMoving = _Moving.of(
+    "is_moving", True, "True when the object's detections moved faster than the speed."
+)
+IsStationary = _Moving.of(
+    "is_stationary",
+    False,
+    "True when the object's detections stayed (slower than the speed); "
+    "false when too few were seen.",
+)
 
 
 TOLERANCE = number("tolerance", 0.003, unit="m", doc="surfaces this close count as touching")
@@ -247,6 +185,14 @@ class _Contact(_Predicate):
 
     LIMIT: ClassVar[InPort[float]]  # TOLERANCE (touching) or DISTANCE (near_collision)
     TOOL: ClassVar[bool]
+
+    @classmethod
+    def of(cls, name: str, doc: str) -> OperationClass:
+        """The operation ``name``: ``[tool_]touching`` or ``[tool_]near_collision``."""
+        limit = DISTANCE if name.endswith("near_collision") else TOLERANCE
+        tool = name.startswith("tool_")
+        ports = (OBJECT, limit) if tool else (OBJECT_A, OBJECT_B, limit)
+        return variant(cls, manifest(CAP, name, CONDITION, doc, *ports), LIMIT=limit, TOOL=tool)
 
     def _start(self, call: OperationCall) -> Job:
         state = self._state
@@ -270,62 +216,16 @@ class _Contact(_Predicate):
         )
 
 
-class Touching(_Contact):
-    """predicates.touching."""
-
-    LIMIT, TOOL = TOLERANCE, False
-    MANIFEST = manifest(
-        CAP,
-        "touching",
-        CONDITION,
-        "True when the two objects' shapes touch or overlap.",
-        OBJECT_A,
-        OBJECT_B,
-        TOLERANCE,
-    )
-
-
-class NearCollision(_Contact):
-    """predicates.near_collision."""
-
-    LIMIT, TOOL = DISTANCE, False
-    MANIFEST = manifest(
-        CAP,
-        "near_collision",
-        CONDITION,
-        "True when the two objects' shapes are closer than the distance (touching included).",
-        OBJECT_A,
-        OBJECT_B,
-        DISTANCE,
-    )
-
-
-class ToolTouching(_Contact):
-    """predicates.tool_touching."""
-
-    LIMIT, TOOL = TOLERANCE, True
-    MANIFEST = manifest(
-        CAP,
-        "tool_touching",
-        CONDITION,
-        "True when the tool touches or overlaps the object.",
-        OBJECT,
-        TOLERANCE,
-    )
-
-
-class ToolNearCollision(_Contact):
-    """predicates.tool_near_collision."""
-
-    LIMIT, TOOL = DISTANCE, True
-    MANIFEST = manifest(
-        CAP,
-        "tool_near_collision",
-        CONDITION,
-        "True when the tool is closer to the object than the distance (touching included).",
-        OBJECT,
-        DISTANCE,
-    )
+Touching = _Contact.of("touching", "True when the two objects' shapes touch or overlap.")
+NearCollision = _Contact.of(
+    "near_collision",
+    "True when the two objects' shapes are closer than the distance (touching included).",
+)
+ToolTouching = _Contact.of("tool_touching", "True when the tool touches or overlaps the object.")
+ToolNearCollision = _Contact.of(
+    "tool_near_collision",
+    "True when the tool is closer to the object than the distance (touching included).",
+)
 
 
 def setup(env: CapabilityEnv) -> PredicatesState:
@@ -345,12 +245,7 @@ def capability() -> Capability:
         setup=setup,
     )
     cap.add(
-        LeftOf,
-        RightOf,
-        InFrontOf,
-        Behind,
-        UpFrom,
-        DownFrom,
+        *RELATIONS,
         IsMoving,
         IsStationary,
         Touching,

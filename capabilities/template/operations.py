@@ -6,11 +6,13 @@ The one shape of a capability module (copy it):
    and docs; a cell file gives them in its ``capabilities.<CAP>`` block);
 2. a per-cell state class and ``setup(env)`` that makes it (py_trees' ``setup()``): what
    the operations of one cell share, made once per cell from the checked settings;
-3. its input ports, made with the typed constructors of :mod:`engine.operations`
-   (``text``, ``number``, ``duration``, ``flag``, ``pose``...);
+3. its input ports, made with the typed constructors :mod:`capabilities.kit` re-exports
+   (``text``, ``number``, ``duration``, ``flag``, ``pose``...), output ports with
+   ``output``;
 4. per operation, one class: ``MANIFEST = manifest(CAP, ...)`` listing its ports,
    ``__init__(env)`` (the registry makes one per leaf; ``env.state`` is what ``setup``
-   made) and ``start(call)``, which reads each input through its port (``call.input(COLOUR)``
+   made, kept as ``self._state`` by the base ``StatefulOperation[LampState]``) and
+   ``start(call)``, which reads each input through its port (``call.input(COLOUR)``
    is a ``str``) and returns a ``Job`` (``Job.done()``, ``Job.failed(why)``,
    ``Job.answer(flag)``, or a running job);
 5. ``capability()``: the capability with every operation class added.
@@ -19,9 +21,9 @@ The one shape of a capability module (copy it):
 from __future__ import annotations
 
 from capabilities.base import Capability, CapabilityEnv
-from capabilities.kit import Setting, manifest
+from capabilities.kit import OperationKind, Setting, StatefulOperation, manifest, text
 from capabilities.template.backend import INTERFACE, LampBackend
-from engine.operations import Job, OperationCall, OperationKind, text
+from engine.operations import Job, OperationCall
 
 __all__ = ["COLOUR", "SETTINGS", "LampIsLit", "LampState", "capability", "setup"]
 
@@ -50,7 +52,7 @@ def setup(env: CapabilityEnv) -> LampState:
 COLOUR = text("colour", "green", doc="which light", choices=("green", "amber", "red"))
 
 
-class LampIsLit:
+class LampIsLit(StatefulOperation[LampState]):
     """template.lamp_is_lit: reads the lamp through the cell's backend and answers at once."""
 
     MANIFEST = manifest(
@@ -60,9 +62,6 @@ class LampIsLit:
         "True when the stack light shows the given colour.",
         COLOUR,
     )
-
-    def __init__(self, env: CapabilityEnv) -> None:
-        self._state: LampState = env.state
 
     def start(self, call: OperationCall) -> Job:
         return Job.answer(self._state.is_lit(call.input(COLOUR)))

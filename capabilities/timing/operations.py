@@ -10,9 +10,9 @@ condition, can run on the cell and needs no inputs.
 from __future__ import annotations
 
 from capabilities.base import Capability, CapabilityEnv
-from capabilities.kit import manifest
+from capabilities.kit import InPort, OperationKind, manifest, text
 from capabilities.timing.until import ConditionRunner, OperationsLookup, WaitUntilJob
-from engine.operations import InPort, Job, OperationCall, OperationKind, text
+from engine.operations import Job, OperationCall
 from engine.types import ParamType
 
 __all__ = ["CONDITION", "TIMEOUT", "WaitUntil", "capability"]

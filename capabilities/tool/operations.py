@@ -13,10 +13,10 @@ from collections.abc import Callable
 from capabilities.base import Capability, CapabilityEnv
 from capabilities.gripper.backend import GRIPPER, SUCTION, GripperBackend
 from capabilities.jobs import chain_jobs, job_from_handle
-from capabilities.kit import manifest
+from capabilities.kit import OperationKind, manifest
 from capabilities.motion.backend import ARM, ArmBackend
 from capabilities.tool.backend import SuctionBackend
-from engine.operations import Job, OperationCall, OperationKind
+from engine.operations import Job, OperationCall
 from engine.types import Pose
 
 __all__ = ["capability", "APPROACH_HEIGHT", "LIFT_HEIGHT"]
