@@ -439,10 +439,16 @@ class MainWindow(QMainWindow):
         self.files.new_plan()
 
     def open_plan(self, path: str | Path | None = None) -> bool:
-        return self.files.open_plan(path)
+        if not self.files.open_plan(path):
+            return False
+        self.cells.use_plan_scene()
+        return True
 
     def offer_recoveries(self) -> bool:
-        return self.files.offer_recoveries()
+        if not self.files.offer_recoveries():
+            return False
+        self.cells.use_plan_scene()
+        return True
 
     def _run_entries(self, node_id: str) -> list[tuple[str, Callable[[], None]]]:
         """The run commands of a node's context menu: resume from it after a run ended."""

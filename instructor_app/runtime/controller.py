@@ -187,13 +187,12 @@ class RunController(QObject):
 
     def reset_cell(self, scene: str = "") -> bool:
         """Put the cell back to its start (see CellSession.reset); False while a plan runs
-        or a cell opens. ``scene``: the simulated scene to start from instead (the plan's
-        own).
+        or a cell opens. ``scene``: the simulated scene to start from (the plan's own; "":
+        the session's default).
         """
         if self.is_running or self.session.opening:
             return False
-        if scene and self.session.name == "sim":
-            self.session.scene = scene
+        self.session.scene = scene or self.session.default_scene
         self.session.reset()
         self.log_message.emit(f"The {self.session.name} cell was reset", "info")
         return True
