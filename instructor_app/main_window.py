@@ -283,6 +283,7 @@ class MainWindow(QMainWindow):
     def _wire_run(self) -> None:
         controller, views = self.controller, self.views
         controller.statuses_changed.connect(views.canvas.set_statuses)
+        controller.nodes_halted.connect(views.canvas.set_halted)
         controller.failures_described.connect(views.canvas.set_failure_tips)
         views.canvas.commands.run_entries = self._run_entries
         controller.inner_statuses_changed.connect(views.inside.set_statuses)

@@ -73,6 +73,8 @@ class RunController(QObject):
         failures_described(object): node id -> "error type: message" of the nodes that failed.
         inner_statuses_changed(object): runtime id ("instance/inner") -> Status inside subtree
             instances; None when a new run starts.
+        nodes_halted(list): ids of the nodes that were running when the run was stopped (or
+            ended by an error): halted, they keep their last status.
     """
 
     # object, not dict: a dict signal goes through QVariantMap and turns Status into str.
@@ -87,6 +89,7 @@ class RunController(QObject):
     inner_statuses_changed = Signal(object)
     failure_changed = Signal(str, str)
     failures_described = Signal(object)
+    nodes_halted = Signal(list)
 
     def __init__(
         self,
@@ -360,6 +363,10 @@ class RunController(QObject):
         if event.status is Status.FAILURE:
             failed, message = self._deepest_failure()
         self._set_failure(failed, message or (event.message if failed else ""))
+        if event.reason != "finished":
+            halted = [k for k, v in self._statuses.items() if v is Status.RUNNING]
+            if halted:
+                self.nodes_halted.emit(halted)
         if self._running:
             self._running = []
             self.running_nodes_changed.emit([])
