@@ -382,8 +382,24 @@ class RunController(QObject):
         return f"Run of {name} ended: {event.status.value} after {event.tick} ticks"
 
     def _label(self, node_id: str) -> str:
-        node = self._plan.find(node_id) if self._plan is not None else None
-        return node.label if node is not None else node_id
+        """What the log calls a node; inside an instance (runtime id "instance/inner"), the
+        instance's label then the inner node's: "greet > say".
+        """
+        plan = self._plan
+        if plan is None:
+            return node_id
+        first, *inner = node_id.split("/")
+        node = plan.find(first)
+        labels = []
+        for part in inner:
+            if node is None or node.subtree is None:
+                return node_id
+            labels.append(node.label)
+            subtree = plan.subtree(node.subtree)
+            node = subtree.tree.find(part) if subtree is not None else None
+        if node is None:
+            return node_id
+        return " > ".join([*labels, node.label])
 
     def _set_state(self, state: ExecutorState) -> None:
         if state != self._state:
