@@ -379,6 +379,9 @@ class MainWindow(QMainWindow):
     def _on_summary(self, errors: int, warnings: int) -> None:
         parts = [f"{errors} error{'s' * (errors != 1)}"] if errors else []
         parts += [f"{warnings} warning{'s' * (warnings != 1)}"] if warnings else []
+        if not parts and self.document.plan.tree is None:
+            self.problems_label.setText("Empty plan: add a node from the palette")
+            return
         self.problems_label.setText(", ".join(parts) or "No problems")
 
     # ------------------------------------------------------------------ start page
