@@ -371,15 +371,21 @@ class RunController(QObject):
             self._running = []
             self.running_nodes_changed.emit([])
         level = "info" if event.status is Status.SUCCESS else "warning"
-        self.log_message.emit(self._summary(event), level)
+        self.log_message.emit(self._summary(event, failed, message), level)
         self._set_state(ExecutorState.FINISHED)
         self.run_finished.emit(RunOutcome(event, failed, message, dict(self._statuses)))
 
-    def _summary(self, event: RunFinished) -> str:
+    def _summary(self, event: RunFinished, failed: str = "", message: str = "") -> str:
+        """The run's last log line; a failed run names the leaf that made it fail and why
+        (not the composites above it, "Selector failed").
+        """
         name = (self._plan.name if self._plan else "") or "the plan"
         if event.reason != "finished":
             return f"Run of {name} {event.reason} after {event.tick} ticks"
-        return f"Run of {name} ended: {event.status.value} after {event.tick} ticks"
+        text = f"Run of {name} ended: {event.status.value} after {event.tick} ticks"
+        if event.status is Status.FAILURE and failed:
+            text += f": {self._label(failed)} failed" + (f": {message}" if message else "")
+        return text
 
     def _label(self, node_id: str) -> str:
         """What the log calls a node; inside an instance (runtime id "instance/inner"), the
