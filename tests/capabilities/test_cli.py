@@ -249,4 +249,6 @@ def test_a_failed_run_names_the_leaf_that_made_it_fail_and_why(tmp_path: Path) -
     code, out, _ = run_cli("run", "--cell", "none", "--rate", "200", _save(tmp_path, tree))
     last = out.strip().splitlines()[-1]
     assert code == 1 and "FAILURE" in last
-    assert "look for the cup failed: no cup in view" in last and "selector failed" not in out.lower()
+    assert (
+        "look for the cup failed: no cup in view" in last and "selector failed" not in out.lower()
+    )
