@@ -217,7 +217,9 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             restore()
             if answerer is not None:
                 answerer.detach()
-        code = _report(result, plan, tree.blackboard.snapshot(), out, args.verbose)
+        code = _report(
+            result, plan, tree.blackboard.snapshot(), out, args.verbose, failures.cause()
+        )
         _report_caught(failures, out)
         return code
 
@@ -244,8 +246,16 @@ def _wait(executor: Executor, timeout: float | None, holds: HoldWatch, out: Text
 
 
 def _report(
-    result: RunFinished, plan: PlanSpec, board: dict[str, Any], out: TextIO, verbose: bool
+    result: RunFinished,
+    plan: PlanSpec,
+    board: dict[str, Any],
+    out: TextIO,
+    verbose: bool,
+    cause: str = "",
 ) -> int:
+    """Print the run's result (with ``cause``, the failing leaf and its message, when it
+    failed); returns the exit code.
+    """
     if verbose and board:
         for key, value in sorted(board.items()):
             print(f"  {key} = {format_value(value)}", file=out)
@@ -256,7 +266,8 @@ def _report(
     if result.reason == "error":
         print(f"{name}: engine error after {result.tick} ticks: {result.message}", file=out)
         return EXIT_FAILURE
-    note = f" ({result.message})" if result.message else ""
+    why = cause if result.status is Status.FAILURE and cause else result.message
+    note = f" ({why})" if why else ""
     print(f"{name}: {result.status.value} after {result.tick} ticks{note}", file=out)
     return EXIT_SUCCESS if result.status is Status.SUCCESS else EXIT_FAILURE
 

@@ -40,6 +40,7 @@ from engine.node import Node
 from engine.operations import Direction, OperationNotFound, OperationSource
 from engine.spec import NodeKind, NodeSpec, PlanSpec
 from engine.tree import BehaviorTree, Root
+from engine.types import with_article
 
 __all__ = ["BuildError", "build_tree", "ROOT_ID"]
 
@@ -208,7 +209,7 @@ def _build_node(spec: NodeSpec, build: _Build, path: str, scope: Scope) -> Node:
         ]
         if isinstance(node, (OperationLeaf, Wait)):
             if children:
-                raise BuildError(path, f"a {spec.kind.value} node cannot have children")
+                raise BuildError(path, f"{with_article(spec.kind.value)} node cannot have children")
         else:
             node.set_children(children)
     except BuildError:

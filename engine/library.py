@@ -54,6 +54,7 @@ from engine.plan_reader import read_subtree
 from engine.plan_writer import dump_json, encode_subtree, write_atomic
 from engine.processes import process_alive
 from engine.spec import SubtreeSpec
+from engine.types import with_article
 from resources import resource_path
 
 __all__ = [
@@ -187,7 +188,7 @@ def check_folder(root: Path, folder: str) -> Path:
         return LibraryError(f"library folder {folder!r} refused: {why}; expected {expected}")
 
     if not isinstance(folder, str):
-        raise refused(f"a {type(folder).__name__}, not text")
+        raise refused(f"{with_article(type(folder).__name__)}, not text")
     if any(ord(char) < 32 or ord(char) == 127 for char in folder):
         raise refused("it holds a control character")
     windows = PureWindowsPath(folder)

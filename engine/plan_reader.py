@@ -38,7 +38,7 @@ from engine.spec import (
     SubtreeSpec,
     new_id,
 )
-from engine.types import ParamType, Waypoint
+from engine.types import ParamType, Waypoint, with_article
 
 __all__ = ["load_plan", "loads_plan", "read_subtree"]
 
@@ -195,7 +195,9 @@ class _Reader:
             node.op = self.operation_id(obj.get("op"), at(path, "op"))
         elif "op" in obj:
             self.fail(
-                at(path, "op"), "no op: only operation nodes have one", f"a {kind.value} node"
+                at(path, "op"),
+                "no op: only operation nodes have one",
+                f"{with_article(kind.value)} node",
             )
         if kind is NodeKind.SUBTREE:
             if "subtree" not in obj:
@@ -209,7 +211,7 @@ class _Reader:
             self.fail(
                 at(path, "subtree"),
                 "no subtree: only subtree instances have one",
-                f"a {kind.value} node",
+                f"{with_article(kind.value)} node",
             )
         params = self.mapping(obj.get("params", {}), at(path, "params"), "port -> binding")
         node.params = {

@@ -87,6 +87,30 @@ class FailureLog:
             for node, by in order
         ]
 
+    def cause(self) -> str:
+        """Why the run failed, as a user reads it: the last failure no ancestor carried on
+        past that is not only a child's failure, "pick cup failed: no cup in view" ("" when
+        none: the run did not fail). A composite's own words ("every option failed") are
+        left out: the leaf under it says more.
+        """
+        with self._lock:
+            results = {node: list(entries) for node, entries in self._results.items()}
+        last: tuple[int, str, str] | None = None
+        for node_id, entries in results.items():
+            if node_id == ROOT_ID:  # the root fails only when the plan's top node did
+                continue
+            for tick, status, message in entries:
+                if status is not Status.FAILURE or self._child_failed(results, node_id, tick):
+                    continue
+                if self._catcher(results, node_id, tick) is None and (
+                    last is None or tick >= last[0]
+                ):
+                    last = (tick, node_id, message)
+        if last is None:
+            return ""
+        _, node_id, message = last
+        return f"{self._name(node_id)} failed" + (f": {message}" if message else "")
+
     def _child_failed(
         self, results: dict[str, list[tuple[int, Status, str]]], node: str, tick: int
     ) -> bool:

@@ -16,6 +16,7 @@ from typing import Any
 from engine.errors import EngineError
 
 __all__ = [
+    "with_article",
     "ParamType",
     "Pose",
     "JointConfig",
@@ -53,6 +54,11 @@ class ValueShapeError(EngineError):
         self.got = got
         self.got_text = _describe(got) if got_text is None else got_text
         super().__init__(f"{path}: expected {expected}, got {self.got_text}")
+
+
+def with_article(word: str) -> str:
+    """``word`` after the article its sound takes: "a Pose", "an ObjectModel"."""
+    return f"{'an' if word[:1].lower() in 'aeiou' else 'a'} {word}"
 
 
 def _describe(value: Any) -> str:

@@ -54,7 +54,10 @@ from engine.validation_ports import (
     type_names,
 )
 
+EMPTY_PLAN = "The plan is empty: add a node to start from."
+
 __all__ = [
+    "EMPTY_PLAN",
     "ERROR",
     "WARNING",
     "Severity",
@@ -98,7 +101,7 @@ def validate_plan(
     """
     check = Check(plan, source)
     if plan.tree is None:
-        check.add(ERROR, None, "The plan is empty: add a node to start from.")
+        check.add(ERROR, None, EMPTY_PLAN)
     _check_parameters(check)
     for name, types in (given or {}).items():
         check.writers.setdefault(name, []).append(Writer(f"the input {name}", types))

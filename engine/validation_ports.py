@@ -20,7 +20,7 @@ from engine.operations import (
     PortSpec,
 )
 from engine.spec import Binding, NodeSpec, PlanSpec, SubtreeSpec
-from engine.types import ParamType, check_value
+from engine.types import ParamType, check_value, with_article
 
 __all__ = [
     "ERROR",
@@ -280,7 +280,10 @@ def any_type(a: Sequence[ParamType], b: Sequence[ParamType]) -> bool:
 
 def type_names(types: Sequence[ParamType]) -> str:
     """The types in words: "a Pose or a Waypoint" ("a value" for none)."""
-    names = [f"a {ParamType(t).value}" for t in types]
+    names = [
+        "a value of any type" if t == ParamType.ANY else with_article(ParamType(t).value)
+        for t in types
+    ]
     return " or ".join(names) if names else "a value"
 
 

@@ -72,8 +72,8 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--seed", type=int, default=0, help="scene seed of the simulated cell")
     parser.add_argument(
         "--scene",
-        help="scene of the simulated cell (name or path; default "
-        "cup_to_bin), e.g. tending for the wire bender",
+        help="scene of the simulated cell when the plan names none (name or path; default "
+        "cup_to_bin), e.g. tending for the wire bender; a plan that names one opens on it",
     )
     parser.add_argument("--run", action="store_true", help="run the plan once it is open")
     parser.add_argument(
@@ -139,7 +139,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         except FileNotFoundError as exc:
             print(f"error: {exc}", file=sys.stderr)
             return EXIT_BAD_INPUT
-        args.scene = args.scene or plan_scene(args.plan)  # the scene the plan was taught on
     if args.screenshot and not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
         os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
     app = QApplication.instance() or QApplication(
@@ -158,6 +157,8 @@ def _start_session(args: argparse.Namespace, speed: float | None) -> CellSession
     before the cell asked for is open; the window then opens that one in the background.
     """
     session = CellSession(args.cell, seed=args.seed, scene=args.scene, speed=speed)
+    if args.plan:  # the scene the plan was taught on, so that opening it reopens nothing
+        session.scene = plan_scene(args.plan) or args.scene
     session.open("none")
     return session
 

@@ -110,6 +110,15 @@ class CellControl(QObject):
         else:
             self.show_message("Stop the run before resetting the cell.")
 
+    def use_plan_scene(self) -> None:
+        """The simulated cell holds the scene the plan names (the default when it names
+        none): it reopens with it now, or, while a plan runs, on the next reset.
+        """
+        if self.controller.is_running:
+            self.session.scene = self.document.plan.scene or self.session.default_scene
+        elif self.session.use_scene(self.document.plan.scene):
+            self.show_message(f"Loading the scene {self.session.scene}…", 0)
+
     def _show_cell(self, name: str) -> None:
         """Select ``name`` in the cell chooser (a cell file gets an entry of its own)."""
         index = self.combo.findData(name)

@@ -283,6 +283,7 @@ class MainWindow(QMainWindow):
     def _wire_run(self) -> None:
         controller, views = self.controller, self.views
         controller.statuses_changed.connect(views.canvas.set_statuses)
+        controller.nodes_halted.connect(views.canvas.set_halted)
         controller.failures_described.connect(views.canvas.set_failure_tips)
         views.canvas.commands.run_entries = self._run_entries
         controller.inner_statuses_changed.connect(views.inside.set_statuses)
@@ -379,6 +380,9 @@ class MainWindow(QMainWindow):
     def _on_summary(self, errors: int, warnings: int) -> None:
         parts = [f"{errors} error{'s' * (errors != 1)}"] if errors else []
         parts += [f"{warnings} warning{'s' * (warnings != 1)}"] if warnings else []
+        if not parts and self.document.plan.tree is None:
+            self.problems_label.setText("Empty plan: add a node from the palette")
+            return
         self.problems_label.setText(", ".join(parts) or "No problems")
 
     # ------------------------------------------------------------------ start page
@@ -440,10 +444,16 @@ class MainWindow(QMainWindow):
         self.files.new_plan()
 
     def open_plan(self, path: str | Path | None = None) -> bool:
-        return self.files.open_plan(path)
+        if not self.files.open_plan(path):
+            return False
+        self.cells.use_plan_scene()
+        return True
 
     def offer_recoveries(self) -> bool:
-        return self.files.offer_recoveries()
+        if not self.files.offer_recoveries():
+            return False
+        self.cells.use_plan_scene()
+        return True
 
     def _run_entries(self, node_id: str) -> list[tuple[str, Callable[[], None]]]:
         """The run commands of a node's context menu: resume from it after a run ended."""

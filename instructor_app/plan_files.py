@@ -19,6 +19,17 @@ from instructor_app.document.editing import PlanDocument
 from instructor_app.document.model import DocumentError
 from instructor_app.settings import AppSettings, is_shipped_example
 
+UNNAMED = ("", "Untitled plan")  # the names of a plan the user never named
+
+
+def plan_name_of(path: Path) -> str:
+    """The plan name a file suggests: ``pick cups.costar.json`` -> "pick cups"."""
+    name = path.name
+    for suffix in (".costar.json", ".json"):
+        if name.endswith(suffix):
+            return name[: -len(suffix)] or name
+    return name
+
 
 class PlanFiles(QObject):
     """The plan's file operations.
@@ -105,7 +116,14 @@ class PlanFiles(QObject):
         path = Path(chosen)
         if not path.name.endswith(".json"):
             path = path.with_name(path.name + ".costar.json")
-        return self._save_to(path)
+        named = self.document.plan.name not in UNNAMED
+        if not named:  # a plan the user never named takes the file's name (one undo step)
+            self.document.rename_plan(plan_name_of(path))
+        if self._save_to(path):
+            return True
+        if not named:
+            self.document.undo_stack.undo()
+        return False
 
     def _save_to(self, path: Path) -> bool:
         try:

@@ -89,6 +89,8 @@ class CanvasActions(QObject):
             owner.addAction(action)
             self.actions[name] = action
         self.update_enabled()
+        # Paste follows the plan too: a node that stops taking children, an emptied plan.
+        document.plan_changed.connect(self.update_enabled)
 
     def _guard(self, handler: Callable[[], None]) -> Callable[[], None]:
         def run() -> None:
@@ -100,8 +102,18 @@ class CanvasActions(QObject):
         return run
 
     def update_enabled(self) -> None:
-        """Enable the node commands only when a node is selected."""
-        has_node = bool(self.selected())
+        """Enable the node commands only when a node is selected; Paste as child when the
+        selected node takes a child, or the plan is empty (the pasted nodes become it).
+        """
+        selected = self.selected()
+        has_node = bool(selected)
+        plan = self.document.plan
+        if selected:
+            node = plan.find(selected[0])
+            pastes = node is not None and can_have_child(node)
+        else:
+            pastes = plan.tree is None
+        self.actions["paste"].setEnabled(pastes)
         for name in (
             "delete",
             "cut",

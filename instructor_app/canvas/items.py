@@ -42,7 +42,7 @@ from PySide6.QtWidgets import (
 
 from engine.status import Status
 from instructor_app.canvas import overview
-from instructor_app.canvas.style import RGB, STATUS_COLOURS, NodeLook
+from instructor_app.canvas.style import HALTED_COLOUR, RGB, STATUS_COLOURS, NodeLook
 
 __all__ = ["TreeNode", "TreeNodeItem", "NODE_WIDTH", "DETAIL_LOD", "PARENT_PORT", "CHILD_PORT"]
 
@@ -165,6 +165,7 @@ class TreeNodeItem(NodeItem):
         self.look: NodeLook | None = None
         self.status: Status | None = None
         self.status_tip = ""  # why the node failed in the last run ("error type: message")
+        self.halted = False  # it was running when the run was stopped
         self.index_badge = 0  # 1-based place among its parent's children; 0: none
         self.hidden_count = 0  # descendants hidden by collapsing; 0: expanded
         self._elided = ""
@@ -192,6 +193,8 @@ class TreeNodeItem(NodeItem):
             tip = f"{look.title}\n{look.broken}".strip()
         if self.status_tip:
             tip = f"{look.title}\nFailed: {self.status_tip}"
+        elif self.halted:
+            tip = f"{look.title}\nHalted: it was running when the run was stopped"
         self.setToolTip(tip)
 
     def set_status_tip(self, text: str) -> None:
@@ -201,9 +204,29 @@ class TreeNodeItem(NodeItem):
             self._update_tip()
 
     def set_status(self, status: Status | None) -> None:
+        """Colour the body by ``status`` (None: the category colour); ends a halt."""
+        if self.halted:
+            self.halted = False
+            self._update_tip()
+            self.update()
         if status is not self.status:
             self.status = status
             self.update()
+
+    def set_halted(self) -> None:
+        """Show that the node was halted by a stop (it keeps its last status)."""
+        if not self.halted:
+            self.halted = True
+            self._update_tip()
+            self.update()
+
+    def fill(self) -> RGB:
+        """The body's colour: the halt's, the status's, else the category's."""
+        if self.halted:
+            return HALTED_COLOUR
+        if self.status is not None:
+            return STATUS_COLOURS[self.status]
+        return self.look.fill if self.look is not None else (200, 200, 200)
 
     def set_badges(self, index: int, hidden: int) -> None:
         if (index, hidden) != (self.index_badge, self.hidden_count):
@@ -361,8 +384,7 @@ class TreeNodeItem(NodeItem):
         self, painter: QPainter, option: QStyleOptionGraphicsItem, widget: QWidget | None = None
     ) -> None:
         look = self.look
-        base = look.fill if look is not None else (200, 200, 200)
-        fill = _qcolor(STATUS_COLOURS[self.status]) if self.status is not None else _qcolor(base)
+        fill = _qcolor(self.fill())
         rect = QRectF(0.0, 0.0, self._width, self._height)
         scale = painter.worldTransform().m11()  # the view neither rotates nor shears
         if scale < DETAIL_LOD:

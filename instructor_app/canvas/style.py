@@ -19,6 +19,7 @@ __all__ = [
     "RGB",
     "NodeLook",
     "STATUS_COLOURS",
+    "HALTED_COLOUR",
     "look_of",
     "default_title",
     "binding_text",
@@ -32,6 +33,8 @@ STATUS_COLOURS: dict[Status, RGB] = {
     Status.SUCCESS: (96, 192, 96),
     Status.FAILURE: (226, 84, 72),
 }
+# A node that was running when the run was stopped: halted, no longer running.
+HALTED_COLOUR: RGB = (140, 162, 200)
 
 _COMPOSITE_FILL: RGB = (250, 250, 250)
 _DECORATOR_FILL: RGB = (214, 214, 214)

@@ -8,7 +8,7 @@ so undo and redo are the document's.
 from __future__ import annotations
 
 import json
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 
 from PySide6.QtCore import QMimeData, QPoint, QPointF, QRectF, Signal
 from PySide6.QtGui import QAction
@@ -133,6 +133,27 @@ class CanvasView(QWidget):
                 node.item.set_status(None)
                 node.item.set_status_tip("")
         self._statused.clear()
+
+    def set_halted(self, node_ids: Sequence[str]) -> None:
+        """Show the named nodes as halted: they were running when the run was stopped."""
+        nodes = self.mirror.nodes
+        for node_id in node_ids:
+            node = nodes.get(node_id)
+            if node is not None:
+                node.item.set_halted()
+                self._statused.add(node_id)
+
+    def is_halted(self, node_id: str) -> bool:
+        """True when the node shows as halted by a stop."""
+        return self.mirror.nodes[node_id].item.halted
+
+    def fill_of(self, node_id: str) -> tuple[int, int, int]:
+        """The node's body colour as painted (halt, status or category)."""
+        return self.mirror.nodes[node_id].item.fill()
+
+    def tooltip_of(self, node_id: str) -> str:
+        """The node's tooltip."""
+        return self.mirror.nodes[node_id].item.toolTip()
 
     def status_of(self, node_id: str) -> Status | None:
         """The status the node shows (None: none)."""

@@ -19,7 +19,9 @@ from PySide6.QtGui import (
     QDragEnterEvent,
     QDragMoveEvent,
     QDropEvent,
+    QFocusEvent,
     QKeyEvent,
+    QMouseEvent,
     QPainter,
     QPainterPath,
     QPaintEvent,
@@ -94,6 +96,32 @@ class CanvasViewer(NodeViewer):
         item = self.node_item_at(self.mapToScene(event.pos()))
         self.context_requested.emit(item.id if item is not None else "", event.globalPos())
         event.accept()
+
+    # ------------------------------------------------------------------ modifiers
+
+    # NodeGraphQt decides what a click does (select, Ctrl: deselect, Shift: extend, Alt: pan)
+    # from ALT_state / CTRL_state / SHIFT_state, which only its key events set. A modifier's
+    # own key events do not say reliably whether it is still held, and its release may go to
+    # another widget (a shortcut, a dock taking the focus): a stale Ctrl made the next click
+    # deselect instead of select. The mouse event's modifiers are what is held now.
+
+    def _sync_modifiers(self, modifiers: Qt.KeyboardModifier) -> None:
+        self.ALT_state = bool(modifiers & Qt.KeyboardModifier.AltModifier)
+        self.CTRL_state = bool(modifiers & Qt.KeyboardModifier.ControlModifier)
+        self.SHIFT_state = bool(modifiers & Qt.KeyboardModifier.ShiftModifier)
+
+    def mousePressEvent(self, event: QMouseEvent) -> None:
+        self._sync_modifiers(event.modifiers())
+        super().mousePressEvent(event)
+
+    def mouseMoveEvent(self, event: QMouseEvent) -> None:
+        self._sync_modifiers(event.modifiers())
+        super().mouseMoveEvent(event)
+
+    def focusOutEvent(self, event: QFocusEvent) -> None:
+        self._sync_modifiers(Qt.KeyboardModifier.NoModifier)  # the release goes elsewhere
+        self._cursor_text.setVisible(False)
+        super().focusOutEvent(event)
 
     def keyPressEvent(self, event: QKeyEvent) -> None:
         super().keyPressEvent(event)

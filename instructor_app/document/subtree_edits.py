@@ -92,11 +92,12 @@ class SubtreeEditor:
     def use_saved(
         self, node_id: str, saved: SubtreeSpec, open_ports: Sequence[OpenPort] = ()
     ) -> str:
-        """Replace a node with an instance of ``saved`` that does what it did; returns its id."""
+        """Replace a node with an instance of ``saved`` that does what it did, named as the
+        subtree (the name chosen when saving); returns its id.
+        """
         doc = self.document
         original = doc.node(node_id)
         instance = instance_of(saved, original, open_ports)
-        instance.name = original.name or saved.name
         doc.push(UseSavedSubtreeCommand(doc, node_id, saved, instance))
         return instance.id
 

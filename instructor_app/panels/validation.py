@@ -11,7 +11,7 @@ from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtWidgets import QStyle, QTreeWidget, QTreeWidgetItem, QVBoxLayout, QWidget
 
 from engine.operations import OperationSource
-from engine.validation import ERROR, Problem, SubtreeSource, validate_plan
+from engine.validation import EMPTY_PLAN, ERROR, Problem, SubtreeSource, validate_plan
 from instructor_app.document import PlanDocument
 
 __all__ = ["ValidationPanel", "DEBOUNCE_MS"]
@@ -25,7 +25,8 @@ class ValidationPanel(QWidget):
 
     Signals:
         node_selected(str): the user picked a problem that concerns this node.
-        summary_changed(int, int): the numbers of errors and warnings after a validation.
+        summary_changed(int, int): the numbers of errors and warnings after a validation (an
+            empty plan counts none).
         problems_changed(list): every problem after a validation (the inspector marks fields).
     """
 
@@ -80,7 +81,10 @@ class ValidationPanel(QWidget):
     def revalidate(self) -> None:
         """Validate now (the timer calls this after edits pause)."""
         self._timer.stop()
-        self._problems = validate_plan(self.document.plan, self._registry, self._library)
+        problems = validate_plan(self.document.plan, self._registry, self._library)
+        # An empty plan (a new one) is where the user starts, not a mistake: the summary
+        # gives a hint instead (a run still refuses it and says why).
+        self._problems = [p for p in problems if p.message != EMPTY_PLAN]
         self._show()
         errors = sum(1 for p in self._problems if p.severity == ERROR)
         self.summary_changed.emit(errors, len(self._problems) - errors)

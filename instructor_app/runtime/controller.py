@@ -77,6 +77,8 @@ class RunController(QObject):
             ("" ""). The nodes that were running stay shown RUNNING while it is held.
         inner_statuses_changed(object): runtime id ("instance/inner") -> Status inside subtree
             instances; None when a new run starts.
+        nodes_halted(list): ids of the nodes that were running when the run was stopped (or
+            ended by an error): halted, they keep their last status.
     """
 
     # object, not dict: a dict signal goes through QVariantMap and turns Status into str.
@@ -92,6 +94,7 @@ class RunController(QObject):
     failure_changed = Signal(str, str)
     failures_described = Signal(object)
     hold_changed = Signal(str, str)
+    nodes_halted = Signal(list)
 
     def __init__(
         self,
@@ -199,13 +202,12 @@ class RunController(QObject):
 
     def reset_cell(self, scene: str = "") -> bool:
         """Put the cell back to its start (see CellSession.reset); False while a plan runs
-        or a cell opens. ``scene``: the simulated scene to start from instead (the plan's
-        own).
+        or a cell opens. ``scene``: the simulated scene to start from (the plan's own; "":
+        the session's default).
         """
         if self.is_running or self.session.opening:
             return False
-        if scene and self.session.name == "sim":
-            self.session.scene = scene
+        self.session.scene = scene or self.session.default_scene
         self.session.reset()
         self.log_message.emit(f"The {self.session.name} cell was reset", "info")
         return True
@@ -408,23 +410,49 @@ class RunController(QObject):
         if event.status is Status.FAILURE:
             failed, message = self._deepest_failure()
         self._set_failure(failed, message or (event.message if failed else ""))
+        if event.reason != "finished":
+            halted = [k for k, v in self._statuses.items() if v is Status.RUNNING]
+            if halted:
+                self.nodes_halted.emit(halted)
         if self._running:
             self._running = []
             self.running_nodes_changed.emit([])
         level = "info" if event.status is Status.SUCCESS else "warning"
-        self.log_message.emit(self._summary(event), level)
+        self.log_message.emit(self._summary(event, failed, message), level)
         self._set_state(ExecutorState.FINISHED)
         self.run_finished.emit(RunOutcome(event, failed, message, dict(self._statuses)))
 
-    def _summary(self, event: RunFinished) -> str:
+    def _summary(self, event: RunFinished, failed: str = "", message: str = "") -> str:
+        """The run's last log line; a failed run names the leaf that made it fail and why
+        (not the composites above it, "Selector failed").
+        """
         name = (self._plan.name if self._plan else "") or "the plan"
         if event.reason != "finished":
             return f"Run of {name} {event.reason} after {event.tick} ticks"
-        return f"Run of {name} ended: {event.status.value} after {event.tick} ticks"
+        text = f"Run of {name} ended: {event.status.value} after {event.tick} ticks"
+        if event.status is Status.FAILURE and failed:
+            text += f": {self._label(failed)} failed" + (f": {message}" if message else "")
+        return text
 
     def _label(self, node_id: str) -> str:
-        node = self._plan.find(node_id) if self._plan is not None else None
-        return node.label if node is not None else node_id
+        """What the log calls a node; inside an instance (runtime id "instance/inner"), the
+        instance's label then the inner node's: "greet > say".
+        """
+        plan = self._plan
+        if plan is None:
+            return node_id
+        first, *inner = node_id.split("/")
+        node = plan.find(first)
+        labels = []
+        for part in inner:
+            if node is None or node.subtree is None:
+                return node_id
+            labels.append(node.label)
+            subtree = plan.subtree(node.subtree)
+            node = subtree.tree.find(part) if subtree is not None else None
+        if node is None:
+            return node_id
+        return " > ".join([*labels, node.label])
 
     def _set_state(self, state: ExecutorState) -> None:
         if state != self._state:

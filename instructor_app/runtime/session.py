@@ -68,6 +68,12 @@ class _Arrival:
     registry: CapabilityRegistry | None
     error: str
     generation: int
+    scene: str | None  # the scene it was opened with
+
+
+def _is_sim(cell: ClosableCell | None) -> bool:
+    """True for a simulated cell (built in or from a cell file): it has a scene."""
+    return cell is not None and cell.name == "sim"
 
 
 class CellSession(QObject):
@@ -78,7 +84,8 @@ class CellSession(QObject):
         seed: scene seed of the simulated cell.
         speed: real-time factor of the simulated cell (1.0 real time; None as fast as
             possible).
-        scene: scene of the simulated cell (default: the cell's default).
+        scene: scene of the simulated cell when a plan names none (None: the cell's default);
+            :meth:`use_scene` picks a plan's.
         opener: opens a cell by name (tests may inject a fake); called on the worker thread
             by :meth:`open_in_background`.
         registry_factory: makes the registry for an open cell.
@@ -115,7 +122,8 @@ class CellSession(QObject):
         self.name = name
         self.seed = seed
         self.speed = speed
-        self.scene = scene
+        self.default_scene = scene  # for a plan that names no scene
+        self.scene = scene  # the one the simulated cell opens with
         self._opener = opener
         self._registry_factory = registry_factory
         self.cell: ClosableCell | None = None
@@ -174,16 +182,16 @@ class CellSession(QObject):
         # robot that does not answer (the pool's threads are joined at exit).
         threading.Thread(
             target=self._open_on_worker,
-            args=(wanted, generation),
+            args=(wanted, generation, self.scene),
             name="costar-cell-open",
             daemon=True,
         ).start()
         return True
 
-    def _open_on_worker(self, wanted: str, generation: int) -> None:
+    def _open_on_worker(self, wanted: str, generation: int, scene: str | None) -> None:
         cell, registry, error = None, None, ""
         try:
-            cell = self._opener(wanted, seed=self.seed, scene=self.scene, speed=self.speed)
+            cell = self._opener(wanted, seed=self.seed, scene=scene, speed=self.speed)
             # here too: the first registry imports every capability (over half a second)
             registry = self._registry_factory(cell)
         except CellError as exc:
@@ -196,7 +204,7 @@ class CellSession(QObject):
         if generation != self._generation:
             return
         with contextlib.suppress(RuntimeError):  # the session is gone: nobody to tell
-            self._arrived.emit(_Arrival(wanted, cell, registry, error, generation))
+            self._arrived.emit(_Arrival(wanted, cell, registry, error, generation, scene))
 
     def _on_arrived(self, arrival: object) -> None:
         """(GUI thread) The worker's result: use the cell, or keep the old one and say why."""
@@ -210,6 +218,10 @@ class CellSession(QObject):
             self._failed(arrival.error)
             return
         self._use(arrival.name, arrival.cell, True, arrival.registry)
+        if arrival.scene != self.scene and _is_sim(arrival.cell):
+            # a plan chose another scene while this one opened: open that one (Run waits)
+            self.open_in_background(arrival.name)
+            return
         self.cell_ready.emit(True)
 
     def _failed(self, message: str) -> bool:
@@ -248,13 +260,26 @@ class CellSession(QObject):
         """
         if self._opening:
             return False
-        if self.cell is not None and self.cell.name != "sim":
+        if self.cell is not None and not _is_sim(self.cell):
             self._use(self.name, self.cell, close_old_in_background=False)
             return True
         cell, self.cell = self.cell, None
         if cell is not None:
             cell.close()
         return self.open(self.name)
+
+    def use_scene(self, scene: str | None) -> bool:
+        """Make ``scene`` (a plan's; "" or None: the default) the scene the simulated cell
+        opens with, and reopen the simulated cell in the background when it holds another
+        (as :meth:`open_in_background`). True when a reopening started.
+        """
+        wanted = scene or self.default_scene
+        if wanted == self.scene:
+            return False
+        self.scene = wanted
+        if not _is_sim(self.cell) or self._opening:
+            return False  # the next opening or reset uses it
+        return self.open_in_background(self.name)
 
     def clock(self) -> Callable[[], float] | None:
         """The open cell's clock (simulated time on the simulated cell), None if none open."""

@@ -237,3 +237,18 @@ def test_ops_into_a_closed_pipe_ends_quietly() -> None:
     )  # fmt: skip
     assert proc.stdout.count("\n") == 1
     assert "Traceback" not in proc.stderr
+
+
+def test_a_failed_run_names_the_leaf_that_made_it_fail_and_why(tmp_path: Path) -> None:
+    text = Binding.fixed("no cup in view", ParamType.TEXT)
+    look = NodeSpec(
+        NodeKind.OPERATION, "look for the cup", op="debug.fail", params={"message": text}
+    )
+    choose = NodeSpec(NodeKind.SELECTOR, children=[look])
+    tree = NodeSpec(NodeKind.SEQUENCE, children=[choose])
+    code, out, _ = run_cli("run", "--cell", "none", "--rate", "200", _save(tmp_path, tree))
+    last = out.strip().splitlines()[-1]
+    assert code == 1 and "FAILURE" in last
+    assert (
+        "look for the cup failed: no cup in view" in last and "selector failed" not in out.lower()
+    )

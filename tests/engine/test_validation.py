@@ -413,3 +413,21 @@ def test_deep_and_large_plans() -> None:
     assert check(node) == []
     wide = seq(*(n for _ in range(500) for n in (find(), move())))
     assert check(wide) == []
+
+
+def test_messages_put_an_before_a_vowel() -> None:
+    """'a ObjectModel', 'a inverter node': the article follows the word's sound."""
+    import json
+
+    from engine.files import loads_plan
+    from engine.plan_format import PlanFileError
+    from engine.validation_ports import type_names
+
+    assert type_names([ParamType.OBJECT]) == "an ObjectModel"
+    assert type_names([ParamType.POSE, ParamType.OBJECT]) == "a Pose or an ObjectModel"
+    assert type_names([ParamType.ANY]) == "a value of any type"
+    doc = {"format": "costar-plan", "format_version": 2, "name": "x",
+           "tree": {"kind": "inverter", "id": "n1", "op": "debug.succeed"}}  # fmt: skip
+    with pytest.raises(PlanFileError) as caught:
+        loads_plan(json.dumps(doc), "x.costar.json")
+    assert "an inverter node" in str(caught.value) and "a inverter" not in str(caught.value)

@@ -324,3 +324,31 @@ def test_a_folder_outside_the_library_is_refused_in_the_window(
     )
     assert _node(window, "part").kind is NodeKind.SEQUENCE
     assert not list(Path(os.environ[LIBRARY_ENV]).rglob("*.subtree.json"))
+
+
+def test_a_saved_selection_is_an_instance_named_by_its_subtree_and_logs_name_its_nodes(
+    qtbot: Any, window: MainWindow, tmp_path: Path
+) -> None:
+    say = _op("say", "debug.log", message=_text("hello"))
+    group = NodeSpec(NodeKind.SEQUENCE, "Sequence", children=[say])  # as the palette names it
+    _open(window, tmp_path, PlanSpec(NodeSpec(NodeKind.SEQUENCE, "main", children=[group]), "p"))
+
+    def dialog(*args: Any) -> SaveSubtreeDialog:
+        made = SaveSubtreeDialog(*args)
+        made.name_field.setText("greet")
+        made.folder_field.setText("tests")
+        made.exec = lambda: QDialog.DialogCode.Accepted  # type: ignore[method-assign]
+        return made
+
+    window.library.dialog_factory = dialog
+    select(window, group.id)
+    with qtbot.waitSignal(window.library.save_finished, timeout=20000) as finished:
+        window.library.actions["save_subtree"].trigger()
+    assert finished.args[0] is not None, "the save failed"
+    instance = window.document.plan.tree.children[0]  # type: ignore[union-attr]
+    assert instance.kind is NodeKind.SUBTREE and instance.label == "greet"
+    assert window.views.canvas.mirror.nodes[instance.id].item.look.title == "greet"
+    assert run_to_end(qtbot, window).status is Status.SUCCESS
+    said = [line for line in window.views.log.lines() if line.endswith("hello")]
+    assert said and all("greet" in line and "say" in line for line in said), said
+    assert not any(instance.id in line for line in window.views.log.lines())

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import re
 from pathlib import Path
 
@@ -12,6 +13,7 @@ from engine.build import build_tree
 from engine.executor import run_to_end
 from engine.files import dump_plan, load_plan
 from engine.validation import has_errors, validate_plan
+from resources import plan_argument
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "resources" / "examples"
 DEBUG_PLANS = sorted(
@@ -92,3 +94,14 @@ class _InterfacesOnly:
 
     def clock(self) -> float:
         return 0.0
+
+
+def test_the_command_an_example_suggests_names_it_as_costar_finds_it() -> None:
+    """``costar run cup_to_bin.costar.json`` only works inside resources/examples: a shipped
+    plan is run as ``example:NAME`` (its path under the examples, without .costar.json).
+    """
+    for path in sorted(EXAMPLES.rglob("*.costar.json")):
+        description = json.loads(path.read_text(encoding="utf-8")).get("description", "")
+        for plan in re.findall(r"costar run (\S+)", description):
+            assert plan.startswith("example:"), f"{path.name} suggests costar run {plan}"
+            assert Path(plan_argument(plan.rstrip("."))).is_file()  # as the CLI reads it

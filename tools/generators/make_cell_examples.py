@@ -156,7 +156,7 @@ def cup_to_bin() -> PlanSpec:
         "markers, check the cup was found, query both poses, grasp the cup at its pose with the "
         "grasp of its object model and drop it over the bin. When the cup is not visible the selector falls "
         "back to WAIT (forced to fail) and the root, which runs until success, looks again. "
-        "Run it with: costar run cup_to_bin.costar.json --cell sim --seed N. Runs to SUCCESS.",
+        "Run it with: costar run example:cup_to_bin --seed N. Runs to SUCCESS.",
     )
 
 
@@ -171,7 +171,7 @@ def cup_to_bin_vision() -> PlanSpec:
         "camera's point cloud is matched to the cup and waste-bin models, the plan checks the "
         "cup was found, queries both poses, grasps the cup at its pose with the grasp of its "
         "object model and drops it over the bin; when the cup is not recognised it waits and looks "
-        "again. Run it with: costar run cup_to_bin_vision.costar.json --cell sim --seed N.",
+        "again. Run it with: costar run example:cup_to_bin_vision --seed N.",
     )
 
 

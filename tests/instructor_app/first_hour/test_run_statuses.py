@@ -1,5 +1,5 @@
-"""Stop keeps the last statuses on the canvas until the next run; the status bar says
-"Running…", not "Run running".
+"""Stop keeps the last statuses on the canvas until the next run, the running nodes shown as
+halted; the status bar says "Running…", not "Run running".
 """
 
 from __future__ import annotations
@@ -9,6 +9,7 @@ from typing import Any
 
 from engine.files import dump_plan
 from engine.status import Status
+from instructor_app.canvas.style import HALTED_COLOUR, STATUS_COLOURS
 from instructor_app.runtime.session import CellSession
 from tests.instructor_app.gui_driver import make_window, node_named
 from tests.instructor_app.runtime.plans import endless_plan
@@ -26,12 +27,15 @@ def test_stop_keeps_the_last_statuses_until_the_next_run(
     assert window.statusBar().currentMessage() == "Running…"
     with qtbot.waitSignal(window.controller.run_finished, timeout=10_000):
         window.run_actions.stop.trigger()
-    # Where the run stopped stays visible: the halt's resets do not grey the nodes.
-    assert canvas.status_of(slow) is Status.RUNNING
-    assert canvas.status_of(top) is Status.RUNNING
+    # Where the run stopped stays visible, as halted (not amber: nothing runs any more); the
+    # halt's resets do not grey the nodes.
+    for node_id in (slow, top):
+        assert canvas.is_halted(node_id) and canvas.status_of(node_id) is Status.RUNNING
+        assert canvas.fill_of(node_id) == HALTED_COLOUR != STATUS_COLOURS[Status.RUNNING]
+        assert "halted" in canvas.tooltip_of(node_id).lower()
     # The next run starts from grey.
     window.run_actions.run.trigger()
-    assert canvas.status_of(top) in (Status.IDLE, None)
+    assert canvas.status_of(top) in (Status.IDLE, None) and not canvas.is_halted(top)
     qtbot.waitUntil(lambda: canvas.status_of(slow) is Status.RUNNING)
     with qtbot.waitSignal(window.controller.run_finished, timeout=10_000):
         window.run_actions.stop.trigger()

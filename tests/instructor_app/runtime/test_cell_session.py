@@ -148,3 +148,31 @@ def test_what_an_opening_does_is_said_in_words(tmp_path: Path) -> None:
     assert opening_words(str(ur)) == "Connecting to 10.0.0.5…"
     assert opening_words(str(simulated)) == "Starting the simulated cell of sim.cell.json…"
     assert opening_words(str(broken)) == "Opening broken.cell.json…"
+
+
+def test_a_plans_scene_reopens_the_simulated_cell_and_the_default_comes_back(qtbot: Any) -> None:
+    opener = BlockingOpener()
+    opener.go.set()
+    session = CellSession("sim", scene="tending", opener=opener)
+    session.open()
+    assert not session.use_scene("tending"), "the cell holds it already"
+    with qtbot.waitSignal(session.cell_ready):
+        assert session.use_scene("kitting")
+    assert opener.opened[-1][1]["scene"] == "kitting"
+    opener.go.clear()  # a plan naming none opens while that opening is under way ...
+    assert session.use_scene("")
+    assert not session.use_scene("kitting") and session.opening == "sim"
+    with qtbot.waitSignal(session.cell_ready, timeout=5000):
+        opener.go.set()  # ... so the scene chosen meanwhile is opened after it
+    assert opener.opened[-1][1]["scene"] == "kitting" and session.scene == "kitting"
+    session.close()
+
+
+def test_a_plans_scene_waits_on_a_cell_without_a_scene(qtbot: Any) -> None:
+    opener = Opener()
+    session = CellSession("none", opener=opener)
+    session.open()
+    assert not session.use_scene("kitting") and len(opener.opened) == 1
+    session.open("sim")
+    assert opener.opened[-1][0] == "sim" and opener.opened[-1][1]["scene"] == "kitting"
+    session.close()

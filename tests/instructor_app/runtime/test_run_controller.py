@@ -181,3 +181,25 @@ def test_a_failure_shows_its_error_type_in_the_log_the_panel_and_the_canvas_tips
     merged = {k: v for batch in described for k, v in batch.items()}
     assert merged[leaf] == "not_found: no cup"
     assert merged[document.plan.tree.id] == "not_found: inner failed"  # passed up the tree
+
+
+def test_a_failed_runs_summary_names_the_failing_leaf_and_its_message(
+    qtbot: Any, none_session: CellSession
+) -> None:
+    from engine.spec import NodeKind, NodeSpec, PlanSpec
+
+    text = Binding.fixed("no cup in view", ParamType.TEXT)
+    look = NodeSpec(
+        NodeKind.OPERATION, "look for the cup", op="debug.fail", params={"message": text}
+    )
+    tree = NodeSpec(NodeKind.SEQUENCE, children=[NodeSpec(NodeKind.SELECTOR, children=[look])])
+    document = PlanDocument()
+    document.plan = PlanSpec(tree, "cups")
+    controller = RunController(document, none_session, rate_hz=200)
+    logs: list[str] = []
+    controller.log_message.connect(lambda text, _level: logs.append(text))
+    with qtbot.waitSignal(controller.run_finished, timeout=10_000):
+        controller.run()
+    summary = logs[-1]
+    assert summary.startswith("Run of cups ended: FAILURE"), summary
+    assert "look for the cup failed: no cup in view" in summary, summary

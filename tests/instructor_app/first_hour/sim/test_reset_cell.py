@@ -70,3 +70,40 @@ def _push_cup(client: int, cell: Any) -> None:
     pybullet.resetBasePositionAndOrientation(
         body, (pos[0] + 0.1, pos[1], pos[2]), orn, physicsClientId=client
     )
+
+
+def _names(session: CellSession) -> set[str]:
+    return set(session.cell.scene.names())
+
+
+def _settle(qtbot: Any, session: CellSession) -> None:
+    """Wait until no cell is opening (a plan's scene opens in the background)."""
+    qtbot.waitUntil(lambda: not session.opening, timeout=60_000)
+
+
+def test_opening_a_plan_loads_its_scene_and_reset_cell_restores_that_one(
+    qtbot: Any, fast_sim: CellSession, tmp_path: Path
+) -> None:
+    dialogs = ScriptedDialogs()
+    dialogs.open_paths = [
+        str(EXAMPLES / "kitting.costar.json"),
+        str(EXAMPLES / "cup_to_bin.costar.json"),
+    ]
+    window = make_window(qtbot, fast_sim, tmp_path, dialogs)
+    assert "cup" in _names(fast_sim)  # the cell's default scene
+    window.actions_by_name["open"].trigger()  # the kitting example names kitting_handoff
+    _settle(qtbot, fast_sim)
+    assert "plate_3_holes" in _names(fast_sim) and "cup" not in _names(fast_sim)
+    window.actions_by_name["reset_cell"].trigger()
+    assert "plate_3_holes" in _names(fast_sim) and "cup" not in _names(fast_sim)
+    window.actions_by_name["open"].trigger()  # cup to bin names none: the cell's default
+    _settle(qtbot, fast_sim)
+    assert {"cup", "waste_bin"} <= _names(fast_sim) and "plate_3_holes" not in _names(fast_sim)
+    window.actions_by_name["reset_cell"].trigger()
+    assert {"cup", "waste_bin"} <= _names(fast_sim) and "plate_3_holes" not in _names(fast_sim)
+    window.switch_cell("none")
+    _settle(qtbot, fast_sim)
+    window.switch_cell("sim")
+    _settle(qtbot, fast_sim)
+    assert fast_sim.name == "sim" and "plate_3_holes" not in _names(fast_sim)
+    assert {"cup", "waste_bin"} <= _names(fast_sim)
