@@ -16,7 +16,15 @@ from capabilities.cell_features import ClosableCell, ClosesOnExit
 from capabilities.collaboration.console import OperatorConsole
 from capabilities.errors import CapabilityError
 
-__all__ = ["CELL_NAMES", "DEFAULT_SCENE", "CellError", "ManagedCell", "is_cell_file", "open_cell"]
+__all__ = [
+    "CELL_NAMES",
+    "DEFAULT_SCENE",
+    "CellError",
+    "ManagedCell",
+    "cell_argument",
+    "is_cell_file",
+    "open_cell",
+]
 
 CELL_NAMES: tuple[str, ...] = ("none", "sim")
 DEFAULT_SCENE = "cup_to_bin"  # the simulated cell's scene when none is named
@@ -102,6 +110,22 @@ def _lockstep(speed: float | None) -> float | None:
     from capabilities.sim.session import PERCEPTION_S
 
     return PERCEPTION_S
+
+
+def cell_argument(value: str) -> str:
+    """A command line's ``--cell``: a built-in cell name or a cell file's path, checked by
+    name only (the file is read when the cell opens, and its errors come then).
+
+    Raises:
+        argparse.ArgumentTypeError: neither a built-in cell nor a cell file.
+    """
+    import argparse  # here: only the command lines parse arguments
+
+    if value in CELL_NAMES or is_cell_file(value):
+        return value
+    raise argparse.ArgumentTypeError(
+        f"unknown cell {value!r}: expected {', '.join(CELL_NAMES)} or a cell file (*.cell.json)"
+    )
 
 
 def is_cell_file(name: str) -> bool:

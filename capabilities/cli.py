@@ -21,7 +21,7 @@ from typing import Any, NamedTuple, TextIO
 
 from capabilities.base import CapabilityError, CapabilityRegistry
 from capabilities.cell_features import ClosableCell
-from capabilities.cells import CELL_NAMES, CellError, is_cell_file, open_cell
+from capabilities.cells import CellError, cell_argument, open_cell
 from capabilities.collaboration.answers import CONFIRM_MODES, PromptAnswerer
 from capabilities.doctor import cmd_doctor
 from capabilities.faults import hold_check
@@ -350,15 +350,6 @@ def _cmd_trace_show(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     return EXIT_SUCCESS
 
 
-def _cell_argument(value: str) -> str:
-    """A built-in cell name or the path of a cell file."""
-    if value in CELL_NAMES or is_cell_file(value):
-        return value
-    raise argparse.ArgumentTypeError(
-        f"{value!r} is not a cell: {', '.join(CELL_NAMES)}, or a cell file (*.cell.json)"
-    )
-
-
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="costar", description="CoSTAR task plans from the command line."
@@ -366,7 +357,7 @@ def _parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     def add_cell(p: argparse.ArgumentParser) -> None:
-        p.add_argument("--cell", type=_cell_argument, default="sim", help=CELL_HELP)
+        p.add_argument("--cell", type=cell_argument, default="sim", help=CELL_HELP)
         p.add_argument("--seed", type=int, default=0, help="scene seed of the simulated cell")
         p.add_argument(
             "--scene", help="scene of the simulated cell (name or path; default cup_to_bin)"
@@ -407,7 +398,7 @@ def _parser() -> argparse.ArgumentParser:
 
     ops = sub.add_parser("ops", help="list every operation with its parameters")
     ops.add_argument("--json", action="store_true")
-    ops.add_argument("--cell", type=_cell_argument, default="sim", help=CELL_HELP)
+    ops.add_argument("--cell", type=cell_argument, default="sim", help=CELL_HELP)
     ops.set_defaults(func=_cmd_ops)
 
     examples = sub.add_parser("examples", help="list the plans shipped with the application")

@@ -29,7 +29,7 @@ from PySide6.QtCore import QEvent, QEventLoop, QSettings, QTimer
 from PySide6.QtGui import QIcon
 from PySide6.QtWidgets import QApplication, QWidget
 
-from capabilities.cells import CELL_NAMES, is_cell_file
+from capabilities.cells import cell_argument
 from engine.files import plan_scene
 from engine.library import LIBRARY_ENV
 from engine.status import Status
@@ -64,7 +64,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     parser.add_argument(
         "--cell",
-        type=_cell,
+        type=cell_argument,
         default="sim",
         help="the cell to work with: sim (the default, the simulated cell), "
         "none, or a cell file (*.cell.json); it opens after the window shows",
@@ -101,15 +101,6 @@ def _parser() -> argparse.ArgumentParser:
         help="with --screenshot --run: give up after this many seconds (exit 3)",
     )
     return parser
-
-
-def _cell(text: str) -> str:
-    """A built-in cell's name or a cell file (read when it is opened: its errors come then)."""
-    if text in CELL_NAMES or is_cell_file(text):
-        return text
-    raise argparse.ArgumentTypeError(
-        f"unknown cell {text!r}: expected {', '.join(CELL_NAMES)} or a cell file (*.cell.json)"
-    )
 
 
 def _size(text: str) -> tuple[int, int]:

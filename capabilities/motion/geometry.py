@@ -9,6 +9,7 @@ import math
 from collections.abc import Sequence
 
 from engine.types import Pose
+from engine.units import quaternion_to_rpy
 
 __all__ = [
     "axis_rotation",
@@ -45,15 +46,7 @@ def translated(pose: Pose, dx: float, dy: float, dz: float) -> Pose:
 def format_pose_mm(pose: Pose) -> str:
     """A pose as users read it: position in mm, orientation as roll/pitch/yaw in degrees."""
     x, y, z = (v * 1000 for v in pose.position)
-    roll, pitch, yaw = (math.degrees(v) for v in _rpy(pose.orientation))
+    roll, pitch, yaw = (math.degrees(v) for v in quaternion_to_rpy(pose.orientation))
     return (
         f"({x:.1f}, {y:.1f}, {z:.1f}) mm, roll/pitch/yaw ({roll:.1f}, {pitch:.1f}, {yaw:.1f}) deg"
     )
-
-
-def _rpy(q: tuple[float, float, float, float]) -> tuple[float, float, float]:
-    x, y, z, w = q
-    roll = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
-    pitch = math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x))))
-    yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
-    return roll, pitch, yaw
