@@ -25,6 +25,7 @@ from engine.operations import (
     OperationFailed,
     OperationKind,
     OperationManifest,
+    PortRule,
     PortSpec,
     duration,
     flag,
@@ -97,8 +98,13 @@ def manifest(
     doc: str,
     *ports: PortSpec,
     aliases: tuple[str, ...] = (),
+    rules: tuple[PortRule, ...] = (),
 ) -> OperationManifest:
     """The manifest of operation ``capability.name`` (the one manifest helper).
+
+    ``rules`` are checks across its ports (:data:`engine.operations.PortRule`): an input
+    that another input's type or value makes meaningless is a validation error, never
+    accepted and then ignored.
 
     Example::
 
@@ -108,7 +114,9 @@ def manifest(
             MANIFEST = manifest("template", "lamp_is_lit", OperationKind.CONDITION,
                                 "True when the stack light shows the given colour.", COLOUR)
     """
-    return OperationManifest(f"{capability}.{name}", kind, doc, capability, ports, aliases)
+    return OperationManifest(
+        f"{capability}.{name}", kind, doc, capability, ports, aliases, rules=rules
+    )
 
 
 def output(name: str, *types: ParamType, unit: str = "", doc: str = "") -> PortSpec:

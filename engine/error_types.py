@@ -19,6 +19,7 @@ class ErrorType(str, enum.Enum):
     GRASP_FAILED = "grasp_failed"
     OBJECT_LOST = "object_lost"
     NOT_FOUND = "not_found"
+    OCCLUDED = "occluded"  # a look found nothing because something (the arm) hid the view
     PROTECTIVE_STOP = "protective_stop"
     EMERGENCY_STOP = "emergency_stop"
     TIMEOUT = "timeout"

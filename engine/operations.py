@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import enum
 import threading
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass, field
 from typing import Any, Generic, Protocol, TypeVar
 
 from engine.error_types import ErrorType
@@ -29,6 +29,8 @@ from engine.types import (
 
 __all__ = [
     "OperationKind",
+    "BoundPort",
+    "PortRule",
     "Direction",
     "PortSpec",
     "InPort",
@@ -194,6 +196,36 @@ def object_model(name: str, *, doc: str = "") -> InPort[ObjectModel]:
 
 
 @dataclass(frozen=True)
+class BoundPort:
+    """What validation knows of one bound input port, for a :data:`PortRule`.
+
+    Attributes:
+        types: the types its value may have: the fixed value's type, or the types of what
+            writes the reference (``(ParamType.ANY,)`` when that is not known).
+        value: the fixed value, None for a reference.
+        ref: the blackboard name it reads, None for a fixed value.
+    """
+
+    types: tuple[ParamType, ...]
+    value: Any = None
+    ref: str | None = None
+
+    def may_be(self, ptype: ParamType) -> bool:
+        """True when the value may be of ``ptype``."""
+        return ptype in self.types or ParamType.ANY in self.types
+
+    def only(self, ptype: ParamType) -> bool:
+        """True when the value is surely of ``ptype``."""
+        return set(self.types) == {ptype}
+
+
+# A check across an operation's ports: given its bound inputs (port name -> BoundPort;
+# unbound ports are absent), the (port, sentence) of each input it would ignore or cannot
+# use with the others. The sentence names the port; validation adds the node.
+PortRule = Callable[[Mapping[str, BoundPort]], Iterable[tuple[str, str]]]
+
+
+@dataclass(frozen=True)
 class OperationManifest:
     """What an operation is, for the palette, validation and ``costar ops``."""
 
@@ -203,6 +235,9 @@ class OperationManifest:
     capability: str
     ports: tuple[PortSpec, ...] = ()
     aliases: tuple[str, ...] = ()  # former ids that files may still use
+    # Checks across ports (an input that some other input makes meaningless): validation
+    # runs each on the node's bindings and reports what it returns as errors.
+    rules: tuple[PortRule, ...] = field(default=(), compare=False)
 
     def port(self, name: str) -> PortSpec | None:
         for port in self.ports:

@@ -20,6 +20,7 @@ from typing import Any
 
 from engine.kinds import KIND_PORTS, check_setting, kind_port
 from engine.operations import (
+    BoundPort,
     Direction,
     OperationNotFound,
     OperationSource,
@@ -123,6 +124,7 @@ def validate_plan(
             check_instance(check, node, library, stack, validate_plan)
     check_crossings(check)
     _check_writer_types(check)
+    _check_rules(check)
     if plan.tree is not None:
         initial = {p.name for p in plan.parameters if p.value is not None} | set(given or {})
         _check_reads(check, plan.tree, frozenset(initial))
@@ -258,6 +260,28 @@ def _check_operation(check: Check, node: NodeSpec) -> None:
     params = stated(node.params)
     check_bound_ports(check, node, manifest, params)
     check_unbound_ports(check, node, manifest, params)
+
+
+def _check_rules(check: Check) -> None:
+    """The checks across ports that operations declare (``OperationManifest.rules``)."""
+    for _path, node in check.plan.walk():
+        manifest = check.manifests.get(id(node))
+        if manifest is None or not manifest.rules:
+            continue
+        bound: dict[str, BoundPort] = {}
+        for name, binding in stated(node.params).items():
+            port = manifest.port(name)
+            if port is None or port.direction is not Direction.IN:
+                continue
+            if binding.ref is not None:
+                writers = check.writers.get(binding.ref) or []
+                types = tuple({t: None for w in writers for t in w.types}) or (ParamType.ANY,)
+                bound[name] = BoundPort(types, ref=binding.ref)
+            elif binding.type is not None:
+                bound[name] = BoundPort((ParamType(binding.type),), binding.value)
+        for rule in manifest.rules:
+            for port_name, message in rule(bound):
+                check.add(ERROR, node, f"{node.label!r}: {message}", port_name)
 
 
 def _check_writer_types(check: Check) -> None:

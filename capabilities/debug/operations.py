@@ -77,6 +77,8 @@ class _TickJob(Job):
             return RUNNING
         if self._then is FAILURE:
             self.message = self._final_message or "failed on purpose"
+        else:
+            self.message = self._final_message
         return self._then
 
 
@@ -88,7 +90,7 @@ class Running(_Debug):
     """debug.running: RUNNING for some ticks, then the chosen status."""
 
     THEN = text("then", "SUCCESS", doc="status at the end", choices=("SUCCESS", "FAILURE"))
-    MESSAGE = text("message", "", doc="failure message")
+    MESSAGE = text("message", "", doc="the message it ends with (a failure's reason)")
     MANIFEST = manifest(
         CAP,
         "running",

@@ -8,7 +8,7 @@ the tick except :class:`OperationFailed`.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from typing import Any
 
 from capabilities.base import Capability, CapabilityEnv, CapabilityError
@@ -18,10 +18,10 @@ from capabilities.kit import InPort, OperationKind, joints, manifest, number, ou
 from capabilities.motion.backend import ARM, WORLD, ArmBackend, WorldBackend
 from capabilities.motion.geometry import format_pose_mm
 from capabilities.motion.symmetry import SymmetryTable
-from capabilities.motion.targets import TargetResolver
+from capabilities.motion.targets import TargetResolver, reference_set, unused_reference
 from engine.error_types import ErrorType
-from engine.operations import Job, OperationCall, OperationFailed
-from engine.types import JointConfig, ParamType, Pose, Waypoint
+from engine.operations import BoundPort, Job, OperationCall, OperationFailed
+from engine.types import JointConfig, ParamType, Pose, Waypoint, WaypointFrame
 
 __all__ = ["capability", "scale"]
 
@@ -85,6 +85,30 @@ class _ArmOp:
         self._arm: ArmBackend = env.interface(ARM)
 
 
+def _linear_to_joints(target: Waypoint) -> str:
+    return (
+        f"'mode' is linear, but the waypoint {target.name!r} is joint positions, which the arm "
+        "reaches by a joint move: set 'mode' to joint, or teach the waypoint as a pose"
+    )
+
+
+def _move_to_rules(bound: Mapping[str, BoundPort]) -> Iterator[tuple[str, str]]:
+    """move_to's inputs that its target would make it ignore (validation's side of
+    :meth:`TargetResolver.resolve`, which refuses the same at run time for references).
+    """
+    target = bound.get("target")
+    waypoint = target.value if target is not None else None
+    if not isinstance(waypoint, Waypoint):
+        return
+    reference = bound.get("reference")
+    given = reference is not None and (reference.ref is not None or reference_set(reference.value))
+    if given and waypoint.frame in (WaypointFrame.JOINTS, WaypointFrame.WORLD):
+        yield "reference", unused_reference(waypoint)
+    mode = bound.get("mode")
+    if mode is not None and mode.value == "linear" and waypoint.frame is WaypointFrame.JOINTS:
+        yield "mode", _linear_to_joints(waypoint)
+
+
 class MoveTo(_ArmOp):
     """motion.move_to: a pose or a waypoint in any frame, by a joint or a linear move."""
 
@@ -99,8 +123,9 @@ class MoveTo(_ArmOp):
         default="",
         doc="for a relative waypoint: the object's (marker's) pose, or a class name / marker id "
         "to look up; empty: the waypoint's own reference in the world model. For a Pose "
-        "target that is an object's pose: a grasp reference, 'cup' (its model's first grasp) "
-        "or 'cup/rim'",
+        "target: a pose, and the target is taken in its frame; or, the target being an "
+        "object's pose, a grasp reference, 'cup' (its model's first grasp) or 'cup/rim'. "
+        "Not for a waypoint in the world or joints frame",
     )
     MODE = text(
         "mode",
@@ -120,6 +145,7 @@ class MoveTo(_ArmOp):
         MODE,
         SPEED,
         ACCEL,
+        rules=(_move_to_rules,),
     )
 
     def __init__(self, env: CapabilityEnv) -> None:
@@ -129,9 +155,10 @@ class MoveTo(_ArmOp):
     def start(self, call: OperationCall) -> Job:
         mode = call.input(self.MODE)
         current = self._arm.tcp_pose()
-        target = self._resolver.resolve(
-            call.input(self.TARGET), call.input(self.REFERENCE), current
-        )
+        given = call.input(self.TARGET)
+        if mode == "linear" and isinstance(given, Waypoint) and given.frame is WaypointFrame.JOINTS:
+            raise OperationFailed(_linear_to_joints(given))
+        target = self._resolver.resolve(given, call.input(self.REFERENCE), current)
         if target.joints is not None:
             return _joint_move(
                 self._arm, target.joints.positions, call, f"move to {target.describe}"

@@ -6,7 +6,9 @@ the operation, or the world model's best detection of the waypoint's class. Symm
 objects give several equivalent tool poses; they are ordered by how little the wrist has to
 turn from where the tool is now, and the first reachable one is used.
 
-A Pose target with a grasp reference (``"cup"`` or ``"cup/rim"``) is an object's pose, as
+A Pose target with a Pose reference is taken in the reference's frame (``reference *
+target``); a reference with a waypoint in the world or joints frame is an error, never
+ignored. A Pose target with a grasp reference (``"cup"`` or ``"cup/rim"``) is an object's pose, as
 Figure 3's "move to CUP_POSE": the tool goes to that grasp of the object's model, through
 the grasp's approach (:class:`capabilities.object_library.GraspSpec`).
 """
@@ -24,7 +26,14 @@ from capabilities.object_library import ObjectLibraryError
 from engine.operations import OperationFailed
 from engine.types import JointConfig, Pose, Waypoint, WaypointFrame
 
-__all__ = ["ResolvedTarget", "TargetResolver", "symmetric_rotations", "symmetric_tool_poses"]
+__all__ = [
+    "ResolvedTarget",
+    "TargetResolver",
+    "reference_set",
+    "symmetric_rotations",
+    "symmetric_tool_poses",
+    "unused_reference",
+]
 
 _CONTINUOUS_STEPS = 24  # fallbacks tried around a continuous symmetry, 15 deg apart
 
@@ -80,6 +89,21 @@ def symmetric_tool_poses(
     ]
 
 
+def reference_set(reference: Any) -> bool:
+    """True when move_to's ``reference`` says something (a pose, or a non-empty text)."""
+    return reference is not None and not (isinstance(reference, str) and not reference.strip())
+
+
+def unused_reference(target: Waypoint) -> str:
+    """Why a reference cannot go with a waypoint in the world or joints frame."""
+    frame = "joint positions" if target.frame is WaypointFrame.JOINTS else "in the world frame"
+    return (
+        f"'reference' is set, but the waypoint {target.name!r} is {frame}, not relative to an "
+        "object or a marker, so the reference would be ignored: clear 'reference', or teach "
+        "the waypoint relative to the object"
+    )
+
+
 class TargetResolver:
     """Resolves move_to targets against the world model and the object symmetries.
 
@@ -96,12 +120,20 @@ class TargetResolver:
         """Candidate poses for ``target``; raises OperationFailed saying what is missing."""
         if isinstance(target, Pose) and isinstance(reference, str) and reference.strip():
             return self._grasp(target, reference.strip(), current)
+        if isinstance(target, Pose) and isinstance(reference, Pose):
+            return ResolvedTarget(
+                f"pose {format_pose_mm(target)} relative to the reference at "
+                f"{format_pose_mm(reference)}",
+                (reference.compose(target),),
+            )
         if isinstance(target, Pose):
             return ResolvedTarget(f"pose {format_pose_mm(target)}", (target,))
         if not isinstance(target, Waypoint):
             raise OperationFailed(
                 f"the target must be a Pose or a Waypoint, not {type(target).__name__}"
             )
+        if target.frame in (WaypointFrame.JOINTS, WaypointFrame.WORLD) and reference_set(reference):
+            raise OperationFailed(unused_reference(target))
         if target.frame is WaypointFrame.JOINTS:
             return ResolvedTarget(f"waypoint {target.name!r} (joints)", joints=target.joints)
         assert target.pose is not None  # Waypoint checks this for non-joint frames

@@ -97,6 +97,12 @@ def test_running_then_failure_with_a_message(registry: CapabilityRegistry) -> No
     assert ticks(tree) == [FAILURE] and only_leaf(tree).message == "failed on purpose"
 
 
+def test_running_ends_a_success_with_its_message_too(registry: CapabilityRegistry) -> None:
+    # issue 26: no input accepted and then ignored (the message was read only on FAILURE)
+    tree = tree_of(registry, node("debug.running", ticks=0, message="parked"))
+    assert ticks(tree) == [SUCCESS] and only_leaf(tree).message == "parked"
+
+
 def test_running_refuses_a_negative_count(registry: CapabilityRegistry) -> None:
     tree = tree_of(registry, node("debug.running", ticks=-1))
     assert ticks(tree) == [FAILURE]

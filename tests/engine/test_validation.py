@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from typing import Any
 
 import pytest
@@ -10,6 +10,7 @@ from bt_fakes import settings
 
 from engine.operations import (
     Availability,
+    BoundPort,
     Direction,
     Operation,
     OperationKind,
@@ -18,7 +19,7 @@ from engine.operations import (
     PortSpec,
 )
 from engine.spec import Binding, NodeKind, NodeSpec, ParameterDecl, PlanSpec
-from engine.types import ObjectModel, ParamType, Pose
+from engine.types import JointConfig, ObjectModel, ParamType, Pose, Waypoint, WaypointFrame
 from engine.validation import ERROR, WARNING, Problem, has_errors, validate_plan
 
 P = ParamType
@@ -431,3 +432,46 @@ def test_messages_put_an_before_a_vowel() -> None:
     with pytest.raises(PlanFileError) as caught:
         loads_plan(json.dumps(doc), "x.costar.json")
     assert "an inverter node" in str(caught.value) and "a inverter" not in str(caught.value)
+
+
+# ------------------------------------------------------------- checks across ports (rules)
+
+
+def _aim_rule(bound: Mapping[str, BoundPort]) -> Iterator[tuple[str, str]]:
+    """'offset' is used only when 'target' is a Pose."""
+    target = bound.get("target")
+    if "offset" in bound and target is not None and not target.may_be(P.POSE):
+        yield "offset", f"'offset' is ignored with a {target.types[0].value} target"
+
+
+class RuleSource(FakeSource):
+    def __init__(self) -> None:
+        super().__init__()
+        ports = (
+            PortSpec("target", (P.POSE, P.WAYPOINT)),
+            PortSpec("offset", (P.NUMBER,), default=0.0),
+        )
+        aim = OperationManifest(
+            "test.aim", OperationKind.ACTION, "Aim.", "test", ports, rules=(_aim_rule,)
+        )
+        self.by_id[aim.id] = aim
+
+
+def test_a_rule_across_ports_is_an_error_naming_the_node_and_port() -> None:
+    waypoint = Binding.fixed(
+        Waypoint("w", WaypointFrame.JOINTS, joints=JointConfig((0.0,))), P.WAYPOINT
+    )
+    node = op("test.aim", "aim at it", target=waypoint, offset=Binding.fixed(0.1, P.NUMBER))
+    problem = only(validate_plan(PlanSpec(seq(node), "plan"), RuleSource()))
+    assert (problem.severity, problem.node_id, problem.field) == (ERROR, node.id, "offset")
+    assert problem.message == "'aim at it': 'offset' is ignored with a Waypoint target"
+
+
+def test_a_rule_sees_the_types_of_what_writes_a_reference() -> None:
+    node = op("test.aim", "aim", target=ref("W"), offset=Binding.fixed(0.1, P.NUMBER))
+    source = RuleSource()
+    as_waypoint = PlanSpec(seq(node), "plan", parameters=[ParameterDecl("W", P.WAYPOINT)])
+    errors = [p for p in validate_plan(as_waypoint, source) if p.severity == ERROR]
+    assert only(errors).field == "offset"
+    as_pose = PlanSpec(seq(node), "plan", parameters=[ParameterDecl("W", P.POSE)])
+    assert [p for p in validate_plan(as_pose, source) if p.severity == ERROR] == []

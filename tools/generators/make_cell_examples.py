@@ -152,8 +152,10 @@ def cup_to_bin() -> PlanSpec:
         ("markers", "detect_markers"),
         "cup to bin",
         "Cup to bin (Figure 3, simulated cell)",
-        "The paper's Figure 3 on the simulated cell: find the cup and the waste bin through their "
-        "markers, check the cup was found, query both poses, grasp the cup at its pose with the "
+        "The paper's Figure 3 on the simulated cell: step the arm out of the shoulder camera's "
+        "view first (with the arm over the table the camera cannot see the cup, and the look "
+        "says 'the arm hides the table from the shoulder camera'), find the cup and the waste "
+        "bin through their markers, check the cup was found, query both poses, grasp the cup at its pose with the "
         "grasp of its object model and drop it over the bin. When the cup is not visible the selector falls "
         "back to WAIT (forced to fail) and the root, which runs until success, looks again. "
         "Run it with: costar run example:cup_to_bin --seed N. Runs to SUCCESS.",
@@ -167,8 +169,9 @@ def cup_to_bin_vision() -> PlanSpec:
         ("perception", "detect_objects"),
         "cup to bin (vision)",
         "Cup to bin, by vision (Figure 3, simulated cell)",
-        "The paper's Figure 3 with model-based recognition instead of markers: the shoulder "
-        "camera's point cloud is matched to the cup and waste-bin models, the plan checks the "
+        "The paper's Figure 3 with model-based recognition instead of markers: with the arm "
+        "stepped out of its view (over the table it hides the cup, and the look says 'the arm "
+        "hides the table from the shoulder camera'), the shoulder camera's point cloud is matched to the cup and waste-bin models, the plan checks the "
         "cup was found, queries both poses, grasps the cup at its pose with the grasp of its "
         "object model and drops it over the bin; when the cup is not recognised it waits and looks "
         "again. Run it with: costar run example:cup_to_bin_vision --seed N.",
