@@ -80,7 +80,9 @@ def test_btcpp_tree_nodes_model_declares_our_operations_as_we_read_them() -> Non
 
     A subset check: the file pins what BehaviorTree.CPP wrote for the operations it was
     given, so an operation added since needs no new file (it is not in it); every model
-    in it must still be an operation of ours with the same kind, ports and docs.
+    in it must still be an operation of ours with the same kind and ports. The ports' docs
+    are prose BehaviorTree.CPP copied from ours: a doc reworded since is no mismatch, only a
+    port's presence is (it is written at all, as a description).
     """
     root = parse((BTCPP_DATA / "tree_nodes_model.xml").read_text(encoding="utf-8"))
     models = root.children[0].children
@@ -98,7 +100,7 @@ def test_btcpp_tree_nodes_model_declares_our_operations_as_we_read_them() -> Non
         for spec in manifest.ports:
             direction = "output_port" if spec.direction is Direction.OUT else "input_port"
             assert ports[spec.name].tag == direction
-            assert ports[spec.name].text == spec.doc
+            assert bool(ports[spec.name].text) == bool(spec.doc)
 
 
 def test_a_tree_over_btcpp_written_models_imports_with_their_types() -> None:
