@@ -126,10 +126,13 @@ def _serve(conn: Connection) -> None:
     p.disconnect(client)
 
 
-# A body that moved less than this (m, rad; quaternion components) since the last picture did
-# not visibly move (a pixel is some millimetres): the resting world's numerical creep (some
-# micrometres a second) does not make a new picture.
+# A body that moved less than this since the last picture did not visibly move (a pixel is
+# some millimetres where the cameras look): joints (rad) and positions (m) by VIEW_TOLERANCE,
+# orientations (quaternion components; 1e-3 turns a 0.3 m object's end by some 0.3 mm) by
+# ORIENTATION_TOLERANCE. The resting world's numerical creep (the suction tool in its holster
+# turns some 2e-4 a second) then makes a picture every few seconds, not every frame.
 VIEW_TOLERANCE = 2e-4
+ORIENTATION_TOLERANCE = 1e-3
 
 
 def _view_key(snapshot: CellSnapshot, size: tuple[int, int]) -> Any:
@@ -137,22 +140,22 @@ def _view_key(snapshot: CellSnapshot, size: tuple[int, int]) -> Any:
     :func:`_same_view`.
     """
     names = tuple(sorted(snapshot.objects))
-    numbers = [*snapshot.robot_joints, *snapshot.tool[0], *snapshot.tool[1]]
-    for name in names:
-        position, orientation = snapshot.objects[name]
+    poses = [snapshot.tool, *(snapshot.objects[name] for name in names)]
+    numbers = [*snapshot.robot_joints]
+    tolerances = [VIEW_TOLERANCE] * len(numbers)
+    for position, orientation in poses:
         numbers += [*position, *orientation]
-    return (tuple(size), names, tuple(sorted(snapshot.new_models)), np.array(numbers))
+        tolerances += [VIEW_TOLERANCE] * len(position)
+        tolerances += [ORIENTATION_TOLERANCE] * len(orientation)
+    meta = (tuple(size), names, tuple(sorted(snapshot.new_models)))
+    return meta, np.array(numbers), np.array(tolerances)
 
 
 def _same_view(a: Any, b: Any) -> bool:
-    """Two view keys give the same picture: the same size, bodies and models, and no body
-    moved more than ``VIEW_TOLERANCE``.
+    """Two view keys give the same picture: the same size, bodies and models, and no joint
+    or body moved more than its tolerance.
     """
-    return (
-        a[:3] == b[:3]
-        and a[3].shape == b[3].shape
-        and bool(np.max(np.abs(a[3] - b[3]), initial=0.0) <= VIEW_TOLERANCE)
-    )
+    return a[0] == b[0] and a[1].shape == b[1].shape and bool(np.all(np.abs(a[1] - b[1]) <= a[2]))
 
 
 def _resized(camera: SimCamera, size: tuple[int, int]) -> SimCamera:

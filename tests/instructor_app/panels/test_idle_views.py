@@ -9,6 +9,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 
 import pytest
+from PySide6.QtCore import QObject, Signal
 
 from capabilities.sim.session import SimCellSession
 from instructor_app.panels.cameras import CameraPanel
@@ -67,13 +68,20 @@ def test_an_idle_cell_renders_nothing_and_the_camera_timer_stops_until_something
     assert _renders(cell) == renders
 
 
-def test_the_robot_status_is_read_slowly_while_it_does_not_change(qtbot, cell) -> None:
-    class Session:
-        cell_changed = type("S", (), {"connect": lambda self, slot: None})()
+class _Session(QObject):
+    """What RobotStatusLabel reads of a cell session: the open cell and its change signal."""
 
-    session = Session()
-    session.cell = cell  # type: ignore[attr-defined]
-    label = RobotStatusLabel(session, interval_ms=10)  # type: ignore[arg-type]
+    cell_changed = Signal(str)
+
+    def __init__(self, cell: object) -> None:
+        super().__init__()
+        self.cell = cell
+
+
+def test_the_robot_status_is_read_slowly_while_it_does_not_change(
+    qtbot, cell: SimCellSession
+) -> None:
+    label = RobotStatusLabel(_Session(cell), interval_ms=10)  # type: ignore[arg-type]
     qtbot.addWidget(label)
     assert label.interval_ms == 10
     for _ in range(IDLE_READS):
