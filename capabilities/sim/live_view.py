@@ -193,8 +193,9 @@ class _Mirror:
         next frame before returning, so that the mirror renders it while this one is shown.
 
         A cell that did not visibly move since the last reply (:func:`_same_view`)
-        is not rendered again: that reply is returned, the very same object, so that a
-        caller can tell that nothing changed (an idle cell costs its mirror nothing).
+        is not rendered again: that reply's pictures are returned, the very same arrays (so
+        that a caller can tell that nothing changed), stamped with the time now; an idle
+        cell costs its mirror nothing.
         """
         with self._lock:
             conn = self._connection()
@@ -204,7 +205,8 @@ class _Mirror:
                     now = snapshot(self.known)
                     key = _view_key(now, size)
                     if self._last is not None and _same_view(self._last[0], key):
-                        return self._last[1], pose()
+                        # the same pictures, stamped now: they show the cell as it is now
+                        return (*self._last[1][:3], now.stamp), pose()
                     conn.send(_Request(now, size))
                     self.requests += 1
                     reply, key = (self._receive(conn), pose()), key
