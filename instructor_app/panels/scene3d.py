@@ -255,7 +255,7 @@ class Scene3DPanel(PointingMixin, QWidget):
         """Show the draggable tool gizmo at a TCP pose (None hides it; the same pose again
         changes nothing, so draws nothing).
         """
-        if pose != self._gizmo:
+        if pose != getattr(self, "_gizmo", None):  # (no attribute: no OpenGL, no view)
             self._apply_gizmo(pose)
 
     def _apply_gizmo(self, pose: Pose | None) -> None:
