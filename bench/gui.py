@@ -14,12 +14,18 @@ Figures (all in one offscreen QApplication, view 1280 x 800):
 - ``camera_fps``, ``tick_rate_ratio``, ``scene3d_fps`` (and the figures behind them): the
   camera panel and the 3D scene while a plan runs on the simulated cell, measured by
   ``bench/cell_views.py`` in a process of its own (on the display's GL when there is one).
+- ``idle_cpu_cores``: cores the whole app (its process and its children: the live view's
+  renderer processes) uses with the simulated cell open at real time, the camera and 3D
+  panels shown, no plan running and nothing moving, over ``--idle-seconds`` (30 s; goal at
+  most 0.10), measured in a process of its own after the panels showed their first pictures
+  and a few seconds' settling. ``idle_camera_frames`` / ``idle_scene3d_frames``: pictures the
+  camera panel showed and frames the 3D scene drew meanwhile (0 when idle is quiet).
 - ``ngqt_create_node_1000_s``: the peer, NodeGraphQt's own ``NodeGraph.create_node`` with
   its defaults, 1000 times, in the same process (nodes with one input and one output port).
 
 Run from the repository root::
 
-    .venv/bin/python bench/gui.py [--json] [--frames 90]
+    .venv/bin/python bench/gui.py [--json] [--frames 90] [--idle-seconds 30]
 """
 
 from __future__ import annotations
@@ -49,7 +55,14 @@ from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
 from engine.status import Status
 from engine.types import ParamType
 
-__all__ = ["build_plan", "measure_open", "measure_frames", "measure_ngqt_create", "main"]
+__all__ = [
+    "build_plan",
+    "measure_open",
+    "measure_frames",
+    "measure_idle",
+    "measure_ngqt_create",
+    "main",
+]
 
 _COMPOSITES = (NodeKind.SEQUENCE, NodeKind.SELECTOR, NodeKind.PARALLEL)
 _OPS = ("motion.move_to", "perception.detect_object", "gripper.close", "predicates.is_free")
@@ -165,7 +178,7 @@ def _percentile(values: list[float], fraction: float) -> float:
     return ordered[min(len(ordered) - 1, round(fraction * (len(ordered) - 1)))]
 
 
-def run_bench(frames: int) -> dict[str, Any]:
+def run_bench(frames: int, idle_seconds: float = 30.0) -> dict[str, Any]:
     app = QApplication.instance() or QApplication([])
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "bench.costar.json"
@@ -185,7 +198,92 @@ def run_bench(frames: int) -> dict[str, Any]:
         "frame_ms_p99_zoom100": round(_percentile(zoom100, 0.99), 2),
         "ngqt_create_node_1000_s": round(measure_ngqt_create(1000), 3),
         **measure_cell_views_in_a_process(),
+        **measure_idle_in_a_process(idle_seconds),
     }
+
+
+def _tree_cpu_seconds(root: Any) -> float:
+    """CPU seconds (user + system) of a process and its living children so far."""
+    total = 0.0
+    for proc in [root, *root.children(recursive=True)]:
+        try:
+            times = proc.cpu_times()
+        except Exception:  # a child that ended meanwhile
+            continue
+        total += times.user + times.system
+    return total
+
+
+def measure_idle(seconds: float, settle: float = 3.0) -> dict[str, Any]:
+    """Cores the whole app uses with the simulated cell open, its camera and 3D panels shown,
+    nothing running and nothing moving (see the module doc); run in a process of its own.
+    """
+    import psutil
+    from PySide6.QtCore import QSettings
+
+    from instructor_app.app import HeadlessDialogs
+    from instructor_app.main_window import MainWindow
+    from instructor_app.runtime.session import CellSession
+    from instructor_app.settings import AppSettings
+
+    def wait(duration: float) -> None:
+        loop = QEventLoop()
+        QTimer.singleShot(int(duration * 1000), loop.quit)
+        loop.exec()
+
+    _app = QApplication.instance() or QApplication([])
+    session = CellSession("sim", speed=1.0)
+    session.open()
+    me = psutil.Process()
+    with tempfile.TemporaryDirectory() as scratch:
+        settings = AppSettings(QSettings(str(Path(scratch, "s.ini")), QSettings.Format.IniFormat))
+        window = MainWindow(session, settings, HeadlessDialogs(), Path(scratch, "recovery"))
+        try:
+            window.resize(1920, 1080)
+            window.show()
+            for name in ("cameras", "scene3d"):
+                window.docks[name].setVisible(True)
+            window.arrange_cell_views()
+            cameras, scene3d = window.cell_views.cameras, window.cell_views.scene3d
+            started = time.perf_counter()
+            while len(cameras.shown) < len(cameras._pictures):
+                wait(0.1)
+                if time.perf_counter() - started > 60.0:
+                    raise RuntimeError("the camera panel showed no picture within 60 s")
+            wait(settle)  # the arm and the objects come to rest, the views catch up
+            frames0, drawn0 = cameras.frames_shown, scene3d.frames_drawn
+            cpu0, wall0 = _tree_cpu_seconds(me), time.perf_counter()
+            wait(seconds)
+            cpu1, wall = _tree_cpu_seconds(me), time.perf_counter() - wall0
+            result = {
+                "idle_cpu_cores": round((cpu1 - cpu0) / wall, 3),
+                "idle_camera_frames": cameras.frames_shown - frames0,
+                "idle_scene3d_frames": scene3d.frames_drawn - drawn0 if scene3d.available else None,
+                "idle_seconds": round(wall, 1),
+                "idle_load_average": [round(v, 2) for v in os.getloadavg()],
+            }
+        finally:
+            window.cell_views.stop()
+            window.autosaver.stop()
+            window.hide()
+            session.close()
+    return result
+
+
+def measure_idle_in_a_process(seconds: float) -> dict[str, Any]:
+    """:func:`measure_idle` in a process of its own (the display's GL, a fresh cell)."""
+    env = dict(os.environ)
+    if env.get("DISPLAY"):
+        env["QT_QPA_PLATFORM"] = "xcb"
+    done = subprocess.run(
+        [sys.executable, str(Path(__file__)), "--json", "--idle-only", "--idle-seconds",
+         str(seconds)],
+        capture_output=True, text=True, env=env, timeout=seconds + 300,
+    )  # fmt: skip
+    if done.returncode != 0:
+        raise RuntimeError(f"bench/gui.py --idle-only failed:\n{done.stderr[-2000:]}")
+    result: dict[str, Any] = json.loads(done.stdout.strip().splitlines()[-1])
+    return result
 
 
 def measure_cell_views_in_a_process() -> dict[str, Any]:
@@ -210,8 +308,17 @@ def main(argv: list[str] | None = None) -> int:
     """Print the figures (``--json``: one JSON object)."""
     parser = figures_parser(__doc__)
     parser.add_argument("--frames", type=int, default=90, help="frames per measurement")
+    parser.add_argument(
+        "--idle-seconds", type=float, default=30.0, help="length of the idle measurement"
+    )
+    parser.add_argument(
+        "--idle-only", action="store_true", help="only the idle figures (in this process)"
+    )
     args = parser.parse_args(argv)
-    results = run_bench(args.frames)
+    if args.idle_only:
+        print_figures(measure_idle(args.idle_seconds), args.json, 26)
+        return 0
+    results = run_bench(args.frames, args.idle_seconds)
     print_figures(results, args.json, 26, indent=2)
     return 0
 

@@ -90,6 +90,18 @@ class ArmController:
         """True while a move or a stop is under way."""
         return self._motion is not None
 
+    @property
+    def has_work(self) -> bool:
+        """True while the arm may act by itself: a move or stop, freedrive, a protective stop
+        or its unlock under way (the physics thread does not rest meanwhile).
+        """
+        return (
+            self._motion is not None
+            or self.freedrive.active
+            or self.stopped is not None
+            or bool(self._unlocks)
+        )
+
     # ---------------------------------------------------------------- commands (physics thread)
 
     def start_joint_move(

@@ -20,6 +20,7 @@ from typing import Self, TypeVar
 
 import numpy as np
 
+from capabilities.bullet import pybullet
 from capabilities.cell_features import ClosesOnExit
 from capabilities.robot.cell_file import DEFAULT_CONFIG_PATH, CellConfig
 from capabilities.robot.kinematics import UR5Kinematics
@@ -39,6 +40,10 @@ __all__ = ["SimCell"]
 
 T = TypeVar("T")
 TIME_STEP = 1.0 / 240.0
+# Below these speeds a body or joint does not move (m/s, rad/s): the resting world's numerical
+# creep is some micrometres and 1e-4 rad a second, a falling body exceeds them within a step.
+REST_SPEED = 1e-3
+REST_TURN = 1e-2
 
 
 class SimCell(ClosesOnExit):
@@ -223,6 +228,31 @@ class SimCell(ClosesOnExit):
         name = self._namer(body) if self._namer is not None else ""
         return name.replace("_", " ") or f"body {body}"
 
+    def _still(self, client: int) -> bool:
+        """Nothing moves and no controller has work (physics thread; the rest check of
+        ``PhysicsThread``): every body's base and joints slower than ``REST_SPEED`` /
+        ``REST_TURN``.
+        """
+        assert self._arm and self._gripper and self._suction
+        if self._arm.has_work or self._gripper.moving or self._suction.has_work:
+            return False
+        for index in range(pybullet.getNumBodies(physicsClientId=client)):
+            body = pybullet.getBodyUniqueId(index, physicsClientId=client)
+            linear, angular = pybullet.getBaseVelocity(body, physicsClientId=client)
+            if max(map(abs, linear)) > REST_SPEED or max(map(abs, angular)) > REST_TURN:
+                return False
+            joints = pybullet.getNumJoints(body, physicsClientId=client)
+            if joints and any(
+                abs(state[1]) > REST_TURN
+                for state in pybullet.getJointStates(body, range(joints), physicsClientId=client)
+            ):
+                return False
+        return True
+
+    def peek(self, fn: Callable[[int], T]) -> T:
+        """As :meth:`call`, for a ``fn`` that only reads (``PhysicsThread.peek``)."""
+        return self._physics.peek(fn)
+
     def _tcp_matrix(self) -> np.ndarray:
         return self._tcp_matrices["suction" if self._suction_in_hand() else "gripper"]
 
@@ -242,6 +272,10 @@ class SimCell(ClosesOnExit):
             client, world.robot, self._held_tool, self.config.robot.force_limit, self._body_name
         )
         arm, gripper, suction = self._arm, self._gripper, self._suction
-        self._physics.add_hooks(pre=arm.pre_step, post=arm.post_step)
-        self._physics.add_hooks(pre=gripper.pre_step, post=lambda _t: gripper.post_step(TIME_STEP))
-        self._physics.add_hooks(pre=suction.pre_step)
+        physics = self._physics
+        physics.add_hooks(pre=arm.pre_step, post=arm.post_step, may_rest=True)
+        physics.add_hooks(
+            pre=gripper.pre_step, post=lambda _t: gripper.post_step(TIME_STEP), may_rest=True
+        )
+        physics.add_hooks(pre=suction.pre_step, may_rest=True)
+        physics.add_rest_check(lambda: self._still(client))

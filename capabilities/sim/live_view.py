@@ -36,6 +36,8 @@ from multiprocessing.connection import Connection
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from capabilities.robot.cell_file import CellConfig
 from capabilities.sim.cameras import LinkMount, RGBDFrame, SimCamera
 from capabilities.sim.errors import SimError
@@ -124,6 +126,38 @@ def _serve(conn: Connection) -> None:
     p.disconnect(client)
 
 
+# A body that moved less than this since the last picture did not visibly move (a pixel is
+# some millimetres where the cameras look): joints (rad) and positions (m) by VIEW_TOLERANCE,
+# orientations (quaternion components; 1e-3 turns a 0.3 m object's end by some 0.3 mm) by
+# ORIENTATION_TOLERANCE. The resting world's numerical creep (the suction tool in its holster
+# turns some 2e-4 a second) then makes a picture every few seconds, not every frame.
+VIEW_TOLERANCE = 2e-4
+ORIENTATION_TOLERANCE = 1e-3
+
+
+def _view_key(snapshot: CellSnapshot, size: tuple[int, int]) -> Any:
+    """What a picture of ``snapshot`` at ``size`` depends on (not its stamp); see
+    :func:`_same_view`.
+    """
+    names = tuple(sorted(snapshot.objects))
+    poses = [snapshot.tool, *(snapshot.objects[name] for name in names)]
+    numbers = [*snapshot.robot_joints]
+    tolerances = [VIEW_TOLERANCE] * len(numbers)
+    for position, orientation in poses:
+        numbers += [*position, *orientation]
+        tolerances += [VIEW_TOLERANCE] * len(position)
+        tolerances += [ORIENTATION_TOLERANCE] * len(orientation)
+    meta = (tuple(size), names, tuple(sorted(snapshot.new_models)))
+    return meta, np.array(numbers), np.array(tolerances)
+
+
+def _same_view(a: Any, b: Any) -> bool:
+    """Two view keys give the same picture: the same size, bodies and models, and no joint
+    or body moved more than its tolerance.
+    """
+    return a[0] == b[0] and a[1].shape == b[1].shape and bool(np.all(np.abs(a[1] - b[1]) <= a[2]))
+
+
 def _resized(camera: SimCamera, size: tuple[int, int]) -> SimCamera:
     config = dataclasses.replace(camera.config, width=int(size[0]), height=int(size[1]))
     return SimCamera(camera.name, config, camera.mount)
@@ -143,8 +177,10 @@ class _Mirror:
         self.process: Any = None
         self._closed = False
         self._failure = ""
-        # (when, size, believed pose) of the frame asked for ahead and not yet read
-        self._pending: tuple[float, tuple[int, int], Any] | None = None
+        # (when, size, believed pose, view key) of the frame asked for ahead and not yet read
+        self._pending: tuple[float, tuple[int, int], Any, Any] | None = None
+        self._last: tuple[Any, Any] | None = None  # (view key, reply) of the last frame given
+        self.requests = 0  # frames asked of the mirror process (each one it renders)
 
     def render(
         self,
@@ -155,34 +191,51 @@ class _Mirror:
     ) -> tuple[Any, Any]:
         """(the mirror's reply, ``pose()`` taken with its snapshot); ``ahead``: ask for the
         next frame before returning, so that the mirror renders it while this one is shown.
+
+        A cell that did not visibly move since the last reply (:func:`_same_view`)
+        is not rendered again: that reply's pictures are returned, the very same arrays (so
+        that a caller can tell that nothing changed), stamped with the time now; an idle
+        cell costs its mirror nothing.
         """
         with self._lock:
             conn = self._connection()
             try:
-                reply = self._pending_reply(conn, size, ahead)
-                if reply is None:
-                    conn.send(_Request(snapshot(self.known), size))
-                    reply = (self._receive(conn), pose())
+                pending = self._pending_reply(conn, size, ahead)
+                if pending is None:
+                    now = snapshot(self.known)
+                    key = _view_key(now, size)
+                    if self._last is not None and _same_view(self._last[0], key):
+                        # the same pictures, stamped now: they show the cell as it is now
+                        return (*self._last[1][:3], now.stamp), pose()
+                    conn.send(_Request(now, size))
+                    self.requests += 1
+                    reply, key = (self._receive(conn), pose()), key
+                else:
+                    reply, key = pending
+                self._last = (key, reply[0])
                 if ahead:
-                    conn.send(_Request(snapshot(self.known), size))
-                    self._pending = (time.perf_counter(), size, pose())
+                    now = snapshot(self.known)
+                    if not _same_view(_view_key(now, size), key):  # ahead only while it moves
+                        conn.send(_Request(now, size))
+                        self.requests += 1
+                        self._pending = (time.perf_counter(), size, pose(), _view_key(now, size))
                 return reply
             except (EOFError, OSError, TimeoutError) as exc:
                 raise self._stopped(str(exc) or type(exc).__name__) from exc
 
     def _pending_reply(
         self, conn: Connection, size: tuple[int, int], ahead: bool
-    ) -> tuple[Any, Any] | None:
-        """The frame asked for ahead, if this call wants one (``ahead``: a call without it
-        wants the cell now) and it has this size and is not stale.
+    ) -> tuple[tuple[Any, Any], Any] | None:
+        """The frame asked for ahead and its view key, if this call wants one (``ahead``: a
+        call without it wants the cell now) and it has this size and is not stale.
         """
         pending, self._pending = self._pending, None
         if pending is None:
             return None
-        asked, asked_size, pose = pending
+        asked, asked_size, pose, key = pending
         reply = self._receive(conn)  # always read: the pipe holds one reply per request
         fresh = ahead and asked_size == tuple(size) and time.perf_counter() - asked <= STALE_AFTER
-        return (reply, pose) if fresh else None
+        return ((reply, pose), key) if fresh else None
 
     @staticmethod
     def _receive(conn: Connection) -> Any:
@@ -252,7 +305,7 @@ class _Mirror:
 
     def _shutdown(self) -> None:
         conn, process, self._conn = self._conn, self.process, None
-        self._pending = None
+        self._pending = self._last = None
         if conn is not None:
             with contextlib.suppress(OSError):
                 conn.send(None)
@@ -329,6 +382,10 @@ class LiveView:
             for name, m in self._mirrors.items()
             if m.process is not None and m.process.poll() is None
         }
+
+    def requests(self) -> dict[str, int]:
+        """Frames asked of each camera's mirror so far (each one it renders)."""
+        return {name: m.requests for name, m in self._mirrors.items()}
 
     def close(self) -> None:
         """End every mirror process (waits for each; kills one that does not end)."""

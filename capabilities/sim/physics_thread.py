@@ -9,6 +9,15 @@ without one it runs as fast as it can, handing the GIL to other threads every
 computes in Python: perception). Inside :meth:`PhysicsThread.standing_still` (lockstep:
 perception computing on another thread) the world is not stepped and simulated time stands
 still, as it already does while a call (a camera render) is served.
+
+At rest: a loop paced against the wall clock stops stepping once nothing has moved for
+``REST_AFTER_S`` of simulated time (every rest check the cell registered says so: all bodies
+and joints slower than a crawl, no command under way), no command is in flight, no thread
+waits for simulated time and no step hook that may act by itself (an actor's) is registered.
+Simulated time then goes on with the wall clock without stepping (what stepping a world in
+which nothing moves would give), and the thread sleeps until a call comes. A call made with
+:meth:`PhysicsThread.peek` (a read: the live view's snapshots) is served at rest; any other
+call or post, a thread waiting for simulated time, or a rest check saying no ends the rest.
 """
 
 from __future__ import annotations
@@ -38,6 +47,9 @@ _log = logging.getLogger(__name__)
 # pybullet steps without releasing the GIL and a hand-over (time.sleep(0)) costs a system
 # call (~55 us on a VM), so it is not done every step unless another thread asks for it.
 _YIELD_S = 0.001
+REST_AFTER_S = 0.5  # simulated seconds without a move before a paced loop rests
+_REST_CHECK_STEPS = 12  # the rest checks run every this many steps (20 times a second)
+_REST_WAIT_S = 0.1  # at rest, the loop looks at the rest checks and the clock this often
 
 
 class PhysicsThread:
@@ -64,7 +76,7 @@ class PhysicsThread:
         self.client = -1
         self.steps = 0
         self._time = 0.0
-        self._queue: queue.SimpleQueue[tuple[Callable[[int], Any], Future[Any]] | None]
+        self._queue: queue.SimpleQueue[tuple[Callable[[int], Any], Future[Any], bool] | None]
         self._queue = queue.SimpleQueue()
         self._serving_s = 0.0  # wall seconds spent running posted calls (not simulated time)
         self._pre_hooks: list[StepHook] = []
@@ -77,6 +89,13 @@ class PhysicsThread:
         self._sharers = 0  # blocks in sharing: while above 0 the GIL is handed over every step
         self._in_flight = 0  # commands posted and not finished (see waited_on)
         self._gates: list[Callable[[], bool]] = []  # all must say True for a step
+        self._rest_checks: list[Callable[[], bool]] = []  # all must say True for a rest
+        self._restless: list[StepHook] = []  # hooks that may act by themselves: no rest
+        self._quiet_steps = 0  # steps in a row at which every rest check said True
+        self.resting = False  # the loop rests: nothing moves, time goes on without steps
+        self.rests = 0  # times the loop came to rest
+        self._rested_steps = 0  # steps of simulated time that passed at rest
+        self._woken = False  # a call other than a peek was served at rest
         self._ready = threading.Event()
         self._stopping = threading.Event()
         self._setup_error: BaseException | None = None
@@ -119,11 +138,14 @@ class PhysicsThread:
 
     def post(self, fn: Callable[[int], T]) -> Future[T]:
         """Queue ``fn(client)`` to run on the physics thread before the next step."""
+        return self._post(fn, wakes=True)
+
+    def _post(self, fn: Callable[[int], T], wakes: bool) -> Future[T]:
         future: Future[T] = Future()
         if not self.running:
             future.set_exception(SimError("the simulated cell is not running"))
             return future
-        self._queue.put((fn, future))
+        self._queue.put((fn, future, wakes))
         return future
 
     def call(self, fn: Callable[[int], T], timeout: float | None = 60.0) -> T:
@@ -132,12 +154,29 @@ class PhysicsThread:
             return fn(self.client)
         return self.post(fn).result(timeout)
 
-    def add_hooks(self, pre: StepHook | None = None, post: StepHook | None = None) -> None:
-        """Register per-step callbacks (call on the physics thread or before ``start``)."""
+    def peek(self, fn: Callable[[int], T], timeout: float | None = 60.0) -> T:
+        """As :meth:`call`, for a ``fn`` that only reads the world: served at rest without
+        ending it (see the module doc). A ``fn`` that changes the world must use ``call``.
+        """
+        if self.in_thread():
+            return fn(self.client)
+        return self._post(fn, wakes=False).result(timeout)
+
+    def add_hooks(
+        self, pre: StepHook | None = None, post: StepHook | None = None, may_rest: bool = False
+    ) -> None:
+        """Register per-step callbacks (call on the physics thread or before ``start``).
+
+        ``may_rest``: the hooks do nothing by themselves while nothing moves and no command
+        runs (the cell's controllers, which say so through a rest check); other hooks (an
+        actor's) keep the world from resting while registered.
+        """
         if pre is not None:
             self._pre_hooks.append(pre)
         if post is not None:
             self._post_hooks.append(post)
+        if not may_rest:
+            self._restless += [hook for hook in (pre, post) if hook is not None]
 
     def remove_hooks(self, pre: StepHook | None = None, post: StepHook | None = None) -> None:
         """Take hooks out again (call on the physics thread); unknown ones are ignored."""
@@ -145,6 +184,15 @@ class PhysicsThread:
             self._pre_hooks.remove(pre)
         if post is not None and post in self._post_hooks:
             self._post_hooks.remove(post)
+        for hook in (pre, post):
+            if hook is not None and hook in self._restless:
+                self._restless.remove(hook)
+
+    def add_rest_check(self, still: Callable[[], bool]) -> None:
+        """A paced loop rests only while ``still()`` (run on the physics thread) says True:
+        nothing it knows of moves or has work to do (see the module doc).
+        """
+        self._rest_checks.append(still)
 
     def wait_sim(self, seconds: float, timeout: float | None = None) -> bool:
         """Block until simulated time has advanced by ``seconds``; False on a real-time timeout."""
@@ -221,7 +269,7 @@ class PhysicsThread:
     def nudge(self) -> None:
         """Wake a loop that stands still, to look at its gates again (any thread)."""
         if self.running:
-            self._queue.put((lambda _client: None, Future()))
+            self._queue.put((lambda _client: None, Future(), False))
 
     # ------------------------------------------------------------------ loop
 
@@ -252,6 +300,9 @@ class PhysicsThread:
             if self._holds or not all(gate() for gate in self._gates):
                 self._stand_still()
                 continue
+            if self.speed is not None and self._may_rest():
+                self._rest(wall_start, sim_start)
+                continue
             self._step_once()
             if self.speed is not None:
                 # Time spent serving calls (a camera frame takes 30-300 ms to render) does
@@ -266,6 +317,48 @@ class PhysicsThread:
                 if self._sharers or now - yielded > _YIELD_S:
                     time.sleep(0)  # let other Python threads have the GIL
                     yielded = now
+
+    def _quiet(self) -> bool:
+        """Nothing asks for steps: no command in flight, no waiter, no restless hook, and
+        every rest check says still.
+        """
+        return (
+            not self._in_flight
+            and not self._timers
+            and not self._restless
+            and bool(self._rest_checks)
+            and all(still() for still in self._rest_checks)
+        )
+
+    def _may_rest(self) -> bool:
+        """Whether to rest now (after ``REST_AFTER_S`` of quiet steps; see the module doc)."""
+        if self._woken:  # a call at rest may have changed the world: step and look again
+            self._woken, self._quiet_steps = False, 0
+            return False
+        if self._quiet_steps * self.time_step >= REST_AFTER_S:
+            return True
+        if self.steps % _REST_CHECK_STEPS == 0:
+            self._quiet_steps = self._quiet_steps + _REST_CHECK_STEPS if self._quiet() else 0
+        return False
+
+    def _rest(self, wall_start: float, sim_start: float) -> None:
+        """Nothing moves: serve calls and let simulated time go on with the wall clock,
+        without stepping, until a call other than a peek or a rest check ends it.
+        """
+        if not self.resting:
+            self.resting = True
+            self.rests += 1
+        assert self.speed is not None
+        self._serve_one(_REST_WAIT_S)
+        wall = time.perf_counter() - wall_start - self._serving_s
+        due = int((sim_start + wall * self.speed) / self.time_step) - self.steps
+        if due > self._rested_steps:
+            self._rested_steps = due
+            self._time = (self.steps + self._rested_steps) * self.time_step
+            self._fire_timers()
+        if self._woken or not self._quiet():
+            self.resting = False
+            self._woken, self._quiet_steps = False, 0
 
     def _stand_still(self) -> None:
         """Serve calls without stepping while a block holds time (wall time not simulated)."""
@@ -292,7 +385,10 @@ class PhysicsThread:
             return False
         if item is None:
             return False
-        self._execute(*item)
+        fn, future, wakes = item
+        if wakes:
+            self._woken = True
+        self._execute(fn, future)
         return True
 
     def _execute(self, fn: Callable[[int], Any], future: Future[Any]) -> None:
@@ -310,7 +406,7 @@ class PhysicsThread:
         self._run_hooks(self._pre_hooks)
         pybullet.stepSimulation(physicsClientId=self.client)
         self.steps += 1
-        self._time = self.steps * self.time_step
+        self._time = (self.steps + self._rested_steps) * self.time_step
         self._run_hooks(self._post_hooks)
         self._fire_timers()
 

@@ -237,7 +237,7 @@ class SimCellSession(ClosesOnExit):
         sim = self.sim
 
         def snapshot(known: set[str]) -> Any:
-            return sim.call(lambda c: take_snapshot(c, sim.world, self.scene, sim.time(), known))
+            return sim.peek(lambda c: take_snapshot(c, sim.world, self.scene, sim.time(), known))
 
         rendered = {n: d for n, d in self.cameras.items() if isinstance(d, SimCameraDevice)}
         self.live_view = LiveView(recipe, {n: d.camera for n, d in rendered.items()}, snapshot)

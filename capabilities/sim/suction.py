@@ -57,6 +57,13 @@ class SuctionController:
         if handle is not None:
             handle.resolve(False, message)
 
+    @property
+    def has_work(self) -> bool:
+        """True while a command waits for the next contact check, or the vacuum is on with
+        no part yet (it grips one that comes to the cup).
+        """
+        return self._pending is not None or (self.on and self.part is None)
+
     def pre_step(self, _t: float) -> None:
         """Grip a part at the cup while the vacuum is on."""
         if self.on and self.part is None:

@@ -5,7 +5,9 @@ colour picture and the depth picture, both with the overlays of
 :class:`~instructor_app.runtime.overlays.OverlayPainter` (detected objects with class and
 confidence, markers, the plan's regions). Frames are captured and drawn by a
 :class:`~instructor_app.runtime.camera_feed.CameraFeed` thread; a GUI timer only shows the
-newest picture of each camera when it changed. A hidden or paused panel captures nothing.
+newest picture of each camera when it changed, and stops once no new picture came for
+``IDLE_POLLS`` turns (an idle cell gives none: nothing in view moved); the feed wakes it
+again with the next picture. A hidden or paused panel captures nothing.
 A camera that gives no picture (the simulated cell's live-view renderer stopped, a camera
 failed) says so on its pictures' captions, with the reason in the toolbar; the rest of the
 app goes on.
@@ -45,7 +47,8 @@ from instructor_app.runtime.overlays import OverlayPainter, unproject
 __all__ = ["CameraPanel", "camera_interfaces"]
 
 PathAsker = Callable[[QWidget], str]
-POLL_MS = 30  # the GUI looks for new frames ~33 times a second
+POLL_MS = 30  # the GUI looks for new frames ~33 times a second while they come
+IDLE_POLLS = 10  # turns without a new frame after which the timer stops until the next one
 # Each camera is captured a little above the 15 pictures a second the panel should show: a
 # picture is shown at most once, and one that a late GUI turn finds already replaced by the
 # next is never shown, so a feed at exactly 15 shows 14-15 (bench/cell_views.py).
@@ -101,6 +104,7 @@ class CameraPanel(QWidget):
 
     region_drawn = Signal(object)
     message = Signal(str)
+    _frame_left = Signal()  # the feed left a frame or a failure (emitted on its thread)
 
     def __init__(
         self, fps: float = LIVE_FPS, ask_path: PathAsker = _ask_png, parent: QWidget | None = None
@@ -125,6 +129,9 @@ class CameraPanel(QWidget):
         self._timer = QTimer(self)
         self._timer.setInterval(POLL_MS)
         self._timer.timeout.connect(self._poll)
+        self._idle_polls = 0
+        self.timer_stops = 0  # times the timer stopped because no new picture came
+        self._frame_left.connect(self._wake)  # queued: the feed's thread emits it
 
     def _build(self) -> None:
         self.pause_button = QPushButton("Pause")
@@ -190,7 +197,7 @@ class CameraPanel(QWidget):
                 self._labels.setdefault(name, []).append(label)
                 pictures.append(picture)
             self._pictures[name] = (pictures[0], pictures[1])
-        self.feed = CameraFeed(cameras, self.painter, self.fps)
+        self.feed = CameraFeed(cameras, self.painter, self.fps, on_frame=self._frame_left.emit)
         feed = self.feed  # a panel deleted without stop() still ends its thread
         self.destroyed.connect(lambda *_: feed.stop(0.5))
         # cleared too: a cell with cameras after one without (the window starts on none)
@@ -232,14 +239,29 @@ class CameraPanel(QWidget):
         feed.set_active(set(feed.cameras) if live else set())
         if live:
             feed.start()
+            self._idle_polls = 0
             self._timer.start()
             self._rate_start, self._rate_frames = time.perf_counter(), self.frames_shown
         else:
             self._timer.stop()
 
+    @property
+    def polling(self) -> bool:
+        """True while the GUI's timer looks for new pictures (False when idle or not live)."""
+        return self._timer.isActive()
+
+    def _wake(self) -> None:
+        """A new picture (or a failure) came: look for pictures again if the timer slept."""
+        feed = self.feed
+        if feed is not None and feed.active and not self._timer.isActive():
+            self._idle_polls = 0
+            self._timer.start()
+            self._poll()
+
     def _poll(self) -> None:
         if self.feed is None:
             return
+        before = self.frames_shown
         for name, (colour, depth) in self._pictures.items():
             latest = self.feed.latest(name)
             if latest is None or (name in self.shown and self.shown[name].seq == latest.seq):
@@ -252,10 +274,19 @@ class CameraPanel(QWidget):
         if frozenset(failures) != self._stopped:
             self._stopped = frozenset(failures)
             self._caption(self._stopped)
+        self._idle_polls = 0 if self.frames_shown != before else self._idle_polls + 1
+        idle = self._idle_polls >= IDLE_POLLS
+        if idle:  # nothing new: sleep until the feed leaves a frame or a failure
+            self._timer.stop()
+            self.timer_stops += 1
+            self._rate_start, self._rate_frames = time.perf_counter(), self.frames_shown
         if failures:  # e.g. the simulated cell's live-view renderer stopped: say so
             text = "; ".join(f"{name}: {why}" for name, why in sorted(failures.items()))
             self.rate_label.setText(f"No live picture ({text})")
             self.rate_label.setToolTip(text)
+            return
+        if idle:
+            self.rate_label.setText("still")
             return
         elapsed = time.perf_counter() - self._rate_start
         if elapsed > 1.0:

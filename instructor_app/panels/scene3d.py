@@ -47,7 +47,13 @@ from instructor_app.panels.scene3d_view import SceneView, opengl_problem
 
 __all__ = ["Scene3DPanel"]
 
-REFRESH_MS = 33
+REFRESH_MS = 33  # while something in view changes
+# After IDLE_TICKS refreshes without a change the panel looks for changes only every
+# IDLE_REFRESH_MS (the arm's joints are a read of a snapshot, the rest compares values); the
+# view is redrawn only when something it shows changed, so an idle cell draws nothing.
+IDLE_REFRESH_MS = 250
+IDLE_TICKS = 30
+JOINT_TOLERANCE = 1e-5  # rad: less is the resting arm's numerical jitter, not a move
 REGION_RGBA = (1.0, 0.25, 0.8, 0.25)
 DETECTED_RGBA = (0.2, 0.9, 0.35, 1.0)
 TRUTH_RGBA = (1.0, 0.6, 0.1, 0.45)
@@ -94,6 +100,8 @@ class Scene3DPanel(PointingMixin, QWidget):
         self._workers = ThreadPoolExecutor(1, "scene3d-truth")
         self._truth_job: Future[list[tuple[str, Pose]]] | None = None
         self._tick = 0
+        self._still = 0  # refreshes in a row that changed nothing
+        self._shown_keys: dict[str, Any] = {}  # what each dynamic part was last drawn from
         self._build(layout)
         self._timer = QTimer(self)
         self._timer.setInterval(REFRESH_MS)
@@ -192,9 +200,11 @@ class Scene3DPanel(PointingMixin, QWidget):
             "waypoints": [],
             "draft": [],
         }
-        self.set_gizmo(self._gizmo)
+        self._apply_gizmo(self._gizmo)
         self._show_regions()
         self._show_waypoints()
+        self._tick, self._still, self._shown_keys = 0, 0, {}
+        self._timer.setInterval(REFRESH_MS)
         self._timer.start()
 
     def set_frame_source(self, source: FrameSource) -> None:
@@ -242,7 +252,13 @@ class Scene3DPanel(PointingMixin, QWidget):
         ghost.set_visible(joints is not None)
 
     def set_gizmo(self, pose: Pose | None) -> None:
-        """Show the draggable tool gizmo at a TCP pose (None hides it)."""
+        """Show the draggable tool gizmo at a TCP pose (None hides it; the same pose again
+        changes nothing, so draws nothing).
+        """
+        if pose != getattr(self, "_gizmo", None):  # (no attribute: no OpenGL, no view)
+            self._apply_gizmo(pose)
+
+    def _apply_gizmo(self, pose: Pose | None) -> None:
         self._gizmo = pose
         items = getattr(self, "gizmo_items", ())
         for item in items:
@@ -264,30 +280,46 @@ class Scene3DPanel(PointingMixin, QWidget):
     def frames_drawn(self) -> int:
         return self.view.frames_drawn if self.view is not None else 0
 
+    @property
+    def refresh_interval_ms(self) -> int:
+        """How often the panel looks for changes now (slower once nothing changes)."""
+        return self._timer.interval() if self.view is not None else 0
+
     def _refresh(self) -> None:
         if self.view is None or not self.isVisible():
             return
         self._tick += 1
+        slow = self._timer.interval() > REFRESH_MS
         changed = False
         if self.robot is not None and self.arm is not None:
             q = tuple(self.arm.joint_positions())
-            if q != self.robot.joints:
+            shown = self.robot.joints
+            if shown is None or len(q) != len(shown) or _moved(q, shown, JOINT_TOLERANCE):
                 self.robot.set_joints(q)
                 changed = True
         for name, camera in self.cameras.items():
             if getattr(camera, "on_wrist", False) or self._tick == 1:
-                self._show_frustum(name, camera)
-        if self._tick % 10 == 1:
-            self._show_objects()
-            self._show_truth()
-            changed = True
-        if self._tick % 15 == 1:
-            self._show_cloud()
-            changed = True
+                changed |= self._show_frustum(name, camera)
+        if slow or self._tick % 10 == 1:
+            changed |= self._show_objects()
+            changed |= self._show_truth()
+        if slow or self._tick % 15 == 1:
+            changed |= self._show_cloud()
         if changed:
             self.view.update()
+        self._still = 0 if changed else self._still + 1
+        interval = IDLE_REFRESH_MS if self._still >= IDLE_TICKS else REFRESH_MS
+        if interval != self._timer.interval():
+            self._timer.setInterval(interval)
 
-    def _show_frustum(self, name: str, camera: Any) -> None:
+    def _changed(self, part: str, key: Any) -> bool:
+        """True (and remembers ``key``) when ``part`` was last drawn from something else."""
+        if part in self._shown_keys and _same(self._shown_keys[part], key):
+            return False
+        self._shown_keys[part] = key
+        return True
+
+    def _show_frustum(self, name: str, camera: Any) -> bool:
         latest = self._frames(name)
         K = camera.intrinsics
         size = (
@@ -295,13 +327,22 @@ class Scene3DPanel(PointingMixin, QWidget):
             if latest is not None
             else (int(2 * K[0, 2]), int(2 * K[1, 2] + 2))
         )
-        self.frusta[name].setData(pos=frustum_lines(K, size, camera.extrinsics()))
+        extrinsics = camera.extrinsics()
+        matrix = np.round(pose_to_matrix(extrinsics) / JOINT_TOLERANCE)
+        if not self._changed(f"frustum:{name}", (tuple(size), matrix)):
+            return False
+        self.frusta[name].setData(pos=frustum_lines(K, size, extrinsics))
+        return True
 
-    def _show_cloud(self) -> None:
+    def _show_cloud(self) -> bool:
         latest = self._frames("shoulder")
         if not self.cloud_box.isChecked() or latest is None:
+            if not self._changed("cloud", None):
+                return False
             self.cloud.setVisible(False)
-            return
+            return True
+        if not self._changed("cloud", latest.seq):
+            return False
         frame = latest.frame
         stride = max(1, frame.depth.shape[1] // 120)
         # The floor around the table says nothing about the task: only what is on the table.
@@ -313,6 +354,7 @@ class Scene3DPanel(PointingMixin, QWidget):
         )
         self.cloud.setVisible(True)
         self._cloud_points = points
+        return True
 
     def _replace(self, group: str, items: list[Any]) -> None:
         assert self.view is not None
@@ -344,17 +386,22 @@ class Scene3DPanel(PointingMixin, QWidget):
         )
         return [mesh, text]
 
-    def _show_objects(self) -> None:
+    def _show_objects(self) -> bool:
         world = (self._cell.interfaces() if self._cell else {}).get("world")
+        detections = tuple(world.detections()) if world is not None else ()
+        if not self._changed("objects", detections):
+            return False
         items: list[Any] = []
-        for d in world.detections() if world is not None else []:
+        for d in detections:
             items += self._object_items(
                 d.object_class, d.pose, DETECTED_RGBA, f"{d.object_class} {d.confidence:.0%}"
             )
         self._replace("objects", items)
+        return True
 
-    def _show_truth(self) -> None:
+    def _show_truth(self) -> bool:
         """Ground truth (simulation only): fetched on a worker, shown when it arrives."""
+        changed = False
         job, self._truth_job = self._truth_job, None
         if (
             job is not None
@@ -362,20 +409,25 @@ class Scene3DPanel(PointingMixin, QWidget):
             and job.exception() is None
             and self.truth_box.isChecked()
         ):
-            self._replace(
-                "truth",
-                [
-                    i
-                    for n, p in job.result()
-                    for i in self._object_items(n, p, TRUTH_RGBA, f"{n} (truth)")
-                ],
-            )
-        elif not self.truth_box.isChecked():
+            truth = job.result()
+            if self._changed("truth", tuple(truth)):
+                self._replace(
+                    "truth",
+                    [
+                        i
+                        for n, p in truth
+                        for i in self._object_items(n, p, TRUTH_RGBA, f"{n} (truth)")
+                    ],
+                )
+                changed = True
+        elif not self.truth_box.isChecked() and self._changed("truth", None):
             self._replace("truth", [])
+            changed = True
         cell = self._cell
         if self.truth_box.isChecked() and isinstance(cell, ShowsGroundTruth):
             names = list(cell.scene.objects)
             self._truth_job = self._workers.submit(lambda: [(n, cell.truth_pose(n)) for n in names])
+        return changed
 
     def _show_regions(self) -> None:
         items: list[Any] = []
@@ -423,6 +475,24 @@ class Scene3DPanel(PointingMixin, QWidget):
                 ),
             ]
         self._replace("waypoints", items)
+
+
+def _moved(a: Sequence[float], b: Sequence[float], tolerance: float) -> bool:
+    return any(abs(x - y) > tolerance for x, y in zip(a, b, strict=True))
+
+
+def _same(a: Any, b: Any) -> bool:
+    """Equality that also compares numpy arrays (inside tuples) element by element."""
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return (
+            isinstance(a, np.ndarray)
+            and isinstance(b, np.ndarray)
+            and a.shape == b.shape
+            and bool(np.array_equal(a, b))
+        )
+    if isinstance(a, tuple) and isinstance(b, tuple):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
+    return bool(a == b)
 
 
 def pg_vector(x: float, y: float, z: float) -> Any:

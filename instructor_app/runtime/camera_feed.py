@@ -10,6 +10,10 @@ thread; any other capture holds the cell and is limited to a share of the time.
 :class:`FeedFrame` per camera in a latest-frame slot. The GUI thread polls :meth:`latest`
 from a timer, as it drains the event pump: frames it did not get to are coalesced away (only
 the newest is kept), so a slow GUI never queues frames and never slows the capture.
+A capture that gives the very same picture as the last one (the simulated cell's live view
+renders nothing while nothing in view moved) with the same overlays leaves no new frame:
+an idle cell makes the GUI draw nothing. ``on_frame`` (if given) is called on the capture
+thread whenever a new frame or a failure is left, so that a GUI may sleep until then.
 No Qt here.
 """
 
@@ -66,6 +70,7 @@ class CameraFeed:
             ``capture`` takes a ``size`` (a smaller picture renders faster); others give
             their own size; None: every camera's own size through ``capture()``.
         clock: monotonic seconds (tests may pass their own).
+        on_frame: called (on a capture thread) after a new frame or a failure was left.
     """
 
     def __init__(
@@ -76,6 +81,7 @@ class CameraFeed:
         size: tuple[int, int] | None = (320, 240),
         max_duty: float = 0.3,
         clock: Callable[[], float] = time.perf_counter,
+        on_frame: Callable[[], None] | None = None,
     ) -> None:
         self.cameras = dict(cameras)
         self.size = size
@@ -83,6 +89,9 @@ class CameraFeed:
         self.painter = painter
         self.fps = fps
         self._clock = clock
+        self.on_frame = on_frame
+        self._sources: dict[str, tuple[Any, Any]] = {}  # camera -> (picture, overlay key) shown
+        self.unchanged = 0  # captures that gave the same picture and overlays as the last
         self._slots: dict[str, FeedFrame] = {}
         self._active: frozenset[str] = frozenset(self.cameras)
         self._stop = threading.Event()
@@ -175,8 +184,15 @@ class CameraFeed:
             self.errors += 1
             self.failures[name] = str(exc) or type(exc).__name__
             _log.debug("camera %s: %s", name, exc)
+            self._notify()
             return False
-        self.failures.pop(name, None)
+        failed = self.failures.pop(name, None) is not None
+        key = self.painter.state_key() if self.painter is not None else None
+        source = self._sources.get(name)
+        if source is not None and source[0] is frame.rgb and source[1] == key and not failed:
+            self.unchanged += 1  # nothing in view moved and the overlays are the same
+            return True
+        self._sources[name] = (frame.rgb, key)
         rgb = np.array(frame.rgb, dtype=np.uint8, copy=True)
         depth = depth_image(frame.depth)
         if self.painter is not None:
@@ -185,4 +201,12 @@ class CameraFeed:
             except Exception:  # an overlay bug shows a plain picture, never ends the feed
                 _log.exception("drawing the overlays of camera %s failed", name)
         self._slots[name] = FeedFrame(frame, rgb, depth, seq)
+        self._notify()
         return True
+
+    def _notify(self) -> None:
+        if self.on_frame is not None:
+            try:
+                self.on_frame()
+            except Exception:  # e.g. the GUI's object was deleted: the feed goes on
+                _log.debug("on_frame failed", exc_info=True)

@@ -107,6 +107,20 @@ class OverlayPainter:
     def regions(self) -> tuple[tuple[str, Region], ...]:
         return self._regions
 
+    def state_key(self) -> Any:
+        """What the overlays drawn depend on besides the frame (switches, regions, markers and
+        detections): equal keys draw the same overlays into the same frame.
+        """
+        world = self.world
+        markers = (
+            tuple(world.marker(m) for m in self.marker_sizes)
+            if self.show_markers and world is not None
+            else ()
+        )
+        found = tuple(world.detections()) if self.show_objects and world is not None else ()
+        switches = (self.show_objects, self.show_markers, self.show_regions)
+        return (switches, self._regions if self.show_regions else (), markers, found)
+
     def paint(self, frame: Any, *images: np.ndarray) -> None:
         """Draw the overlays into each image (RGB uint8, the frame's size) in place."""
         if self.show_regions:

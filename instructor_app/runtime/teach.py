@@ -34,6 +34,13 @@ __all__ = ["ArmState", "RobotTeacher", "MOVE_HERE_FRACTION"]
 
 MOVE_HERE_FRACTION = 0.25  # Move here runs at a quarter of the slider's speed, as PolyScope
 _POLL_MS = 100
+# After _IDLE_READS reads in a row that found the arm where it was, it is read only every
+# _IDLE_POLL_MS (a read that finds it moved makes it quick again).
+_IDLE_READS = 20
+_IDLE_POLL_MS = 300
+# A joint that moved less than this (rad), a TCP less than this (m, quaternion components),
+# did not move: the resting simulated arm's numerical jitter is not a change to show.
+_STILL = 1e-6
 _DRAG_SETTLE_S = 5.0  # at most this long for the arm to reach a released drag
 
 
@@ -44,6 +51,19 @@ class ArmState:
     joints: tuple[float, ...]
     tcp: Pose
     freedrive: bool = False
+
+
+def _same_state(a: ArmState | None, b: ArmState | None) -> bool:
+    """The same state to show: joints and TCP within ``_STILL``, freedrive the same."""
+    if a is None or b is None:
+        return a is b
+    numbers_a = (*a.joints, *a.tcp.position, *a.tcp.orientation)
+    numbers_b = (*b.joints, *b.tcp.position, *b.tcp.orientation)
+    return (
+        a.freedrive == b.freedrive
+        and len(numbers_a) == len(numbers_b)
+        and all(abs(x - y) <= _STILL for x, y in zip(numbers_a, numbers_b, strict=True))
+    )
 
 
 class RobotTeacher(QObject):
@@ -83,6 +103,8 @@ class RobotTeacher(QObject):
         self._symmetries = SymmetryTable()
         self.speed_fraction = 0.25
         self.state: ArmState | None = None
+        self._poll_ms = poll_ms
+        self._unchanged = 0  # reads in a row that found the state shown
         self._timer = QTimer(self)
         self._timer.setInterval(poll_ms)
         self._timer.timeout.connect(self.poll)
@@ -123,9 +145,16 @@ class RobotTeacher(QObject):
     def poll(self) -> None:
         """Read the arm's state (a snapshot: never waits) and tell the panels if it changed."""
         state = self.read_state()
-        if state != self.state:
-            self.state = state
-            self.state_changed.emit(state)
+        if _same_state(state, self.state):
+            self._unchanged += 1
+            if self._unchanged == _IDLE_READS:
+                self._timer.setInterval(max(self._poll_ms, _IDLE_POLL_MS))
+            return
+        if self._unchanged >= _IDLE_READS:
+            self._timer.setInterval(self._poll_ms)
+        self._unchanged = 0
+        self.state = state
+        self.state_changed.emit(state)
 
     def read_state(self) -> ArmState | None:
         arm = self._interfaces.get("arm")

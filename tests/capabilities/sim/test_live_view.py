@@ -138,18 +138,43 @@ def test_a_live_feed_gets_the_frame_it_asked_for_ahead_but_never_a_stale_one(
     cell: SimCellSession, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     device = _rendered(cell, "wrist")
-    device.preview(SIZE, ahead=True)  # the mirror renders the next frame meanwhile
-    asked = cell.clock()
+    arm = cell.interfaces()["arm"]
+    home = arm.joint_positions()
+    # The arm turns slowly all along: a frame asked for ahead shows another view.
+    moving = arm.move_joints((home[0] + 1.0, *home[1:]), speed=0.05)
+    try:
+        cell.sim.wait_sim(0.1)
+        device.preview(SIZE, ahead=True)  # the mirror renders the next frame meanwhile
+        asked = cell.clock()
+        cell.sim.wait_sim(0.05)
+        ahead = device.preview(SIZE, ahead=True)
+        assert 0.0 < ahead.stamp <= asked  # the frame asked for at the previous call
+        # the belief taken with it, at the previous call: the wrist has turned since
+        assert ahead.T_world_camera != device.extrinsics()
+        now = cell.clock()
+        assert device.preview(SIZE).stamp >= now  # a call without ``ahead`` wants the cell now
+        device.preview(SIZE, ahead=True)
+        monkeypatch.setattr(live_view, "STALE_AFTER", 0.0)
+        later = cell.clock()
+        assert device.preview(SIZE, ahead=True).stamp >= later  # the one asked for is stale
+    finally:
+        moving.cancel()
+        arm.stop().wait(30.0)
+        arm.move_joints(home).wait(60.0)
+
+
+def test_a_cell_that_did_not_move_is_not_rendered_again(cell: SimCellSession) -> None:
+    device = _rendered(cell, "shoulder")
+    device.preview(SIZE, ahead=True)  # may be a frame asked for ahead earlier
+    first = device.preview(SIZE, ahead=True)  # the cell as it is
+    assert cell.live_view is not None
+    asked = cell.live_view.requests()["shoulder"]
     cell.sim.wait_sim(0.05)
-    ahead = device.preview(SIZE, ahead=True)
-    assert 0.0 < ahead.stamp <= asked  # the frame asked for at the previous call
-    assert ahead.T_world_camera == device.extrinsics()  # the belief taken with it
     now = cell.clock()
-    assert device.preview(SIZE).stamp >= now  # a call without ``ahead`` wants the cell now
-    device.preview(SIZE, ahead=True)
-    monkeypatch.setattr(live_view, "STALE_AFTER", 0.0)
-    later = cell.clock()
-    assert device.preview(SIZE, ahead=True).stamp >= later  # the one asked for is stale
+    again = device.preview(SIZE, ahead=True)
+    assert again.rgb is first.rgb and again.depth is first.depth  # the same pictures ...
+    assert again.stamp >= now  # ... showing the cell now
+    assert cell.live_view.requests()["shoulder"] == asked  # the mirror rendered nothing
 
 
 def test_the_mirrors_end_with_the_cell() -> None:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import sys
+from collections.abc import Callable
 
 import numpy as np
 from PySide6.QtCore import QPoint, Qt
@@ -16,7 +17,32 @@ from capabilities.geometry import pose_to_matrix
 from capabilities.robot_body import RobotBody, robot_base_from_arm
 from capabilities.sim.session import SimCellSession
 from engine.types import Pose, Region, Waypoint
-from instructor_app.panels.scene3d import Scene3DPanel
+from instructor_app.panels.scene3d import IDLE_REFRESH_MS, REFRESH_MS, Scene3DPanel
+
+
+def _wait_until(condition: Callable[[], bool], timeout_ms: int = 20000) -> bool:
+    waited = 0
+    while not condition() and waited < timeout_ms:
+        QTest.qWait(20)
+        waited += 20
+    return condition()
+
+
+def _idle_and_moving(panel: Scene3DPanel, cell: SimCellSession) -> dict[str, object]:
+    """Nothing changes: the panel looks for changes slowly and draws nothing; the arm moves:
+    it draws again at the quick rate (issue 26).
+    """
+    out: dict[str, object] = {}
+    out["went_slow"] = _wait_until(lambda: panel.refresh_interval_ms == IDLE_REFRESH_MS)
+    drawn, ticks = panel.frames_drawn, panel._tick
+    out["idle_ticks"] = _wait_until(lambda: panel._tick >= ticks + 8) and panel._tick - ticks
+    out["idle_frames"] = panel.frames_drawn - drawn
+    q = cell.sim.robot.joint_positions()
+    handle = cell.sim.robot.move_joints((q[0] + 0.5, *q[1:]), speed=0.3)
+    out["drew_when_moving"] = _wait_until(lambda: panel.frames_drawn > drawn + 3)
+    out["quick_when_moving"] = panel.refresh_interval_ms == REFRESH_MS or bool(handle.done())
+    handle.wait(30.0)
+    return out
 
 
 def main() -> int:
@@ -80,6 +106,7 @@ def main() -> int:
         out["ghost_visible"] = panel.ghost.items["base_link"].visible()
         panel.show_ghost(None)
         out["ghost_hidden"] = not panel.ghost.items["base_link"].visible()
+        out.update(_idle_and_moving(panel, cell))
         panel.stop()
     print(json.dumps(out))
     return 0

@@ -67,3 +67,7 @@ def test_with_opengl_the_scene_draws_picks_and_drags() -> None:
     assert out["gizmo_moved_by"] is not None and out["gizmo_moved_by"] > 0.01
     assert out["gizmo_kept_orientation"] is True
     assert out["ghost_visible"] is True and out["ghost_hidden"] is True
+    # Idle (issue 26): slow looks, nothing drawn over 8 of them; a move draws again.
+    assert out["went_slow"] is True and out["idle_ticks"] >= 8
+    assert out["idle_frames"] == 0
+    assert out["drew_when_moving"] is True and out["quick_when_moving"] is True
