@@ -11,6 +11,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
+from capabilities.arm_looks import ArmLooks, fail_if_occluded
 from capabilities.base import Capability, CapabilityEnv
 from capabilities.kit import (
     OperationKind,
@@ -54,37 +55,11 @@ class _Env:
         self.workers = env.interface("workers")
         self.layout = env.interface("scene_layout")
         self.library = env.interface("objects")
-        self.arm = env.cell.interfaces().get("arm")
-        self._arm_view: Any = None
-        self.glances: dict[str, Any] = {}  # camera -> arm_view.Glance of its last look
+        self.looks = ArmLooks(env.cell.interfaces().get("arm"))
 
     def camera(self, name: str) -> CameraDevice:
         """The cell's camera ``name``."""
         return camera(self.env, name)
-
-    def glance(self, camera: Any, frame: Any) -> Any:
-        """Note the arm's joints right after ``camera`` took ``frame`` (a fixed camera's look),
-        to tell later whether the arm hid the table in it (:mod:`capabilities.arm_view`).
-        """
-        if self.arm is None:
-            return None
-        from capabilities.arm_view import ArmView
-
-        if self._arm_view is None:
-            self._arm_view = ArmView(self.arm)
-        glance = self._arm_view.glance(camera, frame)
-        self.glances[str(camera.name)] = glance
-        return glance
-
-    def hidden(self) -> str:
-        """What to add to "not seen" when the arm hid the table in a camera's last look:
-        "; the arm hides the table from the <camera> camera (..)"; else "".
-        """
-        for glance in list(self.glances.values()):
-            cover = glance.hides() if glance is not None else None
-            if cover is not None:
-                return f"; {cover.sentence()}"
-        return ""
 
     def markers_on_objects(self) -> dict[int, tuple[str, Pose]]:
         """Marker id -> (object model name, marker pose in the object frame)."""
@@ -118,16 +93,6 @@ def _object_detections(
     return list(best.values())
 
 
-def _occluded(glance: Any, what: str) -> None:
-    """Fail the look (``occluded``) when the arm hid the table in it; it found nothing."""
-    cover = glance.hides() if glance is not None else None
-    if cover is not None:
-        raise OperationFailed(
-            f"{cover.sentence()}: {what}; move the arm out of its view before looking",
-            ErrorType.OCCLUDED,
-        )
-
-
 class DetectMarkers(StatefulOperation[_Env]):
     """markers.detect_markers: one look, on a worker thread, into the world model."""
 
@@ -149,13 +114,13 @@ class DetectMarkers(StatefulOperation[_Env]):
 
         def look() -> dict[str, Any]:
             frame = camera.capture()
-            glance = env.glance(camera, frame)
+            glance = env.looks.glance(camera, frame)
             sizes = env.layout["marker_sizes"]
             observations = detect_markers(frame.rgb, frame.K, sizes)
             if frame.depth is not None:
                 observations = [refine_with_depth(o, frame.depth, frame.K) for o in observations]
             if not observations:
-                _occluded(glance, "no markers were seen")
+                fail_if_occluded(glance, "no markers were seen")
             seen = {
                 o.marker_id: (o, marker_pose_world(o, frame.T_world_camera)) for o in observations
             }
@@ -191,7 +156,8 @@ class MarkerPose(StatefulOperation[_Env]):
         found = self._state.world.marker(marker_id)
         if found is None:
             raise OperationFailed(
-                f"marker {marker_id} has not been seen{self._state.hidden()}", ErrorType.NOT_FOUND
+                f"marker {marker_id} has not been seen{self._state.looks.hidden()}",
+                ErrorType.NOT_FOUND,
             )
         call.write("pose", found[0])
         return Job.done()
@@ -218,7 +184,7 @@ class ObjectPose(StatefulOperation[_Env]):
         detection = _best(self._state, call.input(OBJECT))
         if detection is None:
             raise OperationFailed(
-                f"{call.input(OBJECT).name} has not been seen{self._state.hidden()}",
+                f"{call.input(OBJECT).name} has not been seen{self._state.looks.hidden()}",
                 ErrorType.NOT_FOUND,
             )
         call.write("pose", detection.pose)
@@ -239,7 +205,7 @@ class ObjectFound(StatefulOperation[_Env]):
     def start(self, call: OperationCall) -> Job:
         if _best(self._state, call.input(OBJECT)) is not None:
             return Job.answer(True)
-        return Job.answer(False, f"{call.input(OBJECT).name} not seen{self._state.hidden()}")
+        return Job.answer(False, f"{call.input(OBJECT).name} not seen{self._state.looks.hidden()}")
 
 
 class CalibrateCamera(StatefulOperation[_Env]):

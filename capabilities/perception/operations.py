@@ -17,6 +17,7 @@ import threading
 import weakref
 from typing import TYPE_CHECKING, Any
 
+from capabilities.arm_looks import ArmLooks, fail_if_occluded
 from capabilities.base import Capability, CapabilityEnv
 from capabilities.kit import (
     OperationKind,
@@ -88,39 +89,14 @@ class _Env:
         self.workers = env.interface("workers")
         self.library = env.interface("objects")
         self.config = RecognitionConfig.from_settings(env.settings)
-        self.arm = env.cell.interfaces().get("arm")
-        self._arm_view: Any = None
-        self.glances: dict[str, Any] = {}  # camera -> arm_view.Glance of its last look
+        self.looks = ArmLooks(
+            env.cell.interfaces().get("arm"),
+            (self.config.workspace_min, self.config.workspace_max),
+        )
 
     def camera(self, name: str) -> Any:
         """The cell's camera ``name``."""
         return camera(self.env, name)
-
-    def glance(self, camera: Any, frame: Any) -> Any:
-        """Note the arm's joints right after ``camera`` took ``frame`` (a fixed camera's look),
-        to tell later whether the arm hid the table in it (:mod:`capabilities.arm_view`).
-        """
-        if self.arm is None:
-            return None
-        from capabilities.arm_view import ArmView
-
-        if self._arm_view is None:
-            self._arm_view = ArmView(
-                self.arm, (self.config.workspace_min, self.config.workspace_max)
-            )
-        glance = self._arm_view.glance(camera, frame)
-        self.glances[str(camera.name)] = glance
-        return glance
-
-    def hidden(self) -> str:
-        """What to add to "not seen" when the arm hid the table in a camera's last look:
-        "; the arm hides the table from the <camera> camera (..)"; else "".
-        """
-        for glance in list(self.glances.values()):
-            cover = glance.hides() if glance is not None else None
-            if cover is not None:
-                return f"; {cover.sentence()}"
-        return ""
 
     def seen(self, model: Any) -> list[Detection]:
         """Current perception detections of a class, best first."""
@@ -130,16 +106,6 @@ class _Env:
 
 CAMERA = camera_port()
 OBJECT = object_model("object", doc="the object class (a model name)")
-
-
-def _occluded(glance: Any, what: str) -> None:
-    """Fail the look (``occluded``) when the arm hid the table in it; it found nothing."""
-    cover = glance.hides() if glance is not None else None
-    if cover is not None:
-        raise OperationFailed(
-            f"{cover.sentence()}: {what}; move the arm out of its view before looking",
-            ErrorType.OCCLUDED,
-        )
 
 
 class DetectObjects(StatefulOperation[_Env]):
@@ -164,15 +130,15 @@ class DetectObjects(StatefulOperation[_Env]):
 
         def look() -> dict[str, Any]:
             frame = camera.capture()
-            glance = env.glance(camera, frame)
+            glance = env.looks.glance(camera, frame)
             try:
                 found = recognizer.recognize(frame)
             except PerceptionError as exc:
                 env.world.replace(source, [])
-                _occluded(glance, str(exc))
+                fail_if_occluded(glance, str(exc))
                 raise OperationFailed(f"{camera.name} camera: {exc}") from exc
             if not found:
-                _occluded(glance, "no objects were recognised")
+                fail_if_occluded(glance, "no objects were recognised")
             tracked = tracker.update(found, frame.stamp)
             detections = [
                 Detection(r.object_class, r.pose, r.confidence, frame.stamp, source, instance)
@@ -204,7 +170,9 @@ class ObjectFound(StatefulOperation[_Env]):
     def start(self, call: OperationCall) -> Job:
         if self._state.seen(call.input(OBJECT)):
             return Job.answer(True)
-        return Job.answer(False, f"{_name(call.input(OBJECT))} not seen{self._state.hidden()}")
+        return Job.answer(
+            False, f"{_name(call.input(OBJECT))} not seen{self._state.looks.hidden()}"
+        )
 
 
 class ObjectPose(StatefulOperation[_Env]):
@@ -223,7 +191,7 @@ class ObjectPose(StatefulOperation[_Env]):
         seen = self._state.seen(call.input(OBJECT))
         if not seen:
             raise OperationFailed(
-                f"{_name(call.input(OBJECT))} has not been seen{self._state.hidden()}",
+                f"{_name(call.input(OBJECT))} has not been seen{self._state.looks.hidden()}",
                 ErrorType.NOT_FOUND,
             )
         call.write("pose", seen[0].pose)
