@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 import pyqtgraph.opengl as gl
-from PySide6.QtCore import QPoint, Qt, QTimer, Signal
+from PySide6.QtCore import QPoint, Qt, Signal
 from PySide6.QtGui import QPainter, QPixmap
 from PySide6.QtWidgets import QCheckBox, QLabel, QPushButton, QToolBar, QVBoxLayout, QWidget
 
@@ -33,6 +33,7 @@ from capabilities.motion.targets import TargetResolver
 from capabilities.robot_body import RobotBodyError, robot_base_from_arm
 from engine.operations import OperationFailed
 from engine.types import Pose, Region, Waypoint, WaypointFrame
+from instructor_app.idle_timer import IdlePollTimer
 from instructor_app.panels.scene3d_items import (
     RobotItems,
     axes_item,
@@ -100,11 +101,9 @@ class Scene3DPanel(PointingMixin, QWidget):
         self._workers = ThreadPoolExecutor(1, "scene3d-truth")
         self._truth_job: Future[list[tuple[str, Pose]]] | None = None
         self._tick = 0
-        self._still = 0  # refreshes in a row that changed nothing
         self._shown_keys: dict[str, Any] = {}  # what each dynamic part was last drawn from
         self._build(layout)
-        self._timer = QTimer(self)
-        self._timer.setInterval(REFRESH_MS)
+        self._timer = IdlePollTimer(REFRESH_MS, IDLE_REFRESH_MS, IDLE_TICKS, self)
         self._timer.timeout.connect(self._refresh)
 
     def _build(self, layout: QVBoxLayout) -> None:
@@ -203,8 +202,8 @@ class Scene3DPanel(PointingMixin, QWidget):
         self._apply_gizmo(self._gizmo)
         self._show_regions()
         self._show_waypoints()
-        self._tick, self._still, self._shown_keys = 0, 0, {}
-        self._timer.setInterval(REFRESH_MS)
+        self._tick, self._shown_keys = 0, {}
+        self._timer.polled(True)  # quick again: all is drawn anew
         self._timer.start()
 
     def set_frame_source(self, source: FrameSource) -> None:
@@ -307,10 +306,7 @@ class Scene3DPanel(PointingMixin, QWidget):
             changed |= self._show_cloud()
         if changed:
             self.view.update()
-        self._still = 0 if changed else self._still + 1
-        interval = IDLE_REFRESH_MS if self._still >= IDLE_TICKS else REFRESH_MS
-        if interval != self._timer.interval():
-            self._timer.setInterval(interval)
+        self._timer.polled(changed)
 
     def _changed(self, part: str, key: Any) -> bool:
         """True (and remembers ``key``) when ``part`` was last drawn from something else."""

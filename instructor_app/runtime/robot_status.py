@@ -13,10 +13,11 @@ protective stop in the first 5 s) the button is shown greyed with the seconds le
 
 from __future__ import annotations
 
-from PySide6.QtCore import QTimer, Signal
+from PySide6.QtCore import Signal
 from PySide6.QtWidgets import QLabel, QToolButton, QWidget
 
 from capabilities.cell_features import CellStatus, ClearsStop, ReportsStatus
+from instructor_app.idle_timer import IdlePollTimer
 from instructor_app.runtime.session import CellSession
 
 __all__ = ["CellClearButton", "RobotStatusLabel"]
@@ -58,10 +59,7 @@ class RobotStatusLabel(QLabel):
         self.setObjectName("RobotStatus")
         self._session = session
         self._shown: CellStatus | None = None
-        self._interval_ms = interval_ms
-        self._unchanged = 0  # reads in a row that found the status shown
-        self._timer = QTimer(self)
-        self._timer.setInterval(interval_ms)
+        self._timer = IdlePollTimer(interval_ms, IDLE_INTERVAL_MS, IDLE_READS, self)
         self._timer.timeout.connect(self.refresh)
         self._timer.start()
         session.cell_changed.connect(lambda _name: self.refresh())
@@ -71,14 +69,9 @@ class RobotStatusLabel(QLabel):
         """Read the cell's status snapshot and show it (only when it changed)."""
         cell = self._session.cell
         status = cell.status() if isinstance(cell, ReportsStatus) else None
+        self._timer.polled(status != self._shown)
         if status == self._shown:
-            self._unchanged += 1
-            if self._unchanged == IDLE_READS:
-                self._timer.setInterval(max(self._interval_ms, IDLE_INTERVAL_MS))
             return
-        if self._unchanged >= IDLE_READS:
-            self._timer.setInterval(self._interval_ms)
-        self._unchanged = 0
         if (status is None) != (self._shown is None):
             self.presence_changed.emit(status is not None)
         fault_before, action_before, wait_before = self.fault, self.clear_action, self.clear_wait

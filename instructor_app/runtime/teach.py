@@ -22,13 +22,14 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
-from PySide6.QtCore import QObject, QTimer, Signal
+from PySide6.QtCore import QObject, Signal
 
 from capabilities.motion.jog import JogFailed, Jogger, JogSpeeds
 from capabilities.motion.symmetry import SymmetryTable
 from capabilities.motion.targets import TargetResolver
 from engine.operations import OperationFailed
 from engine.types import Pose
+from instructor_app.idle_timer import IdlePollTimer
 
 __all__ = ["ArmState", "RobotTeacher", "MOVE_HERE_FRACTION"]
 
@@ -103,10 +104,7 @@ class RobotTeacher(QObject):
         self._symmetries = SymmetryTable()
         self.speed_fraction = 0.25
         self.state: ArmState | None = None
-        self._poll_ms = poll_ms
-        self._unchanged = 0  # reads in a row that found the state shown
-        self._timer = QTimer(self)
-        self._timer.setInterval(poll_ms)
+        self._timer = IdlePollTimer(poll_ms, _IDLE_POLL_MS, _IDLE_READS, self)
         self._timer.timeout.connect(self.poll)
         self._timer.start()
         self.set_registry(registry)
@@ -145,14 +143,10 @@ class RobotTeacher(QObject):
     def poll(self) -> None:
         """Read the arm's state (a snapshot: never waits) and tell the panels if it changed."""
         state = self.read_state()
-        if _same_state(state, self.state):
-            self._unchanged += 1
-            if self._unchanged == _IDLE_READS:
-                self._timer.setInterval(max(self._poll_ms, _IDLE_POLL_MS))
+        changed = not _same_state(state, self.state)
+        self._timer.polled(changed)
+        if not changed:
             return
-        if self._unchanged >= _IDLE_READS:
-            self._timer.setInterval(self._poll_ms)
-        self._unchanged = 0
         self.state = state
         self.state_changed.emit(state)
 
