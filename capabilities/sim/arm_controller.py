@@ -2,8 +2,10 @@
 
 It plays a trajectory through pybullet's POSITION_CONTROL motors (target position plus
 feed-forward velocity, forces well above gravity load) so the arm is a physical body that
-pushes objects, and finishes a move once the joints have settled on the target. Stopping
-slows trajectory time down to zero, so a stopped arm stays on its path. A collision (see
+pushes objects, and finishes a move once the joints have settled on the target; a move held
+back short of it (blocked) fails and the arm holds where it stopped, no longer pressing on
+what blocked it. Stopping slows trajectory time down to zero, so a stopped arm stays on its
+path. A collision (see
 ``safety.py``) is a protective stop: the arm holds where it is at once, the move fails with
 the fault's words, and every motion is refused until the stop is unlocked.
 """
