@@ -2,8 +2,10 @@
 
 It plays a trajectory through pybullet's POSITION_CONTROL motors (target position plus
 feed-forward velocity, forces well above gravity load) so the arm is a physical body that
-pushes objects, and finishes a move once the joints have settled on the target. Stopping
-slows trajectory time down to zero, so a stopped arm stays on its path. A collision (see
+pushes objects, and finishes a move once the joints have settled on the target; a move held
+back short of it (blocked) fails and the arm holds where it stopped, no longer pressing on
+what blocked it. Stopping slows trajectory time down to zero, so a stopped arm stays on its
+path. A collision (see
 ``safety.py``) is a protective stop: the arm holds where it is at once, the move fails with
 the fault's words, and every motion is refused until the stop is unlocked.
 """
@@ -292,7 +294,11 @@ class ArmController:
         if error < _SETTLED_RAD and max(abs(v) for v in self.qd_actual) < MOVING_SPEED:
             self._finish_motion(True, "reached")
         elif motion.settle >= _SETTLE_TIMEOUT:
-            self._finish_motion(*self._arrival_check())
+            ok, message = self._arrival_check()
+            # Held back short of the target (blocked by contact): hold where the arm stopped.
+            # Holding the unreached target would keep it pressing with its full joint torques
+            # on whatever holds it back, and the arm would creep as that gives way.
+            self._finish_motion(ok, message, hold=None if ok else np.asarray(self.q_actual))
 
     def _arrival_check(self) -> tuple[bool, str]:
         tcp = self._tcp()
@@ -307,12 +313,17 @@ class ArmController:
             "from the target (a collision?)"
         )
 
-    def _finish_motion(self, ok: bool, message: str) -> None:
+    def _finish_motion(self, ok: bool, message: str, hold: np.ndarray | None = None) -> None:
+        """End the current move; the arm then holds ``hold`` (joints), by default where the
+        trajectory is now (a stopped move stays on its path).
+        """
         motion = self._motion
         self._motion = None
         if motion is None:
             return
-        if not ok:
+        if hold is not None:
+            self.q_cmd = hold
+        elif not ok:
             self.q_cmd = motion.trajectory.sample(motion.elapsed)[0]
         self._command(self.q_cmd, np.zeros(6))
         motion.handle.resolve(ok, message)

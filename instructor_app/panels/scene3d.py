@@ -43,6 +43,7 @@ from instructor_app.panels.scene3d_items import (
     set_pose,
     sphere_item,
 )
+from instructor_app.panels.scene3d_labels import Label, LabelsItem
 from instructor_app.panels.scene3d_pointing import PointingMixin
 from instructor_app.panels.scene3d_view import SceneView, opengl_problem
 
@@ -190,7 +191,8 @@ class Scene3DPanel(PointingMixin, QWidget):
                 shader="shaded",
             ),
         )
-        for item in (*self.frusta.values(), self.cloud, *self.gizmo_items):
+        self.labels = LabelsItem()  # every label of the scene, laid out so none overlaps
+        for item in (*self.frusta.values(), self.cloud, *self.gizmo_items, self.labels):
             view.addItem(item)
         self._dynamic: dict[str, list[Any]] = {
             "objects": [],
@@ -360,9 +362,14 @@ class Scene3DPanel(PointingMixin, QWidget):
             self.view.addItem(item)
         self._dynamic[group] = items
 
+    def label_rects(self) -> list[tuple[str, tuple[float, float, float, float]]]:
+        """Each label shown and its screen rectangle (x, y, w, h) for the camera now."""
+        labels = getattr(self, "labels", None)  # (no attribute: no OpenGL, no view)
+        return [(label.text, rect) for label, rect in labels.layout()] if labels else []
+
     def _object_items(
         self, name: str, pose: Pose, colour: tuple[float, ...], label: str
-    ) -> list[Any]:
+    ) -> tuple[Any, Label]:
         library = (self._cell.interfaces() if self._cell else {}).get("objects")
         try:
             if library is None:
@@ -377,22 +384,22 @@ class Scene3DPanel(PointingMixin, QWidget):
             glOptions="translucent" if colour[3] < 1 else "opaque",
         )
         set_pose(mesh, pose_to_matrix(pose))
-        text = gl.GLTextItem(
-            pos=np.add(pose.position, (0, 0, 0.12)), text=label, color=(230, 230, 230, 255)
-        )
-        return [mesh, text]
+        x, y, z = pose.position
+        return mesh, Label((x, y, z + 0.12), label)
 
     def _show_objects(self) -> bool:
         world = (self._cell.interfaces() if self._cell else {}).get("world")
         detections = tuple(world.detections()) if world is not None else ()
         if not self._changed("objects", detections):
             return False
-        items: list[Any] = []
-        for d in detections:
-            items += self._object_items(
+        shown = [
+            self._object_items(
                 d.object_class, d.pose, DETECTED_RGBA, f"{d.object_class} {d.confidence:.0%}"
             )
-        self._replace("objects", items)
+            for d in detections
+        ]
+        self._replace("objects", [mesh for mesh, _ in shown])
+        self.labels.set_group("objects", [label for _, label in shown])
         return True
 
     def _show_truth(self) -> bool:
@@ -407,17 +414,13 @@ class Scene3DPanel(PointingMixin, QWidget):
         ):
             truth = job.result()
             if self._changed("truth", tuple(truth)):
-                self._replace(
-                    "truth",
-                    [
-                        i
-                        for n, p in truth
-                        for i in self._object_items(n, p, TRUTH_RGBA, f"{n} (truth)")
-                    ],
-                )
+                shown = [self._object_items(n, p, TRUTH_RGBA, f"{n} (truth)") for n, p in truth]
+                self._replace("truth", [mesh for mesh, _ in shown])
+                self.labels.set_group("truth", [label for _, label in shown])
                 changed = True
         elif not self.truth_box.isChecked() and self._changed("truth", None):
             self._replace("truth", [])
+            self.labels.set_group("truth", [])
             changed = True
         cell = self._cell
         if self.truth_box.isChecked() and isinstance(cell, ShowsGroundTruth):
@@ -427,18 +430,15 @@ class Scene3DPanel(PointingMixin, QWidget):
 
     def _show_regions(self) -> None:
         items: list[Any] = []
+        labels: list[Label] = []
         for name, region in self._regions:
             sphere = sphere_item(region.radius, REGION_RGBA)
             sphere.translate(*region.center)
-            items += [
-                sphere,
-                gl.GLTextItem(
-                    pos=np.add(region.center, (0, 0, region.radius + 0.02)),
-                    text=name,
-                    color=(255, 120, 220, 255),
-                ),
-            ]
+            items.append(sphere)
+            x, y, z = region.center
+            labels.append(Label((x, y, z + region.radius + 0.02), name, (255, 120, 220, 255)))
         self._replace("regions", items)
+        self.labels.set_group("regions", labels)
 
     def _waypoint_pose(self, waypoint: Waypoint) -> Pose | None:
         """Where a waypoint is now, resolved as motion.move_to resolves it (a relative one
@@ -456,21 +456,18 @@ class Scene3DPanel(PointingMixin, QWidget):
 
     def _show_waypoints(self) -> None:
         items: list[Any] = []
+        labels: list[Label] = []
         for waypoint in self._waypoints:
             pose = self._waypoint_pose(waypoint)
             if pose is None:
                 continue
             axes = axes_item()
             set_pose(axes, pose_to_matrix(pose))
-            items += [
-                axes,
-                gl.GLTextItem(
-                    pos=np.add(pose.position, (0, 0, 0.03)),
-                    text=waypoint.name,
-                    color=(200, 230, 255, 255),
-                ),
-            ]
+            items.append(axes)
+            x, y, z = pose.position
+            labels.append(Label((x, y, z + 0.03), waypoint.name, (200, 230, 255, 255)))
         self._replace("waypoints", items)
+        self.labels.set_group("waypoints", labels)
 
 
 def _moved(a: Sequence[float], b: Sequence[float], tolerance: float) -> bool:

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
+from capabilities.motion.jog import Jogger
 from capabilities.robot.commands import CommandHandle
 from capabilities.sim.cell import SimCell
 from capabilities.sim.testing import angle_between, distance, down_at, run
@@ -105,3 +107,21 @@ def test_move_linear_through_the_base_singularity_fails_with_a_clear_message(cel
     assert handle.wait(30)
     assert handle.ok is False
     assert "unreachable" in handle.message or "branch flip" in handle.message
+
+
+def test_a_jog_blocked_by_an_object_holds_where_it_stopped(
+    cell: SimCell, make_box: Callable[..., int]
+) -> None:
+    # Issue 26: the arm went on pressing towards the target it could not reach, with its
+    # full joint torques, and crept as what held it back gave way.
+    robot = cell.robot
+    top = cell.table_top_z
+    run(robot.move_pose_joint_space(down_at(0.5, 0.1, top + 0.15)))
+    make_box((0.25, 0.25, 0.05), (0.615, 0.1), mass=1.0)  # its edge under the tool
+    jog = Jogger(robot).step("base", "z", -0.15, 0.2)
+    assert jog.wait(60)
+    assert jog.ok is False and "blocked" in jog.message
+    assert robot.protective_stop() is None  # a movable object is no collision
+    stopped = robot.tcp_pose()
+    cell.wait_sim(60.0)
+    assert distance(robot.tcp_pose(), stopped) < 1e-3

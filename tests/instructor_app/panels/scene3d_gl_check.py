@@ -16,6 +16,7 @@ from PySide6.QtWidgets import QApplication
 from capabilities.geometry import pose_to_matrix
 from capabilities.robot_body import RobotBody, robot_base_from_arm
 from capabilities.sim.session import SimCellSession
+from capabilities.world_model import Detection
 from engine.types import Pose, Region, Waypoint
 from instructor_app.panels.scene3d import IDLE_REFRESH_MS, REFRESH_MS, Scene3DPanel
 
@@ -43,6 +44,18 @@ def _idle_and_moving(panel: Scene3DPanel, cell: SimCellSession) -> dict[str, obj
     out["quick_when_moving"] = panel.refresh_interval_ms == REFRESH_MS or bool(handle.done())
     handle.wait(30.0)
     return out
+
+
+def _labels_of_close_objects(panel: Scene3DPanel, cell: SimCellSession) -> dict[str, object]:
+    """Two objects recognised 2 cm apart: their labels' screen rectangles (issue 26)."""
+    near = [
+        Detection("kit_bin", Pose((0.5, 0.1, 0.02)), 0.88, 0.0, "check"),
+        Detection("plate_8_holes", Pose((0.52, 0.1, 0.02)), 1.0, 0.0, "check"),
+    ]
+    cell.interfaces()["world"].replace("check", near)
+    wanted = {"kit_bin 88%", "plate_8_holes 100%"}
+    _wait_until(lambda: wanted <= {text for text, _ in panel.label_rects()})
+    return {"label_rects": [[text, list(rect)] for text, rect in panel.label_rects()]}
 
 
 def main() -> int:
@@ -107,6 +120,7 @@ def main() -> int:
         panel.show_ghost(None)
         out["ghost_hidden"] = not panel.ghost.items["base_link"].visible()
         out.update(_idle_and_moving(panel, cell))
+        out.update(_labels_of_close_objects(panel, cell))
         panel.stop()
     print(json.dumps(out))
     return 0

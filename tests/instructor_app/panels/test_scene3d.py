@@ -5,6 +5,7 @@ kinematics put it, picks points, draws regions, and the tool gizmo drags.
 
 from __future__ import annotations
 
+import itertools
 import json
 import os
 import subprocess
@@ -17,6 +18,11 @@ import pytest
 from instructor_app.panels.scene3d import Scene3DPanel
 
 ROOT = Path(__file__).resolve().parents[3]
+
+
+def _intersect(a: list[float], b: list[float]) -> bool:
+    """Whether two (x, y, w, h) rectangles share some area."""
+    return a[0] < b[0] + b[2] and b[0] < a[0] + a[2] and a[1] < b[1] + b[3] and b[1] < a[1] + a[3]
 
 
 def test_without_opengl_the_panel_says_why(qtbot) -> None:
@@ -58,6 +64,12 @@ def test_with_opengl_the_scene_draws_picks_and_drags() -> None:
     out = json.loads(done.stdout.strip().splitlines()[-1])
     assert out["available"] is True
     assert out["forearm_matches_fk"] is True
+    # Labels never overlap on screen: not those of two objects side by side (issue 26), nor
+    # those of the regions, waypoints and other objects shown.
+    rects = {text: rect for text, rect in out["label_rects"]}
+    assert {"kit_bin 88%", "plate_8_holes 100%", "REGION", "above"} <= set(rects)
+    for a, b in itertools.combinations(rects.values(), 2):
+        assert not _intersect(a, b), out["label_rects"]
     assert out["frames_drawn"] > 0
     assert len(out["picked"]) == 1
     assert np.linalg.norm(np.subtract(out["picked"][0], out["table_point"])) < 0.01
