@@ -52,6 +52,19 @@ class Dialogs:
         )
         return answer == buttons.Yes
 
+    def ask_overwrite_waypoint(self, parent: QWidget, name: str, users: list[str]) -> bool:
+        """Ask whether to teach again the waypoint ``name`` that the nodes ``users`` use too."""
+        buttons = QMessageBox.StandardButton
+        shown = ", ".join(repr(u) for u in users[:5]) + (" ..." if len(users) > 5 else "")
+        answer = QMessageBox.question(
+            parent,
+            APP_TITLE,
+            f"The waypoint {name!r} is also used by {shown}. Teach it again for all of them?",
+            buttons.Yes | buttons.Cancel,
+            buttons.Cancel,
+        )
+        return answer == buttons.Yes
+
     def error(self, parent: QWidget, title: str, text: str) -> None:
         QMessageBox.critical(parent, title, text)
 

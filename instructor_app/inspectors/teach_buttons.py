@@ -4,22 +4,34 @@ As on Rethink Intera's pose nodes: Teach fills the parameter from where the robo
 Pose becomes the tool pose; a Waypoint is taught again in its own frame, and every node
 using it follows; an unset Waypoint parameter gets a new waypoint in the world frame named
 after the node), and Move here, held down, drives the arm to the parameter's pose at
-reduced speed (let go and it stops).
+reduced speed (let go and it stops). :func:`change_text` says what a Teach changed (old and
+new pose in mm and degrees) and :func:`other_users` which other nodes share a waypoint (the
+inspector asks before teaching such a waypoint again).
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import Any
 
 from PySide6.QtWidgets import QHBoxLayout, QPushButton, QWidget
 
 from engine.operations import Direction, PortSpec
-from engine.spec import Binding
+from engine.spec import Binding, PlanSpec
 from engine.types import ParamType, Pose, Waypoint, WaypointFrame
+from engine.units import quaternion_to_rpy
 from instructor_app.runtime.waypoint_teach import TeachError, teach_like, teach_waypoint
 
-__all__ = ["TeachButtons", "TeachResult", "is_teachable", "taught_value", "move_target"]
+__all__ = [
+    "TeachButtons",
+    "TeachResult",
+    "change_text",
+    "is_teachable",
+    "move_target",
+    "other_users",
+    "taught_value",
+]
 
 _TEACHABLE = (ParamType.POSE, ParamType.WAYPOINT)
 
@@ -65,6 +77,39 @@ def taught_value(
         name, n = f"{node_name} {n}", n + 1
     new = teach_waypoint(interfaces, name, WaypointFrame.WORLD)
     return new, Binding.fixed(new, ParamType.WAYPOINT)
+
+
+def other_users(plan: PlanSpec, waypoint: str, node_id: str) -> list[str]:
+    """Names of the nodes other than ``node_id`` with a parameter fixed to ``waypoint``."""
+    return [
+        node.name or node.id
+        for _, node in plan.walk()
+        if node.id != node_id
+        and any(
+            not b.is_ref and isinstance(b.value, Waypoint) and b.value.name == waypoint
+            for b in node.params.values()
+        )
+    ]
+
+
+def pose_text(value: object) -> str:
+    """A Pose, or a Waypoint's pose (joints for a joint-space one), in mm and degrees."""
+    if isinstance(value, Waypoint):
+        if value.pose is None:
+            joints = value.joints.positions if value.joints is not None else ()
+            return "joints (" + ", ".join(f"{math.degrees(q):.1f}" for q in joints) + ")°"
+        where = f" relative to {value.reference}" if value.reference else ""
+        return pose_text(value.pose) + where
+    if not isinstance(value, Pose):
+        return "unset"
+    x, y, z = (v * 1000 for v in value.position)
+    r, p, w = (math.degrees(a) for a in quaternion_to_rpy(value.orientation))
+    return f"({x:.1f}, {y:.1f}, {z:.1f}) mm, ({r:.1f}, {p:.1f}, {w:.1f})°"
+
+
+def change_text(what: str, old: object, new: object) -> str:
+    """What a Teach changed, for the status bar: old and new pose and how to undo it."""
+    return f"Taught {what}: {pose_text(old)} → {pose_text(new)}. Undo: Ctrl+Z."
 
 
 def move_target(binding: Binding | None, reference: Binding | None) -> tuple[Any, Any] | None:

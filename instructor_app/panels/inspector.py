@@ -26,16 +26,20 @@ from engine.instances import instance_manifest
 from engine.kinds import KIND_DOC, KIND_PORTS
 from engine.operations import Direction, OperationSource, PortSpec
 from engine.spec import Binding, NodeKind, NodeSpec
+from engine.types import Waypoint
 from engine.units import display_unit
 from engine.validation import ERROR, Problem
+from instructor_app.dialogs import Dialogs
 from instructor_app.document import DocumentError, PlanDocument
 from instructor_app.inspectors.base import EditorContext
 from instructor_app.inspectors.factory import type_names
 from instructor_app.inspectors.rows import MODE_REFERENCE, PortRow
 from instructor_app.inspectors.teach_buttons import (
     TeachButtons,
+    change_text,
     is_teachable,
     move_target,
+    other_users,
     taught_value,
 )
 from instructor_app.node_factory import manifest_or_none, readable
@@ -68,6 +72,8 @@ class InspectorPanel(QWidget):
         self._field_labels: dict[str, QLabel] = {}
         self._teacher: Any = None  # RobotTeacher: Teach and Move here under Pose/Waypoint ports
         self.teach_buttons: dict[str, TeachButtons] = {}
+        # Questions (None: the window's, or plain message boxes); a test sets scripted ones.
+        self.dialogs: Dialogs | None = None
         self._build()
         document.node_changed.connect(self._node_changed)
         document.node_removed.connect(self._node_removed)
@@ -301,29 +307,50 @@ class InspectorPanel(QWidget):
         self.form.addRow("", buttons)
 
     def teach(self, port: str) -> bool:
-        """Fill ``port`` of the shown node from where the robot is now (one undo step)."""
+        """Fill ``port`` of the shown node from where the robot is now (one undo step). A
+        waypoint other nodes use too is taught again only if the user agrees; what changed
+        (old and new pose) goes to the status bar.
+        """
         node = self._find(self._node_id)
         row = self._port_rows.get(port)
         if node is None or row is None or self._teacher is None:
             return False
+        old = node.params.get(port)
+        old_value = old.value if old is not None and not old.is_ref else None
+        if isinstance(old_value, Waypoint):
+            users = other_users(self.document.plan, old_value.name, node.id)
+            if users and not self._question_dialogs().ask_overwrite_waypoint(
+                self, old_value.name, users
+            ):
+                self._teacher.message.emit(f"Teach cancelled: {old_value.name!r} is unchanged.")
+                return False
         names = [w.name for w in self.document.plan.waypoints]
         interfaces = {name: self._teacher.interface(name) for name in ("arm", "world")}
         try:
             waypoint, binding = taught_value(
-                interfaces, row.port, node.params.get(port), node.name, names, row.value_type
+                interfaces, row.port, old, node.name, names, row.value_type
             )
         except TeachError as exc:
             self._teacher.message.emit(f"Cannot teach {port}: {exc}.")
             return False
         if waypoint is None:
             self.document.set_param(node.id, port, binding)
+            what = f"{port} of {node.name or node.id}"
         else:
-            old = node.params.get(port)
-            old_name = old.value.name if old is not None and not old.is_ref else waypoint.name
+            old_name = old_value.name if isinstance(old_value, Waypoint) else waypoint.name
             self.document.replace_waypoint(
                 old_name, waypoint, f"Teach {waypoint.name!r}", bind=(node.id, port)
             )
+            what = f"the waypoint {waypoint.name!r}"
+        self._teacher.message.emit(change_text(what, old_value, binding.value))
         return True
+
+    def _question_dialogs(self) -> Dialogs:
+        """This panel's dialogs, else the main window's, else plain message boxes."""
+        if self.dialogs is not None:
+            return self.dialogs
+        found = getattr(self.window(), "dialogs", None)
+        return found if isinstance(found, Dialogs) else Dialogs()
 
     # ------------------------------------------------------------------ document -> view
 

@@ -5,7 +5,9 @@ The tool pose is shown in the world frame (origin at the robot's base, z up) in 
 degrees (roll, pitch, yaw about fixed axes, as the inspector shows poses), the joints in
 degrees. Arrows jog the tool in the base or the tool frame, and the joints one by one: by
 the chosen step per click, or while held (the arm moves while the button is down and stops
-when it is let go). Freedrive is held too: the arm can be guided by hand while it is down.
+when it is let go). Freedrive is held too: the arm can be guided by hand while it is down;
+on a cell whose freedrive takes a dragged pose (the simulated one), by dragging the tool in
+the 3D scene, which a line under the button says while it is held.
 All commands go through :class:`instructor_app.runtime.teach.RobotTeacher`.
 """
 
@@ -29,9 +31,10 @@ from PySide6.QtWidgets import (
 from engine.units import quaternion_to_rpy
 from instructor_app.runtime.teach import ArmState, RobotTeacher
 
-__all__ = ["MovePanel", "STEPS", "HOLD", "JOINT_NAMES"]
+__all__ = ["DRAG_HINT", "MovePanel", "STEPS", "HOLD", "JOINT_NAMES"]
 
 HOLD = "while held"
+DRAG_HINT = "Freedrive: drag the tool in the 3D scene"
 # (label, metres, radians): the step of one click, for moves and for turns.
 STEPS: tuple[tuple[str, float, float], ...] = (
     (HOLD, 0.0, 0.0),
@@ -81,6 +84,10 @@ class MovePanel(QWidget):
         self.freedrive_button.pressed.connect(teacher.press_freedrive)
         self.freedrive_button.released.connect(teacher.release_freedrive)
         layout.addWidget(self.freedrive_button)
+        self.freedrive_hint = QLabel("")
+        self.freedrive_hint.setObjectName("FreedriveHint")
+        self.freedrive_hint.setWordWrap(True)
+        layout.addWidget(self.freedrive_hint)
         self.status_label = QLabel("")
         self.status_label.setWordWrap(True)
         layout.addWidget(self.status_label)
@@ -212,6 +219,13 @@ class MovePanel(QWidget):
         for label, angle in zip(self.joint_labels, state.joints, strict=False):
             label.setText(f"{_number(math.degrees(angle), 2)} °")
         self.freedrive_button.setText("Freedrive: ON" if state.freedrive else "Freedrive (hold)")
+        self.freedrive_hint.setText(DRAG_HINT if state.freedrive and self._drag_guided() else "")
+
+    def _drag_guided(self) -> bool:
+        """The cell's freedrive follows a pose dragged in the 3D scene (no hand on a real arm
+        there: the simulated cell's).
+        """
+        return hasattr(self.teacher.interface("freedrive"), "freedrive_drag_to")
 
     def _update_enabled(self) -> None:
         reason = self.teacher.unavailable_reason("arm")
@@ -220,9 +234,10 @@ class MovePanel(QWidget):
             button.setEnabled(not reason)
         drive_reason = self.teacher.unavailable_reason("freedrive")
         self.freedrive_button.setEnabled(not drive_reason)
-        self.freedrive_button.setToolTip(
-            drive_reason.capitalize() if drive_reason else "Hold down to guide the arm by hand"
-        )
+        hold = "Hold down to guide the arm by hand"
+        if self._drag_guided():
+            hold = "Hold down, then drag the tool in the 3D scene: the arm follows"
+        self.freedrive_button.setToolTip(drive_reason.capitalize() if drive_reason else hold)
         self.status_label.setText(f"Cannot move the robot: {reason}." if reason else "")
 
     # ------------------------------------------------------------------ user actions

@@ -9,7 +9,7 @@ simulation's ground truth (a labelled toggle, for checking perception by eye) is
 worker thread.
 
 API for other panels: :meth:`Scene3DPanel.show_ghost`,
-:meth:`Scene3DPanel.set_gizmo` and the signals ``gizmo_dragged``, ``gizmo_released``,
+:meth:`Scene3DPanel.set_gizmo`, :meth:`Scene3DPanel.set_hand_guiding` and the signals ``gizmo_dragged``, ``gizmo_released``,
 ``point_picked`` and ``region_drawn``.
 """
 
@@ -258,6 +258,13 @@ class Scene3DPanel(PointingMixin, QWidget):
         """
         if pose != getattr(self, "_gizmo", None):  # (no attribute: no OpenGL, no view)
             self._apply_gizmo(pose)
+
+    def set_hand_guiding(self, on: bool) -> None:
+        """While on (Freedrive held), a plain left drag on the gizmo moves it, as Shift + drag
+        does at any time; a drag elsewhere still orbits the view.
+        """
+        if self.view is not None:
+            self.view.hand_guiding = on
 
     def _apply_gizmo(self, pose: Pose | None) -> None:
         self._gizmo = pose

@@ -12,7 +12,8 @@ llvmpipe under Xvfb that cost ~15 ms of CPU per repaint of a 1920 x 1080 window 
 Mouse: left drag orbits, middle drag (or Ctrl + left) pans, the wheel zooms (pyqtgraph's
 own); a left click without a drag picks a point; in region mode a left press sets the centre
 and the drag its radius; Shift + left drag on the gizmo's ball moves the gizmo in the plane
-facing the view.
+facing the view, and so does a plain left drag on it while ``hand_guiding`` is on (Freedrive
+held: the tool is taken by hand; a plain drag away from the ball still orbits).
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ from PySide6.QtOpenGL import QOpenGLWindow
 __all__ = ["OpenGLUnavailable", "SceneView", "opengl_problem"]
 
 _CLICK_SLOP_PX = 4.0  # a press and release closer than this is a click, not a drag
-_GIZMO_GRAB_PX = 18.0  # how near the gizmo's ball a Shift press must be to grab it
+_GIZMO_GRAB_PX = 18.0  # how near the gizmo's ball a press must be to grab it
 
 
 class OpenGLUnavailable(RuntimeError):
@@ -84,6 +85,7 @@ class SceneView(GLViewMixin, QOpenGLWindow):
         self.destroyed.connect(lambda *_: _LIVE.discard(self))
         self.frames_drawn = 0
         self.capture_drags = False
+        self.hand_guiding = False  # a plain left press on the gizmo grabs it (Freedrive held)
         self.gizmo_position: Callable[[], np.ndarray | None] = lambda: None
         self._press: tuple[float, float] | None = None
         self._moved = False
@@ -131,9 +133,8 @@ class SceneView(GLViewMixin, QOpenGLWindow):
         pos = ev.position()
         self._press, self._moved = (pos.x(), pos.y()), False
         if ev.button() == Qt.MouseButton.LeftButton:
-            if ev.modifiers() & Qt.KeyboardModifier.ShiftModifier and self._grab_gizmo(
-                pos.x(), pos.y()
-            ):
+            shift = bool(ev.modifiers() & Qt.KeyboardModifier.ShiftModifier)
+            if (shift or self.hand_guiding) and self._grab_gizmo(pos.x(), pos.y()):
                 return
             if self.capture_drags:
                 self.pressed.emit(*self.ray(pos.x(), pos.y()))

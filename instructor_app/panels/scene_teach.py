@@ -1,11 +1,12 @@
 """Teaching in the 3D scene: drag the tool gizmo and the arm follows; preview waypoints.
 
 Uses only the scene's public API (:class:`instructor_app.panels.scene3d.Scene3DPanel`):
-``available``, ``set_gizmo(pose | None)``,
+``available``, ``set_gizmo(pose | None)``, ``set_hand_guiding(bool)``,
 ``show_ghost(joints | None)`` and the signals ``gizmo_dragged(Pose)`` and
 ``gizmo_released(Pose)``. The gizmo sits on the TCP while nobody drags it; a drag sends the
 newest pose to the RobotTeacher (freedrive drag on the simulated cell, IK and joint moves
-elsewhere), off the GUI thread.
+elsewhere), off the GUI thread. While Freedrive is on, a plain drag on the gizmo moves it
+(Shift + drag at any time).
 """
 
 from __future__ import annotations
@@ -56,6 +57,7 @@ class SceneTeachLink(QObject):
         self.dragging = False
 
     def _state(self, state: object) -> None:
+        self.scene.set_hand_guiding(isinstance(state, ArmState) and state.freedrive)
         if self.dragging:
             return  # the gizmo is where the hand is; the arm is on its way
         self.scene.set_gizmo(state.tcp if isinstance(state, ArmState) else None)

@@ -70,13 +70,16 @@ class ScriptedDialogs(Dialogs):
         save_answers: answers to "save the changes?" ("save", "discard", "cancel"); when
             empty, "discard".
         restore_answers: answers to "restore the unsaved plan?"; when empty, False.
+        overwrite_answers: answers to "teach again a waypoint other nodes use?"; when
+            empty, False.
         open_paths / save_paths / cell_paths: what the file dialogs return ("" = cancelled).
-        asked: ("save" | "restore", text) in order; errors: (title, text) in order.
+        asked: ("save" | "restore" | "overwrite", text) in order; errors: (title, text) in order.
     """
 
     def __init__(self) -> None:
         self.save_answers: list[str] = []
         self.restore_answers: list[bool] = []
+        self.overwrite_answers: list[bool] = []
         self.open_paths: list[str] = []
         self.save_paths: list[str] = []
         self.cell_paths: list[str] = []
@@ -90,6 +93,10 @@ class ScriptedDialogs(Dialogs):
     def ask_restore(self, parent: QWidget, description: str) -> bool:
         self.asked.append(("restore", description))
         return self.restore_answers.pop(0) if self.restore_answers else False
+
+    def ask_overwrite_waypoint(self, parent: QWidget, name: str, users: list[str]) -> bool:
+        self.asked.append(("overwrite", f"{name}: {', '.join(users)}"))
+        return self.overwrite_answers.pop(0) if self.overwrite_answers else False
 
     def error(self, parent: QWidget, title: str, text: str) -> None:
         self.errors.append((title, text))

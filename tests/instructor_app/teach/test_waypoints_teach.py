@@ -22,7 +22,7 @@ from engine.types import ParamType, Pose, Waypoint, WaypointFrame
 from instructor_app.document import PlanDocument
 from instructor_app.panels import InspectorPanel, WaypointsPanel
 from instructor_app.runtime.teach import RobotTeacher
-from tests.instructor_app.gui_driver import choose
+from tests.instructor_app.gui_driver import ScriptedDialogs, choose
 
 JOINTS = (0.1, -1.2, 1.3, -1.4, -1.5, 0.6)
 DOWN = (1.0, 0.0, 0.0, 0.0)
@@ -248,3 +248,65 @@ def test_inspector_teach_on_an_unset_waypoint_makes_one_named_after_the_node(
     doc.undo_stack.undo()
     assert "target" not in doc.node(node_id).params and len(doc.plan.waypoints) == 1
     assert math.isfinite(made.pose.position[0])
+
+
+def test_inspector_teach_says_what_it_changed_and_asks_before_a_shared_waypoint(
+    qtbot: Any, doc: PlanDocument, inspector: InspectorPanel, teacher: RobotTeacher
+) -> None:
+    """Issue 26: Teach overwrote the shared 'observe' waypoint with no sign."""
+    observe = Waypoint("observe", WaypointFrame.WORLD, Pose((0.4, 0.0, 0.5), DOWN))
+    doc.store_waypoints([observe])
+    first = plan_using(doc, observe)
+    root = doc.plan.tree.id  # type: ignore[union-attr]
+    params = {"target": Binding.fixed(observe, ParamType.WAYPOINT)}
+    doc.add_node(
+        NodeSpec(NodeKind.OPERATION, "look again", op="motion.move_to", params=params), root
+    )
+    dialogs = ScriptedDialogs()
+    inspector.dialogs = dialogs
+    inspector.show_node(first)
+    before = doc.serialized()
+    teach = inspector.teach_buttons["target"].teach_button
+
+    dialogs.overwrite_answers = [False]  # "used by 'look again' too: teach it again?" No.
+    with qtbot.waitSignal(teacher.message) as said:
+        qtbot.mouseClick(teach, Qt.MouseButton.LeftButton)
+    assert dialogs.asked == [("overwrite", "observe: look again")]
+    assert "cancelled" in said.args[0] and doc.serialized() == before
+
+    dialogs.overwrite_answers = [True]
+    with qtbot.waitSignal(teacher.message) as said:
+        qtbot.mouseClick(teach, Qt.MouseButton.LeftButton)
+    assert len(dialogs.asked) == 2
+    assert said.args[0] == (
+        "Taught the waypoint 'observe': (400.0, 0.0, 500.0) mm, (180.0, 0.0, 0.0)° → "
+        "(500.0, 100.0, 300.0) mm, (180.0, 0.0, 0.0)°. Undo: Ctrl+Z."
+    )
+    assert doc.plan.waypoints[0].pose == TOOL
+    assert all(
+        node.params["target"].value.pose == TOOL
+        for _, node in doc.plan.walk()
+        if "target" in node.params
+    )
+    undoes_exactly(doc, before)  # one step on the undo stack
+
+
+def test_inspector_teach_of_a_waypoint_only_this_node_uses_asks_nothing(
+    qtbot: Any, doc: PlanDocument, inspector: InspectorPanel, teacher: RobotTeacher
+) -> None:
+    mine = Waypoint("mine", WaypointFrame.WORLD, Pose((0.4, 0.0, 0.5), DOWN))
+    doc.store_waypoints([mine])
+    node_id = plan_using(doc, mine)
+    dialogs = ScriptedDialogs()
+    inspector.dialogs = dialogs
+    inspector.show_node(node_id)
+    with qtbot.waitSignal(teacher.message) as said:
+        qtbot.mouseClick(inspector.teach_buttons["target"].teach_button, Qt.MouseButton.LeftButton)
+    assert dialogs.asked == [] and said.args[0].startswith("Taught the waypoint 'mine': (400.0")
+    with qtbot.waitSignal(teacher.message) as said:
+        qtbot.mouseClick(
+            inspector.teach_buttons["reference"].teach_button, Qt.MouseButton.LeftButton
+        )
+    assert said.args[0] == (
+        "Taught reference of go: unset → (500.0, 100.0, 300.0) mm, (180.0, 0.0, 0.0)°. Undo: Ctrl+Z."
+    )

@@ -1,6 +1,7 @@
 """Run by test_scene_drag.py in its own process on Xvfb's GL (QT_QPA_PLATFORM=xcb): in the
 Instructor's window on the simulated cell, Shift-drag the tool gizmo of the 3D scene with the
-mouse, let go, record the waypoint, preview it, and run a plan that goes there; prints one
+mouse, let go, record the waypoint, preview it, and run a plan that goes there; then, with
+the Move panel's Freedrive held, drag the tool with a plain left drag (no Shift); prints one
 JSON object of what it saw.
 """
 
@@ -32,6 +33,67 @@ def wait_for(app: QApplication, done: object, seconds: float) -> bool:
         app.processEvents()
         QTest.qWait(20)
     return bool(done())  # type: ignore[operator]
+
+
+def plain_drag(view: object, x: int, y: int, dx: int) -> None:
+    """A left drag without a modifier from (x, y), ``dx`` px to the right, in steps."""
+    none = Qt.KeyboardModifier.NoModifier
+    QTest.mousePress(view, Qt.MouseButton.LeftButton, none, QPoint(x, y))  # type: ignore[call-overload]
+    for k in range(1, 11):
+        QTest.mouseMove(view, QPoint(x + dx * k // 10, y))  # type: ignore[call-overload]
+        QTest.qWait(30)
+    QTest.mouseRelease(view, Qt.MouseButton.LeftButton, none, QPoint(x + dx, y))  # type: ignore[call-overload]
+
+
+def hand_guided(
+    app: QApplication, window: MainWindow, out: dict[str, object], ended: list[str]
+) -> None:
+    """Without Freedrive a plain drag on the tool orbits the view; with Freedrive held it
+    moves the arm and the Move panel says so; a plain drag away from the tool still orbits.
+    """
+    scene, move = window.cell_views.scene3d, window.views.move
+    view = scene.view
+    arm = window.session.cell.interfaces()["arm"]
+    start = arm.tcp_pose()
+    wait_for(app, lambda: math.dist(scene._gizmo.position, start.position) < 1e-4, 5)
+    azimuth = view.opts["azimuth"]
+    gx, gy = view.to_screen(np.array(start.position))
+    plain_drag(view, int(gx), int(gy), 40)
+    QTest.qWait(300)
+    out["plain_without_freedrive_mm"] = math.dist(arm.tcp_pose().position, start.position) * 1000
+    out["plain_without_freedrive_orbits"] = view.opts["azimuth"] != azimuth
+    out["hint_before"] = move.freedrive_hint.text()
+    QTest.mousePress(move.freedrive_button, Qt.MouseButton.LeftButton)
+    out["freedrive_on"] = wait_for(app, lambda: arm.freedrive_active(), 10)
+    out["hint_held"] = (
+        move.freedrive_hint.text() if wait_for(app, lambda: move.freedrive_hint.text(), 5) else ""
+    )
+    wait_for(app, lambda: view.hand_guiding, 5)
+    start = arm.tcp_pose()
+    gx, gy = view.to_screen(np.array(start.position))
+    azimuth = view.opts["azimuth"]
+    ended.clear()
+    released: list[object] = []
+    scene.gizmo_released.connect(released.append)
+    plain_drag(view, int(gx), int(gy), 40)
+    wait_for(app, lambda: "drag end:" in ended, 30)
+    out["hand_moved_mm"] = math.dist(arm.tcp_pose().position, start.position) * 1000
+    out["hand_at_release_mm"] = (
+        math.dist(arm.tcp_pose().position, released[0].position) * 1000  # type: ignore[attr-defined]
+        if released
+        else None
+    )
+    out["hand_drag_kept_view"] = view.opts["azimuth"] == azimuth
+    out["freedrive_still_on"] = arm.freedrive_active()
+    here = arm.tcp_pose()
+    plain_drag(view, 20, 20, 60)  # far from the tool: orbits
+    QTest.qWait(300)
+    out["away_orbits"] = view.opts["azimuth"] != azimuth
+    out["away_kept_arm_mm"] = math.dist(arm.tcp_pose().position, here.position) * 1000
+    QTest.mouseRelease(move.freedrive_button, Qt.MouseButton.LeftButton)
+    out["freedrive_released"] = wait_for(app, lambda: not arm.freedrive_active(), 10)
+    wait_for(app, lambda: not move.freedrive_hint.text(), 5)
+    out["hint_after"] = move.freedrive_hint.text()
 
 
 def main() -> int:
@@ -82,6 +144,7 @@ def main() -> int:
     dragged = window.document.plan.waypoints[0]
     panel.preview_button.setChecked(True)
     out["ghost_shown"] = wait_for(app, lambda: scene.ghost.items["base_link"].visible(), 10)
+    hand_guided(app, window, out, ended)
     window.views.move.step_combo.setCurrentIndex(5)  # 50 mm
     window.views.move.jog_buttons["z+"].click()
     wait_for(app, lambda: ended[-1].startswith("jog"), 30)

@@ -42,6 +42,10 @@ class SceneStandIn(QObject):
         super().__init__()
         self.gizmo: Pose | None = None
         self.ghosts: list[Any] = []
+        self.hand_guiding = False
+
+    def set_hand_guiding(self, on: bool) -> None:
+        self.hand_guiding = on
 
     def set_gizmo(self, pose: Pose | None) -> None:
         self.gizmo = pose
@@ -124,3 +128,12 @@ def test_with_opengl_a_mouse_drag_of_the_gizmo_teaches_a_waypoint_a_plan_reaches
     assert out["arm_at_release_mm"] < 1.0  # ...to where it let go
     assert out["ghost_shown"] is True
     assert out["run"] == "SUCCESS" and out["after_run_mm"] < 1.0
+    # Freedrive held: a plain drag on the tool moves the arm, and the Move panel says how.
+    assert out["plain_without_freedrive_mm"] < 1.0 and out["plain_without_freedrive_orbits"]
+    assert out["hint_before"] == "" and out["freedrive_on"] is True
+    assert out["hint_held"] == "Freedrive: drag the tool in the 3D scene"
+    assert out["hand_moved_mm"] > 20 and out["hand_drag_kept_view"] is True
+    assert out["hand_at_release_mm"] < 1.0
+    assert out["freedrive_still_on"] is True  # the button holds it, not the drag
+    assert out["away_orbits"] is True and out["away_kept_arm_mm"] < 1.0
+    assert out["freedrive_released"] is True and out["hint_after"] == ""

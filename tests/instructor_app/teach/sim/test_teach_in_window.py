@@ -18,6 +18,7 @@ from engine.types import Waypoint
 from instructor_app.main_window import MainWindow
 from instructor_app.runtime.session import CellSession
 from tests.instructor_app.gui_driver import (
+    ScriptedDialogs,
     choose,
     make_window,
     run_to_end,
@@ -218,3 +219,29 @@ def test_move_here_stops_when_the_button_is_let_go(
     assert blocker.args == ["move to start", ""]
     qtbot.mouseRelease(panel.move_button, LEFT)
     assert arm.joint_positions() == pytest.approx(far.joints.positions, abs=2e-3)
+
+
+def test_teach_in_the_inspector_asks_before_a_shared_waypoint_and_says_what_changed(
+    qtbot: Any, window: MainWindow, fast_sim: CellSession
+) -> None:
+    """Issue 26: Teach overwrote the shared 'observe' waypoint with no sign."""
+    observe = record(qtbot, window, "observe", "world")
+    nodes = plan_of_moves(qtbot, window, [observe, observe])
+    move = window.views.move
+    choose(qtbot, move.step_combo, "50 mm / 15°")
+    click_and_wait(qtbot, window, move.jog_buttons["z+"])
+    select(window, nodes[0])
+    dialogs = window.dialogs
+    assert isinstance(dialogs, ScriptedDialogs)
+    dialogs.overwrite_answers = [True]
+    qtbot.mouseClick(window.views.inspector.teach_buttons["target"].teach_button, LEFT)
+    assert dialogs.asked[-1][0] == "overwrite" and "observe" in dialogs.asked[-1][1]
+    said = window.statusBar().currentMessage()
+    assert said.startswith("Taught the waypoint 'observe': (") and "→" in said
+    assert "Undo" in said
+    taught = window.document.plan.waypoints[0]
+    assert taught.pose is not None and observe.pose is not None
+    assert taught.pose.position[2] == pytest.approx(observe.pose.position[2] + 0.05, abs=1e-3)
+    window.actions_by_name["undo"].trigger()
+    assert window.document.plan.waypoints[0] == observe
+    assert window.document.node(nodes[1]).params["target"].value == observe
