@@ -12,10 +12,16 @@ Figures, through the Instructor's RobotTeacher (the Move panel's and the 3D scen
 - ``jog_step_error_mm`` / ``jog_step_ms``: five 10 mm steps up (Move panel at 25 %): the worst
   difference between the step and how far the arm's reported TCP moved, and the mean time
   from the click to the end of the move.
+- ``figure3_actions`` / ``tending_setup_actions``: the user's actions of the suite's two
+  scripted builds by hand, counted as the suite counts them (tests/instructor_app/
+  gui_driver.py's CountingBot): Figure 3 from an empty plan (test_end_to_end.py) and our
+  tending plan set up from the library (test_tending_setup.py). The builds are those tests
+  themselves, run here by pytest in a child process (their scripts, not a copy); each
+  test records its count with ``record_property`` before it checks it.
 
-Run from the repository root::
+Run from the repository root (under a display, e.g. ``xvfb-run -a``)::
 
-    .venv/bin/python bench/teach.py [--json]
+    .venv/bin/python bench/teach.py [--json] [--actions-only]
 """
 
 from __future__ import annotations
@@ -23,9 +29,15 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import statistics
+import subprocess
+import sys
+import tempfile
 import threading
 import time
+import xml.etree.ElementTree as ET
+from pathlib import Path
 from typing import Any
 
 from PySide6.QtCore import QCoreApplication, Qt
@@ -35,6 +47,14 @@ from capabilities.sim.session import SimCellSession
 from engine.types import Pose
 from instructor_app.runtime.teach import RobotTeacher
 
+_ROOT = Path(__file__).resolve().parents[1]
+# The scripted builds whose counts are reported: test node id -> the figure it records.
+BUILDS = {
+    "tests/instructor_app/test_end_to_end.py::"
+    "test_figure3_built_by_hand_with_grasp_counted_saved_reopened_and_run": "figure3_actions",
+    "tests/instructor_app/test_tending_setup.py::"
+    "test_our_tending_plan_set_up_from_the_library_by_hand_as_on_site": "tending_setup_actions",
+}
 _RATE_HZ = 30.0
 _SPEED = 0.10  # m/s of the hand
 _LENGTH = 0.10  # m
@@ -128,6 +148,28 @@ def measure_jog_steps(teacher: RobotTeacher, arm: Any) -> dict[str, Any]:
     }
 
 
+def action_counts() -> dict[str, Any]:
+    """The user's actions of the suite's scripted builds (``BUILDS``), as their tests count
+    them: the tests run in a child pytest whose JUnit report carries each recorded count (a
+    build whose test fails after counting still reports; one that never counts reports None).
+    """
+    with tempfile.TemporaryDirectory() as folder:
+        report = Path(folder) / "builds.xml"
+        command = [sys.executable, "-m", "pytest", *BUILDS, "-q", "-p", "no:cacheprovider"]
+        command += ["-o", "junit_family=xunit2", f"--junitxml={report}"]
+        env = {**os.environ, "PYTHONPATH": str(_ROOT)}
+        subprocess.run(command, cwd=_ROOT, env=env, stdout=subprocess.DEVNULL, check=False)
+        recorded = (
+            {prop.get("name"): prop.get("value") for prop in ET.parse(report).iter("property")}
+            if report.exists()
+            else {}
+        )
+    return {
+        figure: int(recorded[figure]) if recorded.get(figure) else None
+        for figure in BUILDS.values()
+    }
+
+
 def measurements() -> dict[str, Any]:
     """Jog and drag figures on the simulated cell, with dragging by the cell and by IK as the
     peer.
@@ -147,12 +189,17 @@ def measurements() -> dict[str, Any]:
     return out
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     """Print the teaching figures (``--json``: one JSON object at the end)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--json", action="store_true", help="print one JSON object at the end")
-    args = parser.parse_args()
-    figures = measurements()
+    parser.add_argument(
+        "--actions-only", action="store_true", help="only the scripted builds' action counts"
+    )
+    args = parser.parse_args(argv)
+    figures = action_counts()  # first: the child process has the cores to itself
+    if not args.actions_only:
+        figures.update(measurements())
     if args.json:
         print(json.dumps(figures))
     else:

@@ -314,7 +314,7 @@ def _same_waypoint(ours: Waypoint, shipped: Waypoint) -> None:
 
 
 def test_our_tending_plan_set_up_from_the_library_by_hand_as_on_site(
-    qtbot: Any, tending_session: CellSession, tmp_path: Path
+    qtbot: Any, tending_session: CellSession, tmp_path: Path, record_property: Any
 ) -> None:
     registry = tending_session.registry
     shipped = load_plan(SHIPPED, registry.aliases())
@@ -354,6 +354,7 @@ def test_our_tending_plan_set_up_from_the_library_by_hand_as_on_site(
         _bind(hands, window, nodes[key], bindings)
     actions = len(hands.actions)
     print(f"tending set up by hand: {actions} user actions for {len(nodes)} nodes")
+    record_property("tending_setup_actions", actions)  # bench/teach.py reports it
     assert actions <= MOST_ACTIONS, hands.actions
 
     built = window.document.plan
