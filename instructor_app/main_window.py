@@ -30,6 +30,7 @@ from instructor_app.document.autosave import DEFAULT_INTERVAL_MS, Autosaver
 from instructor_app.document.editing import PlanDocument
 from instructor_app.document.model import DocumentError
 from instructor_app.document.tree_ops import can_have_child
+from instructor_app.inspectors.offers import nodes_before_insert, prebound
 from instructor_app.library_wiring import LibraryController
 from instructor_app.node_factory import make_node, manifest_or_none
 from instructor_app.panels.cell_views import CellViews
@@ -339,16 +340,22 @@ class MainWindow(QMainWindow):
         with a leaf (or a full decorator) selected, it goes right after it, as a sibling.
         Nothing selected: under the root (as the root when the plan is empty). The new
         node is selected, so that consecutive inserts with a leaf line up one after the
-        other, and the view scrolls to it.
+        other, and the view scrolls to it. A required input of the new node is bound to the
+        output of its type that a node before it writes, when exactly one does (one step).
         """
         if not item.available:
             self.show_message(f"{item.label} cannot be used on this cell: {item.reason}")
             return None
         if item.kind is NodeKind.SUBTREE:  # a library subtree: an instance, its subtree embedded
             return self.library.insert(item.op)
-        node = make_node(item, manifest_or_none(self.session.registry, item.op))
+        registry = self.session.registry
+        manifest = manifest_or_none(registry, item.op)
+        node = make_node(item, manifest)
         try:
             parent_id, index = self._insertion_point()
+            # a required input takes the one output of its type written before it, if one
+            before = nodes_before_insert(self.document.plan, parent_id, index)
+            node = prebound(node, manifest, self.document.plan, registry, before)
             new_id = self.document.add_node(node, parent_id, index)
         except DocumentError as exc:
             self.show_message(f"Cannot add {node.label} here: {exc}")

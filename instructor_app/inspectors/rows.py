@@ -47,8 +47,10 @@ class PortRow(QWidget):
     """One port of an operation node.
 
     Inputs: a mode switch (unset / value / parameter), for values the editor of the chosen
-    type, for parameters a name with completion. Outputs: the name the result is stored
-    under.
+    type, for parameters a name with completion that lists the offered names first (the
+    outputs of this type written before the node, nearest first: ``set_offers``); choosing
+    "parameter" with no name yet binds the first offer. Outputs: the name the result is
+    stored under.
 
     Signals:
         binding_committed(object): the new Binding, or None to unbind.
@@ -67,7 +69,15 @@ class PortRow(QWidget):
         self.port = port
         self._context = context
         self.types = concrete_types(port) or [ParamType.TEXT]
-        self.ref_field = _name_field(names)
+        self._names = names
+        self._offers: list[str] = []
+        if port.direction is Direction.OUT:
+            self.ref_field = _name_field(names)
+        else:  # its own list: the offers first, then the plan's other names
+            self._choices = QStringListModel(self)
+            self.ref_field = _name_field(self._choices)
+            names.modelReset.connect(self._fill_choices)
+            self._fill_choices()
         self.ref_field.editingFinished.connect(self._ref_finished)
         self.editor: ParamEditor | None = None
         self.mode_combo = QComboBox()
@@ -107,6 +117,28 @@ class PortRow(QWidget):
     @property
     def value_type(self) -> ParamType:
         return self.types[max(0, self.type_combo.currentIndex())]
+
+    @property
+    def offers(self) -> list[str]:
+        """Names offered first for a parameter of this input, the nearest output first."""
+        return list(self._offers)
+
+    def set_offers(self, names: list[str]) -> None:
+        if names != self._offers:
+            self._offers = list(names)
+            self._fill_choices()
+
+    def reference_choices(self) -> list[str]:
+        """The names the parameter field's completion lists, in order."""
+        return self.ref_field.completer().model().stringList()  # type: ignore[attr-defined]
+
+    def _fill_choices(self) -> None:
+        if self.port.direction is Direction.OUT:
+            return
+        rest = [n for n in self._names.stringList() if n not in self._offers]
+        choices = [*self._offers, *rest]
+        if choices != self._choices.stringList():
+            self._choices.setStringList(choices)
 
     def set_context(self, context: EditorContext) -> None:
         self._context = context
@@ -162,6 +194,8 @@ class PortRow(QWidget):
         elif mode == MODE_VALUE:
             self._emit_fixed()
         else:
+            if not self.ref_field.text().strip() and self._offers:
+                self.ref_field.setText(self._offers[0])  # the nearest output of this type
             self.ref_field.setFocus()
             self._ref_finished()
 

@@ -33,6 +33,7 @@ from instructor_app.dialogs import Dialogs
 from instructor_app.document import DocumentError, PlanDocument
 from instructor_app.inspectors.base import EditorContext
 from instructor_app.inspectors.factory import type_names
+from instructor_app.inspectors.offers import nodes_before, offered_outputs
 from instructor_app.inspectors.rows import MODE_REFERENCE, PortRow
 from instructor_app.inspectors.teach_buttons import (
     TeachButtons,
@@ -273,6 +274,19 @@ class InspectorPanel(QWidget):
             self._add_row(port.name, text, tip, row)
             if self._teacher is not None and is_teachable(port):
                 self._add_teach_buttons(port)
+        self._update_offers()
+
+    def _update_offers(self) -> None:
+        """Offer each input first the outputs of its types written before the shown node."""
+        node = self._find(self._node_id)
+        if node is None or node.kind not in (NodeKind.OPERATION, NodeKind.SUBTREE):
+            return
+        plan = self.document.plan
+        before = nodes_before(plan, node.id)
+        for row in self._port_rows.values():
+            if row.port.direction is Direction.IN:
+                types = tuple(row.port.types)
+                row.set_offers(offered_outputs(plan, self._registry, before, types, node))
 
     def _refresh(self, node: NodeSpec) -> None:
         """Show the node's current values in the existing rows."""
@@ -375,6 +389,7 @@ class InspectorPanel(QWidget):
         if names != self._names.stringList():
             self._names.setStringList(names)
         self._update_context()
+        self._update_offers()
 
     # ------------------------------------------------------------------ view -> document
 

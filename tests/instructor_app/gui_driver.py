@@ -299,11 +299,18 @@ def rename(qtbot: Any, window: MainWindow, node_id: str, name: str) -> None:
 
 
 def bind_reference(qtbot: Any, window: MainWindow, node_id: str, port: str, name: str) -> None:
-    """Bind a port to a named parameter (inputs: choose "parameter" first)."""
+    """Bind a port to a named parameter (inputs: choose "parameter" first; a user leaves
+    the name it then shows, the first offered, when it is the one wanted).
+    """
     select(window, node_id, qtbot)
     row: PortRow = window.views.inspector.port_row(port)
     if row.mode_combo.count():
+        if row.mode == MODE_REFERENCE and row.ref_field.text() == name:
+            return  # already bound so (a fresh node's input pre-bound)
         choose_index(qtbot, row.mode_combo, MODE_REFERENCE)
+        binding = window.document.node(node_id).params.get(port)
+        if row.ref_field.text() == name and binding is not None and binding.ref == name:
+            return
     _replace_text(qtbot, row.ref_field, name)
     qtbot.keyClick(row.ref_field, Qt.Key.Key_Return)
 
