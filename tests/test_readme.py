@@ -20,8 +20,8 @@ def test_the_readme_says_what_the_set_up_downloads_and_how_long_it_takes() -> No
 
 
 def test_the_readme_says_how_to_move_the_simulated_arm_by_hand_as_the_scene_does_it() -> None:
+    # The gestures themselves (Shift+drag on the tool, a plain drag while Freedrive is on)
+    # are driven with real mouse events in tests/instructor_app/teach/sim/test_scene_drag.py.
     text = _readme()
     assert "Shift" in text and "gizmo" in text, "the README does not say how to drag the arm"
-    view = (ROOT / "instructor_app" / "panels" / "scene3d_view.py").read_text(encoding="utf-8")
-    grab = view[view.index("def mousePressEvent") :]
-    assert "ShiftModifier and self._grab_gizmo(" in grab  # the gesture the README names
+    assert "Freedrive" in text, "the README does not say that Freedrive lets a plain drag move it"
