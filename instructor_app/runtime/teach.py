@@ -80,6 +80,7 @@ class RobotTeacher(QObject):
         finished(str, str): a command ended: (what, problem; "" when it went well).
         message(str): words for the status bar.
         preview_ready(object): the joints (rad) a previewed target puts the arm at, or None.
+        freedrive_left(): :meth:`leave_freedrive` turned freedrive off (a run is starting).
     """
 
     state_changed = Signal(object)
@@ -87,6 +88,7 @@ class RobotTeacher(QObject):
     finished = Signal(str, str)
     message = Signal(str)
     preview_ready = Signal(object)
+    freedrive_left = Signal()
 
     def __init__(self, registry: Any = None, poll_ms: int = _POLL_MS, parent: Any = None) -> None:
         super().__init__(parent)
@@ -235,6 +237,21 @@ class RobotTeacher(QObject):
         return drive is not None and self._submit(
             "freedrive off", lambda: drive.set_freedrive(False) or ""
         )
+
+    def leave_freedrive(self) -> None:
+        """Freedrive off now, on the calling thread: a plan is about to command the arm (a
+        move is refused in freedrive). The one wait outside the worker, and short: freedrive
+        is left on only by the simulated cell's toggle (a real arm's button is held).
+        """
+        drive = self._interfaces.get("freedrive")
+        if drive is None:
+            return
+        try:
+            if drive.freedrive_active():
+                drive.set_freedrive(False)
+        except Exception as exc:  # a backend error is told, never raised into the GUI
+            self.message.emit(f"Freedrive off: {type(exc).__name__}: {exc}")
+        self.freedrive_left.emit()
 
     def release(self) -> None:
         """End the held action (the worker stops the arm); never waits."""

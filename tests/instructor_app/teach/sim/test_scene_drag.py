@@ -15,9 +15,16 @@ from typing import Any
 
 import pytest
 from PySide6.QtCore import QObject, Qt, Signal
+from PySide6.QtWidgets import QApplication
 
 from engine.status import Status
 from engine.types import Pose
+from instructor_app.panels.move import (
+    DRAG_HINT,
+    DRAG_HINT_OFF,
+    FREEDRIVE_TOGGLE,
+    FREEDRIVE_TOGGLE_ON,
+)
 from instructor_app.panels.scene_teach import SceneTeachLink
 from instructor_app.runtime.session import CellSession
 from tests.instructor_app.gui_driver import (
@@ -105,6 +112,84 @@ def test_drag_the_tool_record_and_run(qtbot: Any, fast_sim: CellSession, tmp_pat
     set_value(qtbot, window, node_id, "target", dragged)
     assert run_to_end(qtbot, window, 60_000).status is Status.SUCCESS
     assert arm.tcp_pose().position == pytest.approx(path[-1].position, abs=1e-3)
+
+
+def test_on_the_simulated_cell_a_click_turns_freedrive_on_until_the_next_click(
+    qtbot: Any, fast_sim: CellSession, tmp_path: Path
+) -> None:
+    """One mouse cannot hold Freedrive and drag the tool: on the simulated cell a click turns
+    it on and it stays on; a plain drag on the tool moves the arm; the next click, Esc or a
+    run starting turn it off.
+    """
+    window = make_window(qtbot, fast_sim, tmp_path)
+    window.new_plan()
+    teacher, move = window.views.teacher, window.views.move
+    arm = fast_sim.cell.interfaces()["arm"]
+    scene = SceneStandIn()
+    link = SceneTeachLink(scene, teacher, window.views.waypoints)
+    button = move.freedrive_button
+    assert button.isCheckable() and button.text() == FREEDRIVE_TOGGLE
+    assert move.freedrive_hint.text() == DRAG_HINT_OFF
+
+    def turn_on() -> None:
+        with qtbot.waitSignal(teacher.finished, timeout=10_000) as blocker:
+            qtbot.mouseClick(button, LEFT)  # pressed and let go
+        assert blocker.args == ["freedrive", ""]
+        qtbot.waitUntil(lambda: scene.hand_guiding and button.text() == FREEDRIVE_TOGGLE_ON)
+        assert button.isChecked() and arm.freedrive_active()
+        assert move.freedrive_hint.text() == DRAG_HINT
+
+    panel = window.views.waypoints
+    qtbot.waitUntil(lambda: scene.gizmo is not None)
+    choose(qtbot, panel.frame_combo, "world")
+    qtbot.keyClicks(panel.name_field, "start")
+    qtbot.mouseClick(panel.record_button, LEFT)
+    home = window.document.plan.waypoints[0]
+
+    turn_on()
+    fast_sim.cell.sim.wait_sim(0.5)
+    assert arm.freedrive_active() and button.isChecked()  # on without a hand on the button
+
+    start = arm.tcp_pose()
+    path = [
+        Pose(
+            (start.position[0], start.position[1] + 0.01 * k, start.position[2]), start.orientation
+        )
+        for k in range(1, 6)
+    ]
+    for pose in path:  # what a plain drag on the tool emits while hand guiding is on
+        scene.gizmo_dragged.emit(pose)
+        qtbot.wait(20)
+    with qtbot.waitSignal(
+        teacher.finished, timeout=30_000, check_params_cb=lambda w, p: w == "drag end"
+    ):
+        scene.gizmo_released.emit(path[-1])
+    assert arm.tcp_pose().position == pytest.approx(path[-1].position, abs=1e-3)
+    assert arm.freedrive_active() and button.isChecked() and not link.dragging
+
+    with qtbot.waitSignal(teacher.finished, timeout=10_000) as blocker:
+        qtbot.mouseClick(button, LEFT)  # the next click: off
+    assert blocker.args == ["freedrive off", ""]
+    assert not arm.freedrive_active() and not button.isChecked()
+    qtbot.waitUntil(lambda: not scene.hand_guiding and button.text() == FREEDRIVE_TOGGLE)
+    assert move.freedrive_hint.text() == DRAG_HINT_OFF
+
+    turn_on()  # Esc in the window turns it off
+    window.activateWindow()
+    qtbot.waitUntil(window.isActiveWindow)
+    qtbot.waitUntil(lambda: QApplication.focusWidget() is not None)
+    with qtbot.waitSignal(teacher.finished, timeout=10_000) as blocker:
+        qtbot.keyClick(QApplication.focusWidget(), Qt.Key.Key_Escape)
+    assert blocker.args == ["freedrive off", ""]
+    assert not arm.freedrive_active() and not button.isChecked()
+
+    turn_on()  # a run starting turns it off before the plan moves the arm
+    search_insert(qtbot, window, "sequence", "sequence")
+    node_id = search_insert(qtbot, window, "motion.move_to", "motion.move_to")
+    set_value(qtbot, window, node_id, "target", home)
+    assert run_to_end(qtbot, window, 60_000).status is Status.SUCCESS
+    assert not arm.freedrive_active() and not button.isChecked()
+    assert arm.tcp_pose().position == pytest.approx(start.position, abs=1e-3)
 
 
 ROOT = Path(__file__).resolve().parents[4]
