@@ -213,12 +213,16 @@ def test_with_opengl_a_mouse_drag_of_the_gizmo_teaches_a_waypoint_a_plan_reaches
     assert out["arm_at_release_mm"] < 1.0  # ...to where it let go
     assert out["ghost_shown"] is True
     assert out["run"] == "SUCCESS" and out["after_run_mm"] < 1.0
-    # Freedrive held: a plain drag on the tool moves the arm, and the Move panel says how.
+    # Freedrive clicked on (a toggle here): a plain drag on the tool moves the arm, and the
+    # Move panel says how; the next click turns it off.
     assert out["plain_without_freedrive_mm"] < 1.0 and out["plain_without_freedrive_orbits"]
-    assert out["hint_before"] == "" and out["freedrive_on"] is True
-    assert out["hint_held"] == "Freedrive: drag the tool in the 3D scene"
+    assert out["hint_before"] == DRAG_HINT_OFF and out["button_before"] == FREEDRIVE_TOGGLE
+    assert out["freedrive_on"] is True and out["button_down"] is True
+    assert out["button_on"] == FREEDRIVE_TOGGLE_ON and out["hint_held"] == DRAG_HINT
     assert out["hand_moved_mm"] > 20 and out["hand_drag_kept_view"] is True
     assert out["hand_at_release_mm"] < 1.0
-    assert out["freedrive_still_on"] is True  # the button holds it, not the drag
+    assert out["freedrive_still_on"] is True  # the toggle holds it, not the drag
     assert out["away_orbits"] is True and out["away_kept_arm_mm"] < 1.0
-    assert out["freedrive_released"] is True and out["hint_after"] == ""
+    assert out["freedrive_still_on_after_away"] is True
+    assert out["freedrive_released"] is True and out["button_up"] is True
+    assert out["hint_after"] == DRAG_HINT_OFF
