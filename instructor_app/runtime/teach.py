@@ -3,9 +3,10 @@
 It reads the arm's state for display (the backends read a snapshot their own thread keeps,
 so that never waits) and sends every command that can wait (a move, a stop, freedrive on
 or off, a target's inverse kinematics) to ONE worker thread, in order, as the capabilities
-send work off the engine thread. Held actions (a jog arrow, Move here, Freedrive) start on
-press and end on release: :meth:`release` only sets an event the worker watches, so the
-GUI thread never waits for the arm.
+send work off the engine thread. Held actions (a jog arrow, Move here, Freedrive on a real
+arm) start on press and end on release: :meth:`release` only sets an event the worker
+watches, so the GUI thread never waits for the arm (but for :meth:`leave_freedrive`, as a
+run starts, which turns the simulated cell's toggled freedrive off before the plan moves).
 
 It works on any cell whose interfaces follow the backend Protocols: ``arm``
 (:class:`capabilities.motion.backend.ArmBackend`), ``freedrive``
