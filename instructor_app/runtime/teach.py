@@ -81,7 +81,8 @@ class RobotTeacher(QObject):
         finished(str, str): a command ended: (what, problem; "" when it went well).
         message(str): words for the status bar.
         preview_ready(object): the joints (rad) a previewed target puts the arm at, or None.
-        freedrive_left(): :meth:`leave_freedrive` turned freedrive off (a run is starting).
+        freedrive_left(): a toggled freedrive is over: :meth:`leave_freedrive` turned it off
+            (a run is starting), or the cell changed.
     """
 
     state_changed = Signal(object)
@@ -115,10 +116,19 @@ class RobotTeacher(QObject):
     # ------------------------------------------------------------------ cell
 
     def set_registry(self, registry: Any) -> None:
-        """Use another cell (what runs on the old one is stopped)."""
+        """Use another cell (what runs on the old one is stopped, and a toggled Freedrive is
+        over: a new cell starts with it off, the same cell's is turned off).
+        """
         self.stop_all()
+        old_drive = self._interfaces.get("freedrive")
         cell = getattr(registry, "cell", None)
         self._interfaces = dict(cell.interfaces()) if cell is not None else {}
+        drive: Any = self._interfaces.get("freedrive")
+        if drive is not None and drive is old_drive:
+            with contextlib.suppress(Exception):  # a snapshot read: never waits
+                if drive.freedrive_active():
+                    self.release_freedrive()
+        self.freedrive_left.emit()
         self.poll()
         self.availability_changed.emit()
 

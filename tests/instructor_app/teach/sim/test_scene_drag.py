@@ -118,8 +118,8 @@ def test_on_the_simulated_cell_a_click_turns_freedrive_on_until_the_next_click(
     qtbot: Any, fast_sim: CellSession, tmp_path: Path
 ) -> None:
     """One mouse cannot hold Freedrive and drag the tool: on the simulated cell a click turns
-    it on and it stays on; a plain drag on the tool moves the arm; the next click, Esc or a
-    run starting turn it off.
+    it on and it stays on; a plain drag on the tool moves the arm; the next click, Esc, the
+    cell changing or a run starting turn it off.
     """
     window = make_window(qtbot, fast_sim, tmp_path)
     window.new_plan()
@@ -182,6 +182,12 @@ def test_on_the_simulated_cell_a_click_turns_freedrive_on_until_the_next_click(
         qtbot.keyClick(QApplication.focusWidget(), Qt.Key.Key_Escape)
     assert blocker.args == ["freedrive off", ""]
     assert not arm.freedrive_active() and not button.isChecked()
+
+    turn_on()  # the cell (re)opened: what the window does with its new registry
+    with qtbot.waitSignal(teacher.finished, timeout=10_000) as blocker:
+        window.views.set_registry(fast_sim.registry)
+    assert blocker.args == ["freedrive off", ""]
+    assert not arm.freedrive_active() and not button.isChecked() and button.isCheckable()
 
     turn_on()  # a run starting turns it off before the plan moves the arm
     search_insert(qtbot, window, "sequence", "sequence")
