@@ -123,8 +123,8 @@ class RobotTeacher(QObject):
         old_drive = self._interfaces.get("freedrive")
         cell = getattr(registry, "cell", None)
         self._interfaces = dict(cell.interfaces()) if cell is not None else {}
-        drive: Any = self._interfaces.get("freedrive")
-        if drive is not None and drive is old_drive:
+        drive = self._interfaces.get("freedrive")
+        if drive is old_drive and drive is not None:
             with contextlib.suppress(Exception):  # a snapshot read: never waits
                 if drive.freedrive_active():
                     self.release_freedrive()
