@@ -5,9 +5,12 @@ The tool pose is shown in the world frame (origin at the robot's base, z up) in 
 degrees (roll, pitch, yaw about fixed axes, as the inspector shows poses), the joints in
 degrees. Arrows jog the tool in the base or the tool frame, and the joints one by one: by
 the chosen step per click, or while held (the arm moves while the button is down and stops
-when it is let go). Freedrive is held too: the arm can be guided by hand while it is down;
-on a cell whose freedrive takes a dragged pose (the simulated one), by dragging the tool in
-the 3D scene, which a line under the button says while it is held.
+when it is let go). On a real arm Freedrive is held too, as on the pendant: the arm can be
+guided by hand while it is down. On a cell whose freedrive takes a dragged pose (the
+simulated one) the hand is the mouse, which cannot hold the button and drag the tool in the
+3D scene at once: there Freedrive is a toggle (a click turns it on and the button stays
+down; the next click, Esc, a run starting or the cell changing turn it off), and a line
+under the button says how to drag.
 All commands go through :class:`instructor_app.runtime.teach.RobotTeacher`.
 """
 
@@ -16,6 +19,7 @@ from __future__ import annotations
 import math
 
 from PySide6.QtCore import Qt
+from PySide6.QtGui import QKeySequence, QShortcut
 from PySide6.QtWidgets import (
     QComboBox,
     QGridLayout,
@@ -31,10 +35,28 @@ from PySide6.QtWidgets import (
 from engine.units import quaternion_to_rpy
 from instructor_app.runtime.teach import ArmState, RobotTeacher
 
-__all__ = ["DRAG_HINT", "MovePanel", "STEPS", "HOLD", "JOINT_NAMES"]
+__all__ = [
+    "DRAG_HINT",
+    "DRAG_HINT_OFF",
+    "FREEDRIVE_HELD",
+    "FREEDRIVE_ON",
+    "FREEDRIVE_TOGGLE",
+    "FREEDRIVE_TOGGLE_ON",
+    "MovePanel",
+    "STEPS",
+    "HOLD",
+    "JOINT_NAMES",
+]
 
 HOLD = "while held"
-DRAG_HINT = "Freedrive: drag the tool in the 3D scene"
+# The Freedrive button's words: held (a real arm) and toggled (the simulated cell).
+FREEDRIVE_HELD = "Freedrive (hold)"
+FREEDRIVE_ON = "Freedrive: ON"
+FREEDRIVE_TOGGLE = "Freedrive (click to turn on)"
+FREEDRIVE_TOGGLE_ON = "Freedrive ON: drag the tool in the 3D scene"
+# The line under it on the simulated cell: both ways to drag the tool.
+DRAG_HINT_OFF = "Click Freedrive, then drag the tool in the 3D scene; Shift+drag works any time"
+DRAG_HINT = "Drag the tool in the 3D scene; Shift+drag works any time. Click again or Esc: off"
 # (label, metres, radians): the step of one click, for moves and for turns.
 STEPS: tuple[tuple[str, float, float], ...] = (
     (HOLD, 0.0, 0.0),
@@ -74,15 +96,21 @@ class MovePanel(QWidget):
         layout.addWidget(self._build_jog())
         layout.addWidget(self._build_joints())
         layout.addLayout(self._build_speed())
-        self.freedrive_button = QPushButton("Freedrive (hold)")
+        self.freedrive_button = QPushButton(FREEDRIVE_HELD)
         self.freedrive_button.setMinimumWidth(80)
         self.freedrive_button.setObjectName("FreedriveButton")
         self.freedrive_button.setToolTip(
             "Hold down to guide the arm by hand; let go and the arm stays where it is"
         )
         self.freedrive_button.setMinimumHeight(36)
-        self.freedrive_button.pressed.connect(teacher.press_freedrive)
-        self.freedrive_button.released.connect(teacher.release_freedrive)
+        # Held on a real arm (pressed/released), a toggle on the simulated cell (toggled).
+        self.freedrive_button.pressed.connect(self._freedrive_pressed)
+        self.freedrive_button.released.connect(self._freedrive_released)
+        self.freedrive_button.toggled.connect(self._freedrive_toggled)
+        self._freedrive_escape = QShortcut(QKeySequence(Qt.Key.Key_Escape), self)
+        self._freedrive_escape.setContext(Qt.ShortcutContext.WindowShortcut)
+        self._freedrive_escape.setEnabled(False)  # only while toggled on
+        self._freedrive_escape.activated.connect(self.freedrive_off)
         layout.addWidget(self.freedrive_button)
         self.freedrive_hint = QLabel("")
         self.freedrive_hint.setObjectName("FreedriveHint")
@@ -95,6 +123,7 @@ class MovePanel(QWidget):
         teacher.state_changed.connect(self.show_state)
         teacher.availability_changed.connect(self._update_enabled)
         teacher.message.connect(self.status_label.setText)
+        teacher.freedrive_left.connect(lambda: self._set_toggled(False))
         self.show_state(teacher.state)
         self._update_enabled()
 
@@ -218,8 +247,15 @@ class MovePanel(QWidget):
             label.setText(f"{_number(value, 1)} {unit}")
         for label, angle in zip(self.joint_labels, state.joints, strict=False):
             label.setText(f"{_number(math.degrees(angle), 2)} °")
-        self.freedrive_button.setText("Freedrive: ON" if state.freedrive else "Freedrive (hold)")
-        self.freedrive_hint.setText(DRAG_HINT if state.freedrive and self._drag_guided() else "")
+        self._show_freedrive(state.freedrive)
+
+    def _show_freedrive(self, on: bool) -> None:
+        if self.freedrive_button.isCheckable():
+            self.freedrive_button.setText(FREEDRIVE_TOGGLE_ON if on else FREEDRIVE_TOGGLE)
+            self.freedrive_hint.setText(DRAG_HINT if on else DRAG_HINT_OFF)
+        else:
+            self.freedrive_button.setText(FREEDRIVE_ON if on else FREEDRIVE_HELD)
+            self.freedrive_hint.setText("")
 
     def _drag_guided(self) -> bool:
         """The cell's freedrive follows a pose dragged in the 3D scene (no hand on a real arm
@@ -233,11 +269,22 @@ class MovePanel(QWidget):
         for button in buttons:
             button.setEnabled(not reason)
         drive_reason = self.teacher.unavailable_reason("freedrive")
+        toggle = self._drag_guided()
+        if drive_reason or not toggle:
+            # A run starting or another cell: the toggle is let go without a command (the
+            # teacher turns freedrive off before a run, and a new cell starts with it off).
+            self._set_toggled(False)
+        self.freedrive_button.setCheckable(toggle)
         self.freedrive_button.setEnabled(not drive_reason)
         hold = "Hold down to guide the arm by hand"
-        if self._drag_guided():
-            hold = "Hold down, then drag the tool in the 3D scene: the arm follows"
+        if toggle:
+            hold = (
+                "Click to turn on, then drag the tool in the 3D scene: the arm follows; "
+                "click again (or Esc) to turn off"
+            )
         self.freedrive_button.setToolTip(drive_reason.capitalize() if drive_reason else hold)
+        state = self.teacher.state
+        self._show_freedrive(isinstance(state, ArmState) and state.freedrive)
         self.status_label.setText(f"Cannot move the robot: {reason}." if reason else "")
 
     # ------------------------------------------------------------------ user actions
@@ -245,6 +292,35 @@ class MovePanel(QWidget):
     def _speed_changed(self, value: int) -> None:
         self.teacher.speed_fraction = value / 100
         self.speed_label.setText(f"{value:3d} %")
+
+    def freedrive_off(self) -> None:
+        """Turn a toggled Freedrive off (the next click, or Esc)."""
+        if self.freedrive_button.isChecked():
+            self.freedrive_button.setChecked(False)  # toggled(False): the teacher lets go
+
+    def _freedrive_pressed(self) -> None:
+        if not self.freedrive_button.isCheckable():
+            self.teacher.press_freedrive()
+
+    def _freedrive_released(self) -> None:
+        if not self.freedrive_button.isCheckable():
+            self.teacher.release_freedrive()
+
+    def _freedrive_toggled(self, on: bool) -> None:
+        self._freedrive_escape.setEnabled(on)
+        if not self.freedrive_button.isCheckable():
+            return
+        if not on:
+            self.teacher.release_freedrive()
+        elif not self.teacher.press_freedrive():
+            self._set_toggled(False)  # refused (the teacher said why)
+
+    def _set_toggled(self, on: bool) -> None:
+        """Show the toggle on or off without sending a command."""
+        blocked = self.freedrive_button.blockSignals(True)
+        self.freedrive_button.setChecked(on)
+        self.freedrive_button.blockSignals(blocked)
+        self._freedrive_escape.setEnabled(on)
 
     def _jog_pressed(self, axis: str, sign: int) -> None:
         metres, radians = self.step()

@@ -260,7 +260,7 @@ class Scene3DPanel(PointingMixin, QWidget):
             self._apply_gizmo(pose)
 
     def set_hand_guiding(self, on: bool) -> None:
-        """While on (Freedrive held), a plain left drag on the gizmo moves it, as Shift + drag
+        """While on (Freedrive on), a plain left drag on the gizmo moves it, as Shift + drag
         does at any time; a drag elsewhere still orbits the view.
         """
         if self.view is not None:

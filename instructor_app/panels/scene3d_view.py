@@ -13,7 +13,7 @@ Mouse: left drag orbits, middle drag (or Ctrl + left) pans, the wheel zooms (pyq
 own); a left click without a drag picks a point; in region mode a left press sets the centre
 and the drag its radius; Shift + left drag on the gizmo's ball moves the gizmo in the plane
 facing the view, and so does a plain left drag on it while ``hand_guiding`` is on (Freedrive
-held: the tool is taken by hand; a plain drag away from the ball still orbits).
+on: the tool is taken by hand; a plain drag away from the ball still orbits).
 """
 
 from __future__ import annotations
@@ -85,7 +85,7 @@ class SceneView(GLViewMixin, QOpenGLWindow):
         self.destroyed.connect(lambda *_: _LIVE.discard(self))
         self.frames_drawn = 0
         self.capture_drags = False
-        self.hand_guiding = False  # a plain left press on the gizmo grabs it (Freedrive held)
+        self.hand_guiding = False  # a plain left press on the gizmo grabs it (Freedrive on)
         self.gizmo_position: Callable[[], np.ndarray | None] = lambda: None
         self._press: tuple[float, float] | None = None
         self._moved = False

@@ -67,6 +67,8 @@ class RunController(QObject):
         blackboard_written(str, object): a blackboard key and its newest value.
         log_message(str, str): text and level ("info", "warning", "error").
         run_state_changed(object): the run's ExecutorState (READY before the first run).
+        run_starting(): Run or Step was asked for, before the cell is reset and the plan is
+            checked (on the GUI thread: a teaching Freedrive is turned off here).
         running_nodes_changed(list): ids of the nodes now RUNNING, in plan order.
         run_finished(object): a :class:`RunOutcome`.
         run_refused(list): the validation problems (or a build error) that kept it from starting.
@@ -86,6 +88,7 @@ class RunController(QObject):
     blackboard_written = Signal(str, object)
     log_message = Signal(str, str)
     run_state_changed = Signal(object)
+    run_starting = Signal()
     running_nodes_changed = Signal(list)
     run_finished = Signal(object)
     run_refused = Signal(list)
@@ -228,6 +231,7 @@ class RunController(QObject):
             message = f"the {self.session.opening} cell is still opening; run when it is ready"
             self.run_refused.emit([Problem(ERROR, None, "plan", None, message)])
             return False
+        self.run_starting.emit()
         plan = copy.deepcopy(self.document.plan)  # edits during the run do not reach it
         if plan.reset_cell and start_at is None:
             self.reset_cell(plan.scene)

@@ -3,9 +3,10 @@
 It reads the arm's state for display (the backends read a snapshot their own thread keeps,
 so that never waits) and sends every command that can wait (a move, a stop, freedrive on
 or off, a target's inverse kinematics) to ONE worker thread, in order, as the capabilities
-send work off the engine thread. Held actions (a jog arrow, Move here, Freedrive) start on
-press and end on release: :meth:`release` only sets an event the worker watches, so the
-GUI thread never waits for the arm.
+send work off the engine thread. Held actions (a jog arrow, Move here, Freedrive on a real
+arm) start on press and end on release: :meth:`release` only sets an event the worker
+watches, so the GUI thread never waits for the arm (but for :meth:`leave_freedrive`, as a
+run starts, which turns the simulated cell's toggled freedrive off before the plan moves).
 
 It works on any cell whose interfaces follow the backend Protocols: ``arm``
 (:class:`capabilities.motion.backend.ArmBackend`), ``freedrive``
@@ -80,6 +81,8 @@ class RobotTeacher(QObject):
         finished(str, str): a command ended: (what, problem; "" when it went well).
         message(str): words for the status bar.
         preview_ready(object): the joints (rad) a previewed target puts the arm at, or None.
+        freedrive_left(): a toggled freedrive is over: :meth:`leave_freedrive` turned it off
+            (a run is starting), or the cell changed.
     """
 
     state_changed = Signal(object)
@@ -87,6 +90,7 @@ class RobotTeacher(QObject):
     finished = Signal(str, str)
     message = Signal(str)
     preview_ready = Signal(object)
+    freedrive_left = Signal()
 
     def __init__(self, registry: Any = None, poll_ms: int = _POLL_MS, parent: Any = None) -> None:
         super().__init__(parent)
@@ -112,10 +116,19 @@ class RobotTeacher(QObject):
     # ------------------------------------------------------------------ cell
 
     def set_registry(self, registry: Any) -> None:
-        """Use another cell (what runs on the old one is stopped)."""
+        """Use another cell (what runs on the old one is stopped, and a toggled Freedrive is
+        over: a new cell starts with it off, the same cell's is turned off).
+        """
         self.stop_all()
+        old_drive = self._interfaces.get("freedrive")
         cell = getattr(registry, "cell", None)
         self._interfaces = dict(cell.interfaces()) if cell is not None else {}
+        drive = self._interfaces.get("freedrive")
+        if drive is old_drive and drive is not None:
+            with contextlib.suppress(Exception):  # a snapshot read: never waits
+                if drive.freedrive_active():
+                    self.release_freedrive()
+        self.freedrive_left.emit()
         self.poll()
         self.availability_changed.emit()
 
@@ -235,6 +248,21 @@ class RobotTeacher(QObject):
         return drive is not None and self._submit(
             "freedrive off", lambda: drive.set_freedrive(False) or ""
         )
+
+    def leave_freedrive(self) -> None:
+        """Freedrive off now, on the calling thread: a plan is about to command the arm (a
+        move is refused in freedrive). The one wait outside the worker, and short: freedrive
+        is left on only by the simulated cell's toggle (a real arm's button is held).
+        """
+        drive = self._interfaces.get("freedrive")
+        if drive is None:
+            return
+        try:
+            if drive.freedrive_active():
+                drive.set_freedrive(False)
+        except Exception as exc:  # a backend error is told, never raised into the GUI
+            self.message.emit(f"Freedrive off: {type(exc).__name__}: {exc}")
+        self.freedrive_left.emit()
 
     def release(self) -> None:
         """End the held action (the worker stops the arm); never waits."""

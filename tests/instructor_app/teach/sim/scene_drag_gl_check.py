@@ -1,7 +1,8 @@
 """Run by test_scene_drag.py in its own process on Xvfb's GL (QT_QPA_PLATFORM=xcb): in the
 Instructor's window on the simulated cell, Shift-drag the tool gizmo of the 3D scene with the
 mouse, let go, record the waypoint, preview it, and run a plan that goes there; then, with
-the Move panel's Freedrive held, drag the tool with a plain left drag (no Shift); prints one
+the Move panel's Freedrive clicked on (a toggle on the simulated cell: one mouse cannot hold
+it and drag), drag the tool with a plain left drag (no Shift), and click it off; prints one
 JSON object of what it saw.
 """
 
@@ -48,8 +49,9 @@ def plain_drag(view: object, x: int, y: int, dx: int) -> None:
 def hand_guided(
     app: QApplication, window: MainWindow, out: dict[str, object], ended: list[str]
 ) -> None:
-    """Without Freedrive a plain drag on the tool orbits the view; with Freedrive held it
-    moves the arm and the Move panel says so; a plain drag away from the tool still orbits.
+    """Without Freedrive a plain drag on the tool orbits the view; with Freedrive clicked on
+    it moves the arm and the Move panel says so; a plain drag away from the tool still
+    orbits; a second click turns Freedrive off.
     """
     scene, move = window.cell_views.scene3d, window.views.move
     view = scene.view
@@ -63,8 +65,12 @@ def hand_guided(
     out["plain_without_freedrive_mm"] = math.dist(arm.tcp_pose().position, start.position) * 1000
     out["plain_without_freedrive_orbits"] = view.opts["azimuth"] != azimuth
     out["hint_before"] = move.freedrive_hint.text()
-    QTest.mousePress(move.freedrive_button, Qt.MouseButton.LeftButton)
+    out["button_before"] = move.freedrive_button.text()
+    QTest.mouseClick(move.freedrive_button, Qt.MouseButton.LeftButton)  # pressed and let go
     out["freedrive_on"] = wait_for(app, lambda: arm.freedrive_active(), 10)
+    wait_for(app, lambda: move.freedrive_button.text() != out["button_before"], 5)
+    out["button_on"] = move.freedrive_button.text()
+    out["button_down"] = move.freedrive_button.isChecked()
     out["hint_held"] = (
         move.freedrive_hint.text() if wait_for(app, lambda: move.freedrive_hint.text(), 5) else ""
     )
@@ -90,10 +96,12 @@ def hand_guided(
     QTest.qWait(300)
     out["away_orbits"] = view.opts["azimuth"] != azimuth
     out["away_kept_arm_mm"] = math.dist(arm.tcp_pose().position, here.position) * 1000
-    QTest.mouseRelease(move.freedrive_button, Qt.MouseButton.LeftButton)
+    out["freedrive_still_on_after_away"] = arm.freedrive_active()
+    QTest.mouseClick(move.freedrive_button, Qt.MouseButton.LeftButton)  # the next click: off
     out["freedrive_released"] = wait_for(app, lambda: not arm.freedrive_active(), 10)
-    wait_for(app, lambda: not move.freedrive_hint.text(), 5)
+    wait_for(app, lambda: move.freedrive_hint.text() != out["hint_held"], 5)
     out["hint_after"] = move.freedrive_hint.text()
+    out["button_up"] = not move.freedrive_button.isChecked()
 
 
 def main() -> int:

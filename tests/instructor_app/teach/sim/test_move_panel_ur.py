@@ -12,7 +12,7 @@ import pytest
 from PySide6.QtCore import Qt
 
 from capabilities.base import CapabilityRegistry
-from instructor_app.panels.move import MovePanel
+from instructor_app.panels.move import FREEDRIVE_HELD, FREEDRIVE_ON, MovePanel
 from instructor_app.runtime.teach import RobotTeacher
 from tests.capabilities.ur.conftest import connect, start_emulator  # noqa: F401 (fixtures)
 from tests.capabilities.ur.emulators import wait_for
@@ -39,14 +39,19 @@ def ur_panel(qtbot: Any, request: Any, start_emulator: Any, connect: Any) -> Ite
 def test_freedrive_held_and_a_jog_step_on_the_ur_backend(qtbot: Any, ur_panel: Any) -> None:
     panel, arm, emulator = ur_panel
     qtbot.waitUntil(lambda: panel.pose_labels[2].text() != "—", timeout=10_000)
+    # A real arm: held, as the pendant's button (no toggle that could be left on).
+    assert not panel.freedrive_button.isCheckable()
+    assert panel.freedrive_button.text() == FREEDRIVE_HELD and panel.freedrive_hint.text() == ""
     hold_ready(qtbot, panel.freedrive_button)
     qtbot.mousePress(panel.freedrive_button, LEFT)
     assert wait_for(lambda: emulator.state()["freedrive"] is True)
-    qtbot.waitUntil(lambda: panel.freedrive_button.text() == "Freedrive: ON")
+    qtbot.waitUntil(lambda: panel.freedrive_button.text() == FREEDRIVE_ON)
     with qtbot.waitSignal(panel.teacher.finished, timeout=10_000) as blocker:
         qtbot.mouseRelease(panel.freedrive_button, LEFT)
     assert blocker.args == ["freedrive off", ""]
     assert wait_for(lambda: emulator.state()["freedrive"] is False)
+    qtbot.waitUntil(lambda: panel.freedrive_button.text() == FREEDRIVE_HELD)
+    assert not panel.freedrive_button.isChecked()
     choose(qtbot, panel.step_combo, "10 mm / 10°")
     before = arm.tcp_pose().position
     with qtbot.waitSignal(panel.teacher.finished, timeout=30_000) as blocker:

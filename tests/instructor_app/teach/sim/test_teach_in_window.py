@@ -16,6 +16,7 @@ from PySide6.QtCore import Qt
 from engine.status import Status
 from engine.types import Waypoint
 from instructor_app.main_window import MainWindow
+from instructor_app.panels.move import FREEDRIVE_TOGGLE_ON
 from instructor_app.runtime.session import CellSession
 from tests.instructor_app.gui_driver import (
     ScriptedDialogs,
@@ -81,13 +82,13 @@ def test_waypoints_taught_by_freedrive_and_by_jogging_run_in_a_plan(
 ) -> None:
     arm, move = arm_of(fast_sim), window.views.move
     start = arm.tcp_pose().position
-    hold_ready(qtbot, move.freedrive_button)
-    qtbot.mousePress(move.freedrive_button, LEFT)  # hold Freedrive, and push the tool by hand
+    # On the simulated cell Freedrive is a toggle: a click turns it on, push the tool by hand.
+    qtbot.mouseClick(move.freedrive_button, LEFT)
     qtbot.waitUntil(arm.freedrive_active, timeout=5_000)
-    qtbot.waitUntil(lambda: move.freedrive_button.text() == "Freedrive: ON")
+    qtbot.waitUntil(lambda: move.freedrive_button.text() == FREEDRIVE_TOGGLE_ON)
     arm.apply_tcp_wrench((0.0, 30.0, -15.0), duration=0.5)
     qtbot.waitUntil(lambda: math.dist(arm.tcp_pose().position, start) > 0.03, timeout=10_000)
-    qtbot.mouseRelease(move.freedrive_button, LEFT)
+    qtbot.mouseClick(move.freedrive_button, LEFT)  # the next click turns it off
     qtbot.waitUntil(lambda: not arm.freedrive_active(), timeout=5_000)
     qtbot.waitUntil(lambda: not arm.is_moving(), timeout=10_000)
     by_hand = record(qtbot, window, "by hand", "world")
