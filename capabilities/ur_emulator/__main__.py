@@ -47,6 +47,8 @@ def run_command(emulator: UREmulator, line: str) -> dict[str, Any]:
             emulator.protective_stop(on_contact=True)
         elif args and args[0].startswith("at="):
             emulator.protective_stop(at=float(args[0][3:]))
+        elif args and args[0].startswith("lag="):
+            emulator.protective_stop(lag=float(args[0][4:]))
         else:
             emulator.protective_stop()
     elif name in (
@@ -93,6 +95,8 @@ def _state(emulator: UREmulator) -> dict[str, Any]:
         "moving": ctl.arm_moving(),
         "messages": ctl.messages[-5:],
         "popup": ctl.popup,
+        "script_clients": len(ctl.script_clients),
+        "takeovers": ctl.takeovers,
     }
 
 
