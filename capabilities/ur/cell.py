@@ -180,7 +180,9 @@ class URCellSession(ClosesOnExit):
         reason = self.connection.fault()
         if reason == NO_SCRIPT and self._recovery.clearing:
             return self._recovery.clearing
-        return reason
+        # A script's end that a protective stop's safety mode follows within a few frames
+        # is that stop only: no "script not running" in between (the arm stands either way).
+        return self.connection.settled_fault() if reason == NO_SCRIPT else reason
 
     def clear(self) -> None:
         """The operator's clear of what the status names: unlock a protective stop (through
@@ -206,7 +208,7 @@ class URCellSession(ClosesOnExit):
 
     def status(self) -> CellStatus:
         """The robot's state for the toolbar (a snapshot; never blocks)."""
-        state, fault = self.connection.state, self.connection.fault()
+        state, fault = self.connection.state, self.connection.settled_fault()
         if not state.connected or fault.startswith(CONNECTION_LOST):
             return CellStatus(False, "DISCONNECTED", "-", "-", fault + _last_heard(self.connection))
         action, wait, hint = "", 0, ""

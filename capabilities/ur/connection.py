@@ -31,6 +31,7 @@ from capabilities.ur.modes import PolyScopeVersion, RobotMode, SafetyMode, parse
 __all__ = [
     "HALT_DECEL",
     "NO_SCRIPT",
+    "SCRIPT_END_GRACE",
     "TAKEN_OVER",
     "URConnection",
     "WATCHDOG_HZ",
@@ -46,6 +47,9 @@ _MOVING_SPEED = 1e-3  # rad/s
 # can sit inside a ur_rtde call (a move's send) for good when the controller dies under it.
 SILENCE_S = 3.0
 NO_SCRIPT = "the control script is not running on the controller"
+# s a control script's end waits for a safety mode that comes with it: a UR's RTDE streams
+# can report the program's end a few frames before the protective stop that ended it.
+SCRIPT_END_GRACE = 0.3
 # A UR runs one program: another client's (an Instructor, a ur_rtde script) ended ours.
 TAKEN_OVER = (
     "another program took the robot: the controller ended this session's control script "
@@ -157,6 +161,7 @@ class URConnection:
         self._ours = False
         self._uploading = False
         self.taken_over = False
+        self.script_ended_at = -1e9  # when the script was last seen to end (any thread reads)
         # When the I/O thread last resumed after a stall longer than the watchdog's period
         # (another thread held the GIL: an import, a long C call): the script may have
         # stopped on it, which is ours to restart (see capabilities.ur.cell._Recovery).
@@ -246,6 +251,16 @@ class URConnection:
         if reason or silent <= SILENCE_S:
             return reason
         return f"{CONNECTION_LOST} (no word from the controller for {silent:.0f} s)"
+
+    def settled_fault(self) -> str:
+        """:meth:`fault`, with a control script's end that may yet turn out to be a safety
+        stop's ("" until SCRIPT_END_GRACE s after it; the stop's name then, if one came).
+        Any thread.
+        """
+        reason = self.fault()
+        if reason == NO_SCRIPT and time.monotonic() - self.script_ended_at < SCRIPT_END_GRACE:
+            return ""
+        return reason
 
     def call(self, fn: Callable[[], T], timeout: float = 10.0) -> T:
         """Run ``fn()`` on the I/O thread and wait for it (never from the engine thread)."""
@@ -492,6 +507,8 @@ class URConnection:
         if self._uploading or self.control is None:
             return
         if not state.program_running:
+            if self._ours:
+                self.script_ended_at = time.monotonic()
             self._ours = False
         elif not self._ours and not self.taken_over:
             self.taken_over = True
