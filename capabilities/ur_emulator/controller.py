@@ -13,7 +13,7 @@ import select
 import socket
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -406,7 +406,8 @@ class EmulatedController:
                 # Held back short of its target: a UR's joints then deviate from the path it
                 # planned, and its safety system makes a protective stop of it (a script
                 # error would leave the arm pressing on whatever holds it).
-                fault, why = self.protective_stop, f"{DEVIATES} ({h.message})"
+                fault: Callable[[str], None] = self.protective_stop
+                why = f"{DEVIATES} ({h.message})"
             else:
                 fault, why = self.end_program, f"script error: {h.message}"
             threading.Thread(target=fault, args=(why,), daemon=True).start()
