@@ -372,7 +372,8 @@ class URConnection:
     def start_control(self, reupload: bool = False) -> None:
         """(I/O thread) Connect the control interface, or upload its script again: when it
         does not run, or with ``reupload`` (a stop ended it, though the controller may not
-        have said so yet).
+        have said so yet). After another client took the robot (:data:`TAKEN_OVER`) it is
+        the operator's clear: the other program is stopped through the dashboard first.
         """
         self._uploading = True
         try:

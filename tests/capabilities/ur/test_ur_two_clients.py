@@ -7,6 +7,7 @@ first session names ("another program took the robot") instead of a script that 
 
 from __future__ import annotations
 
+import logging
 import threading
 from pathlib import Path
 
@@ -28,14 +29,16 @@ pytestmark = pytest.mark.sim
 
 
 def test_a_second_client_takes_the_robot_and_the_first_session_says_so(
-    tmp_path: Path, start_emulator
+    tmp_path: Path, start_emulator, caplog: pytest.LogCaptureFixture
 ) -> None:
+    caplog.set_level(logging.WARNING, "capabilities.ur")
     cell_file = tmp_path / "emulated.cell.json"
     emulator = start_emulator("5.12", write_cell=cell_file)
     with open_cell(str(cell_file)) as first:
         assert wait_for(lambda: first.hold_reason() == "")  # type: ignore[attr-defined]
         with open_cell(str(cell_file)) as second:
             assert wait_for(lambda: second.hold_reason() == "")  # type: ignore[attr-defined]
+            assert "a program already runs on the controller" in caplog.text  # the second's
             assert wait_for(lambda: first.hold_reason() == TAKEN_OVER)  # type: ignore[attr-defined]
             assert TAKEN_OVER.startswith("another program took the robot: ")
             status = first.status()  # type: ignore[attr-defined]
