@@ -302,6 +302,7 @@ class URConnection:
         control, now = self.control, time.monotonic()
         if (
             not self._watchdog
+            or not self._ours  # a program that runs now may be another client's
             or control is None
             or (not force and now - self._last_kick < _KICK_PERIOD)
         ):

@@ -35,11 +35,11 @@ def test_a_second_client_takes_the_robot_and_the_first_session_says_so(
     cell_file = tmp_path / "emulated.cell.json"
     emulator = start_emulator("5.12", write_cell=cell_file)
     with open_cell(str(cell_file)) as first:
-        assert wait_for(lambda: first.hold_reason() == "")  # type: ignore[attr-defined]
+        assert wait_for(lambda: first.hold_reason() == "", 20)  # type: ignore[attr-defined]
         with open_cell(str(cell_file)) as second:
-            assert wait_for(lambda: second.hold_reason() == "")  # type: ignore[attr-defined]
+            assert wait_for(lambda: second.hold_reason() == "", 20)  # type: ignore[attr-defined]
             assert "a program already runs on the controller" in caplog.text  # the second's
-            assert wait_for(lambda: first.hold_reason() == TAKEN_OVER)  # type: ignore[attr-defined]
+            assert wait_for(lambda: first.hold_reason() == TAKEN_OVER, 20)  # type: ignore[attr-defined]
             assert TAKEN_OVER.startswith("another program took the robot: ")
             status = first.status()  # type: ignore[attr-defined]
             assert status.problem == TAKEN_OVER and status.clear_action == RESTART_SCRIPT
@@ -49,8 +49,8 @@ def test_a_second_client_takes_the_robot_and_the_first_session_says_so(
             assert second.hold_reason() == ""  # type: ignore[attr-defined]
             # Nothing is uploaded again on its own; the operator's clear takes it back.
             first.clear()  # type: ignore[attr-defined]
-            assert wait_for(lambda: first.hold_reason() == "")  # type: ignore[attr-defined]
-            assert wait_for(lambda: second.hold_reason() == TAKEN_OVER)  # type: ignore[attr-defined]
+            assert wait_for(lambda: first.hold_reason() == "", 20)  # type: ignore[attr-defined]
+            assert wait_for(lambda: second.hold_reason() == TAKEN_OVER, 20)  # type: ignore[attr-defined]
 
 
 def test_a_script_end_just_before_the_protective_stop_is_held_as_the_stop_only(
