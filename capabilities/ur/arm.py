@@ -22,6 +22,7 @@ from capabilities.robot.kinematics import UR5Kinematics
 from capabilities.ur.connection import (
     HALT_DECEL,
     NO_SCRIPT,
+    SCRIPT_END_GRACE,
     URConnection,
     URState,
     fault_reason,
@@ -36,7 +37,11 @@ __all__ = ["URArm", "FREEDRIVE_MODE_SINCE", "require_version"]
 FREEDRIVE_MODE_SINCE: PolyScopeVersion = (5, 10)
 _JOINT_TOLERANCE = 0.01  # rad: a finished move this far from its target did not arrive
 _POSITION_TOLERANCE = 0.002  # m
-_SCRIPT_GRACE = 0.06  # s: how long a stopped script must last before it is the reason
+# s a stopped script must last before it is the reason: a dropping connection first looks
+# like one, and a protective stop's safety mode can come a few frames after the script's end.
+# It outlasts the hold's own wait (SCRIPT_END_GRACE) so that the run is held before the
+# move fails: a script that ended for good holds the run rather than failing its node.
+_SCRIPT_GRACE = SCRIPT_END_GRACE + 0.2
 _START_TIMEOUT = 2.0  # s for the controller to report the asynchronous move started
 _CLEAR_TIMEOUT = 20.0  # s for a protective stop to be unlocked and the script to run again
 _UNLOCK_RETRY = 0.5  # s between unlock attempts the controller refused (too early)

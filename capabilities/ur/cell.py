@@ -38,7 +38,7 @@ from capabilities.object_library import ObjectLibrary
 from capabilities.robot.cell_file import CellConfig
 from capabilities.robot.cell_robot import TCP_OF_TOOL, UNLOCK_DELAY
 from capabilities.ur.arm import URArm
-from capabilities.ur.connection import NO_SCRIPT, URConnection, fault_reason
+from capabilities.ur.connection import NO_SCRIPT, TAKEN_OVER, URConnection, fault_reason
 from capabilities.ur.errors import ur_words
 from capabilities.ur.frames import URFrames
 from capabilities.ur.modes import RobotMode, SafetyMode
@@ -180,7 +180,9 @@ class URCellSession(ClosesOnExit):
         reason = self.connection.fault()
         if reason == NO_SCRIPT and self._recovery.clearing:
             return self._recovery.clearing
-        return reason
+        # A script's end that a protective stop's safety mode follows within a few frames
+        # is that stop only: no "script not running" in between (the arm stands either way).
+        return self.connection.settled_fault() if reason == NO_SCRIPT else reason
 
     def clear(self) -> None:
         """The operator's clear of what the status names: unlock a protective stop (through
@@ -206,13 +208,16 @@ class URCellSession(ClosesOnExit):
 
     def status(self) -> CellStatus:
         """The robot's state for the toolbar (a snapshot; never blocks)."""
-        state, fault = self.connection.state, self.connection.fault()
+        state, fault = self.connection.state, self.connection.settled_fault()
         if not state.connected or fault.startswith(CONNECTION_LOST):
             return CellStatus(False, "DISCONNECTED", "-", "-", fault + _last_heard(self.connection))
         action, wait, hint = "", 0, ""
         if fault == NO_SCRIPT:
             action = RESTART_SCRIPT
             hint = f"start it on the pendant or press {RESTART_SCRIPT}"
+        elif fault == TAKEN_OVER:
+            action = RESTART_SCRIPT
+            hint = f"end the other program (or close that client), then press {RESTART_SCRIPT}"
         elif fault == PROTECTIVE_STOP:
             action = UNLOCK_STOP
             since = self._recovery.stopped_at
@@ -286,8 +291,8 @@ class _Recovery:
             self._lost_since = now
         problem = fault_reason(state)
         self._time_stop(problem, now)
-        if problem and problem != NO_SCRIPT:
-            self.clearing = problem
+        if problem and problem not in (NO_SCRIPT, TAKEN_OVER):
+            self.clearing = problem  # (another client's program is the operator's to end)
         elif not problem:
             self.clearing = ""
         elif not self.clearing and now - conn.stalled_at < _STALL_WINDOW:

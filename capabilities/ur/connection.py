@@ -28,7 +28,16 @@ from capabilities.faults import CONNECTION_LOST, EMERGENCY_STOP, PROTECTIVE_STOP
 from capabilities.ur.errors import URConnectionLost, URError, ur_words
 from capabilities.ur.modes import PolyScopeVersion, RobotMode, SafetyMode, parse_version
 
-__all__ = ["HALT_DECEL", "NO_SCRIPT", "URConnection", "WATCHDOG_HZ", "URState", "fault_reason"]
+__all__ = [
+    "HALT_DECEL",
+    "NO_SCRIPT",
+    "SCRIPT_END_GRACE",
+    "TAKEN_OVER",
+    "URConnection",
+    "WATCHDOG_HZ",
+    "URState",
+    "fault_reason",
+]
 
 _log = logging.getLogger(__name__)
 T = TypeVar("T")
@@ -38,6 +47,14 @@ _MOVING_SPEED = 1e-3  # rad/s
 # can sit inside a ur_rtde call (a move's send) for good when the controller dies under it.
 SILENCE_S = 3.0
 NO_SCRIPT = "the control script is not running on the controller"
+# s a control script's end waits for a safety mode that comes with it: a UR's RTDE streams
+# can report the program's end a few frames before the protective stop that ended it.
+SCRIPT_END_GRACE = 0.3
+# A UR runs one program: another client's (an Instructor, a ur_rtde script) ended ours.
+TAKEN_OVER = (
+    "another program took the robot: the controller ended this session's control script "
+    "for a program this session did not start (another Instructor or ur_rtde client)"
+)
 # The control script stops the program (and the arm) when no RTDE input arrives for
 # 1/WATCHDOG_HZ s: kill -9 or a frozen process halts the arm within 0.2 s plus the stop.
 WATCHDOG_HZ = 5.0
@@ -62,6 +79,7 @@ class URState:
     status_bits: int = 0  # robot_status_bits: 0 power on, 1 program running, 2 teach button
     async_running: bool = False
     async_op_id: int = -1
+    taken_over: bool = False  # another client's program ended this session's script
     stamp: float = 0.0
     problem: str = field(default="")
 
@@ -93,6 +111,8 @@ def fault_reason(state: URState) -> str:
             if state.robot_mode <= RobotMode.POWER_OFF
             else (f"the arm is not running (robot mode {mode})")
         )
+    if state.taken_over:
+        return TAKEN_OVER
     if not state.program_running:
         return NO_SCRIPT
     return ""
@@ -136,6 +156,12 @@ class URConnection:
         # Counts the control scripts this connection started: a move's monitor never stops
         # the arm through a script other than the one that ran its move.
         self.script_runs = 0
+        # Whether the program that runs is this session's script (start_control saw it run):
+        # one seen running that this session did not start is another client's.
+        self._ours = False
+        self._uploading = False
+        self.taken_over = False
+        self.script_ended_at = -1e9  # when the script was last seen to end (any thread reads)
         # When the I/O thread last resumed after a stall longer than the watchdog's period
         # (another thread held the GIL: an import, a long C call): the script may have
         # stopped on it, which is ours to restart (see capabilities.ur.cell._Recovery).
@@ -226,6 +252,16 @@ class URConnection:
             return reason
         return f"{CONNECTION_LOST} (no word from the controller for {silent:.0f} s)"
 
+    def settled_fault(self) -> str:
+        """:meth:`fault`, with a control script's end that may yet turn out to be a safety
+        stop's ("" until SCRIPT_END_GRACE s after it; the stop's name then, if one came).
+        Any thread.
+        """
+        reason = self.fault()
+        if reason == NO_SCRIPT and time.monotonic() - self.script_ended_at < SCRIPT_END_GRACE:
+            return ""
+        return reason
+
     def call(self, fn: Callable[[], T], timeout: float = 10.0) -> T:
         """Run ``fn()`` on the I/O thread and wait for it (never from the engine thread)."""
         return self.submit(fn).result(timeout)
@@ -266,6 +302,7 @@ class URConnection:
         control, now = self.control, time.monotonic()
         if (
             not self._watchdog
+            or not self._ours  # a program that runs now may be another client's
             or control is None
             or (not force and now - self._last_kick < _KICK_PERIOD)
         ):
@@ -295,7 +332,7 @@ class URConnection:
         self._halted = True
         self._monitors.clear()
         control = self.control
-        if control is None:
+        if control is None or self.taken_over:  # the program that runs is not ours to end
             return
         try:
             if not (control.isConnected() and control.isProgramRunning()):
@@ -324,14 +361,46 @@ class URConnection:
         self.version = parse_version(self.dashboard.polyscopeVersion())
         self.receive = rtde_receive.RTDEReceiveInterface(self.host)
         self.refresh()
+        if self.state.status_bits & 2:  # robot_status_bits: a program runs already
+            _log.warning(
+                "UR: a program already runs on the controller at %s (another Instructor or "
+                "ur_rtde client?): this session's control script ends it and takes the robot",
+                self.host,
+            )
         if not fault_reason(URState(**{**self.state.__dict__, "program_running": True})):
             self.start_control()
 
     def start_control(self, reupload: bool = False) -> None:
         """(I/O thread) Connect the control interface, or upload its script again: when it
         does not run, or with ``reupload`` (a stop ended it, though the controller may not
-        have said so yet).
+        have said so yet). After another client took the robot (:data:`TAKEN_OVER`) it is
+        the operator's clear: the other program is stopped through the dashboard first.
         """
+        self._uploading = True
+        try:
+            if self.taken_over:
+                self._stop_other_program()
+            self._start_control(reupload or self.taken_over)
+        finally:
+            self._uploading = False
+        self._ours = self.state.program_running
+        if self._ours:
+            self.taken_over = False
+        self.arm_watchdog()
+
+    def _stop_other_program(self) -> None:
+        """(I/O thread) End another client's program through the dashboard (as ur_rtde's
+        start-up does with a program it finds running): the operator took the robot back.
+        """
+        if not self.control.isProgramRunning():
+            return
+        _log.warning("UR: the operator takes the robot back: the other program is stopped")
+        self.dashboard.stop()
+        deadline = time.monotonic() + 2.0
+        while self.control.isProgramRunning() and time.monotonic() < deadline:
+            time.sleep(0.01)
+
+    def _start_control(self, reupload: bool) -> None:
         import rtde_control
 
         if self.control is None:
@@ -355,7 +424,6 @@ class URConnection:
         while not self.state.program_running and time.monotonic() < deadline:
             time.sleep(0.005)
             self.refresh()
-        self.arm_watchdog()
 
     @property
     def watchdog_armed(self) -> bool:
@@ -422,6 +490,7 @@ class URConnection:
         except Exception as exc:
             self.state = URState(connected=False, problem=ur_words(exc))
         if self.state.connected:
+            self._note_owner()
             self.last_heard = self.state
         else:
             # No more kicks until this connection is made afresh (start_control arms the
@@ -429,6 +498,26 @@ class URConnection:
             # reconnect a second time, on this thread, and the two crash the process later.
             # The controller's watchdog stops the script meanwhile, as a lost link should.
             self._watchdog = False
+
+    def _note_owner(self) -> None:
+        """(I/O thread) A program seen running after this session's script ended, and not
+        started by it, is another client's (a UR runs one program): say so, stop kicking
+        (the watchdog's register is the other program's now), and upload again only on the
+        operator's clear.
+        """
+        state = self.state
+        if self._uploading or self.control is None:
+            return
+        if not state.program_running:
+            if self._ours:
+                self.script_ended_at = time.monotonic()
+            self._ours = False
+        elif not self._ours and not self.taken_over:
+            self.taken_over = True
+            self._watchdog = False
+            _log.warning("UR: %s", TAKEN_OVER)
+        if self.taken_over:
+            self.state = URState(**{**state.__dict__, "taken_over": True})
 
     def _read_state(self) -> URState:
         receive, control = self.receive, self.control

@@ -123,14 +123,18 @@ class UREmulator(ClosesOnExit):
             raise RuntimeError("the emulator is not started")
         return self.controller
 
-    def protective_stop(self, at: float | None = None, on_contact: bool = False) -> None:
-        """A protective stop now, at simulated time ``at``, or (armed) on the arm's next contact."""
+    def protective_stop(
+        self, at: float | None = None, on_contact: bool = False, lag: float = 0.0
+    ) -> None:
+        """A protective stop now, at simulated time ``at``, or (armed) on the arm's next contact;
+        with ``lag``, the program's end is published that many s before the safety mode.
+        """
         if on_contact:
             self.ctl.faults.stop_on_contact(True)
         elif at is not None:
             self.ctl.faults.stop_at(at)
         else:
-            self.ctl.protective_stop("injected")
+            self.ctl.protective_stop("injected", lag=lag)
 
     def unlock(self) -> None:
         """The operator unlocks a protective stop on the pendant (the dashboard's command).

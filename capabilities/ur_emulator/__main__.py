@@ -35,6 +35,19 @@ __all__ = ["NO_SCENE", "main", "run_command"]
 NO_SCENE = "none"  # --scene none: the arm alone (no objects, no cameras)
 
 
+def _protective_stop(emulator: UREmulator, args: list[str]) -> None:
+    """protective_stop [on_contact | at=SIM_TIME | lag=S]."""
+    arg = args[0] if args else ""
+    if arg == "on_contact":
+        emulator.protective_stop(on_contact=True)
+    elif arg.startswith("at="):
+        emulator.protective_stop(at=float(arg[3:]))
+    elif arg.startswith("lag="):
+        emulator.protective_stop(lag=float(arg[4:]))
+    else:
+        emulator.protective_stop()
+
+
 def run_command(emulator: UREmulator, line: str) -> dict[str, Any]:
     """Do one control command; the answer is a JSON-able dict with "ok"."""
     words = line.split()
@@ -43,12 +56,7 @@ def run_command(emulator: UREmulator, line: str) -> dict[str, Any]:
     name, args = words[0], words[1:]
     ctl = emulator.ctl
     if name == "protective_stop":
-        if args and args[0] == "on_contact":
-            emulator.protective_stop(on_contact=True)
-        elif args and args[0].startswith("at="):
-            emulator.protective_stop(at=float(args[0][3:]))
-        else:
-            emulator.protective_stop()
+        _protective_stop(emulator, args)
     elif name in (
         "unlock",
         "emergency_stop",
@@ -93,6 +101,8 @@ def _state(emulator: UREmulator) -> dict[str, Any]:
         "moving": ctl.arm_moving(),
         "messages": ctl.messages[-5:],
         "popup": ctl.popup,
+        "script_clients": len(ctl.script_clients),
+        "takeovers": ctl.takeovers,
     }
 
 

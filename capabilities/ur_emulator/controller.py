@@ -13,7 +13,7 @@ import select
 import socket
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -41,6 +41,9 @@ VERSIONS: dict[str, tuple[int, int, int, int]] = {
     "5.12": (5, 12, 0, 1101534),
 }
 _ZEROS6 = (0.0,) * 6
+# s a control script that takes the robot from another client's waits before it runs (a UR
+# loading a program): the first client sees its script end.
+TAKEOVER_START = 0.3
 _SAFETY_BIT = {
     SafetyMode.NORMAL: 0,
     SafetyMode.REDUCED: 1,
@@ -83,6 +86,14 @@ class EmulatedController:
         self.safety_mode = SafetyMode.NORMAL
         self._program: ControlProgram | None = None
         self._pending_script: int | None = None  # reg offset of an uploaded script
+        self._start_after = 0.0  # monotonic time before which the pending script waits
+        # The script-port clients that uploaded a control script, and the one whose script
+        # runs (or ran last): a second client's script takes the robot from the first's.
+        self.script_clients: set[int] = set()
+        self._connected_script_clients: set[int] = set()
+        self._owner: int | None = None
+        self.takeovers = 0
+        self._lagging_stop = False  # a protective stop whose safety mode is still on its way
         self._stopped_at = 0.0
         self.freedrive_on = False
         self._tcp = np.eye(4)
@@ -127,12 +138,20 @@ class EmulatedController:
 
     def _cycle(self) -> None:
         with self._lock:
-            if self._pending_script is not None and self._can_run():
+            if (
+                self._pending_script is not None
+                and self._can_run()
+                and time.monotonic() >= self._start_after
+            ):
                 self._program = ControlProgram(self, self._pending_script)
                 self._pending_script = None
             self.faults.check()
             collision = self.cell.robot.protective_stop()
-            if collision is not None and self.safety_mode == SafetyMode.NORMAL:
+            if (
+                collision is not None
+                and self.safety_mode == SafetyMode.NORMAL
+                and not self._lagging_stop
+            ):
                 self.protective_stop(collision.cause)  # the arm hit something: as a UR does
             if self._program is not None and not self._program.step():
                 self._end_program_locked("the control script ended")
@@ -277,15 +296,49 @@ class EmulatedController:
     # ---------------------------------------------------------------- the program
 
     def _can_run(self) -> bool:
-        return self.robot_mode == RobotMode.RUNNING and self.safety_mode == SafetyMode.NORMAL
+        return (
+            self.robot_mode == RobotMode.RUNNING
+            and self.safety_mode == SafetyMode.NORMAL
+            and not self._lagging_stop
+        )
 
-    def load_script(self, reg_offset: int) -> None:
-        """The control script arrived on the script port: run it from the next cycle."""
+    def script_client(self, client: int, connected: bool = True) -> None:
+        """A script-port client connected (or, ``connected`` False, went away)."""
         with self._lock:
+            if connected:
+                self._connected_script_clients.add(client)
+            else:
+                self._connected_script_clients.discard(client)
+
+    def load_script(self, reg_offset: int, client: int = 0) -> None:
+        """The control script arrived on the script port: run it from the next cycle.
+
+        A UR runs one program: the script of a client other than the one whose script runs
+        (or ran last, stopped through the dashboard as ur_rtde does at its start, while that
+        client is still connected) takes the robot from it. That is logged, and the new
+        script starts after TAKEOVER_START s (a controller loading a program), so the first
+        client sees its script end.
+        """
+        with self._lock:
+            self.script_clients.add(client)
+            previous = self._owner
+            takeover = (
+                previous is not None
+                and previous != client
+                and previous in self._connected_script_clients
+            )
             self._end_program_locked("a new script replaces the running one")
+            if takeover:
+                self.takeovers += 1
+                self.text(
+                    f"script client {client}'s control script took the robot from script "
+                    f"client {previous}'s ({len(self.script_clients)} clients uploaded one)"
+                )
+            self._start_after = time.monotonic() + (TAKEOVER_START if takeover else 0.0)
             if not self._can_run():
                 self.text("script not started: the robot is not running or not in normal mode")
                 return
+            self._owner = client
             self._pending_script = reg_offset
 
     def program_running(self) -> bool:
@@ -353,7 +406,8 @@ class EmulatedController:
                 # Held back short of its target: a UR's joints then deviate from the path it
                 # planned, and its safety system makes a protective stop of it (a script
                 # error would leave the arm pressing on whatever holds it).
-                fault, why = self.protective_stop, f"{DEVIATES} ({h.message})"
+                fault: Callable[[str], None] = self.protective_stop
+                why = f"{DEVIATES} ({h.message})"
             else:
                 fault, why = self.end_program, f"script error: {h.message}"
             threading.Thread(target=fault, args=(why,), daemon=True).start()
@@ -373,11 +427,32 @@ class EmulatedController:
 
     # ---------------------------------------------------------------- safety
 
-    def protective_stop(self, reason: str = "protective stop") -> None:
-        """Halt the arm, stop the program, safety mode PROTECTIVE_STOP."""
+    def protective_stop(self, reason: str = "protective stop", lag: float = 0.0) -> None:
+        """Halt the arm, stop the program, safety mode PROTECTIVE_STOP.
+
+        With ``lag`` the program's end is published ``lag`` s before the safety mode (a real
+        controller's RTDE streams can tell the two apart by a few frames).
+        """
         with self._lock:
-            if self.safety_mode == SafetyMode.PROTECTIVE_STOP:
+            if self.safety_mode == SafetyMode.PROTECTIVE_STOP or self._lagging_stop:
                 return
+            if lag > 0:
+                self._halt(f"protective stop: {reason}")
+                self._lagging_stop = True
+                self._publish()
+                timer = threading.Timer(lag, self._stop_arrives, (reason,))
+                timer.daemon = True
+                timer.start()
+                return
+            self._set_protective_stop(reason)
+
+    def _stop_arrives(self, reason: str) -> None:
+        with self._lock:
+            self._lagging_stop = False
+            self._set_protective_stop(reason)
+
+    def _set_protective_stop(self, reason: str) -> None:
+        with self._lock:
             self._halt(f"protective stop: {reason}")
             # PolyScope's safety popup and log line; the dashboard's safetystatus says
             # PROTECTIVE_STOP until it is unlocked.

@@ -137,8 +137,14 @@ class EmulatorProcess(ClosesOnExit):
         answer = self.command(f"truth {name}")
         return Pose(tuple(answer["position"]), tuple(answer["orientation"]))
 
-    def protective_stop(self, at: float | None = None, on_contact: bool = False) -> None:
+    def protective_stop(
+        self, at: float | None = None, on_contact: bool = False, lag: float = 0.0
+    ) -> None:
+        """A protective stop now (with ``lag``: the program's end published that many s
+        before the safety mode), at simulated time ``at``, or on the arm's next contact.
+        """
         arg = " on_contact" if on_contact else (f" at={at}" if at is not None else "")
+        arg = arg or (f" lag={lag}" if lag > 0 else "")
         self.command("protective_stop" + arg)
 
     def unlock(self) -> None:

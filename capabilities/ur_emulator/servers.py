@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import contextlib
 import ipaddress
+import itertools
 import logging
 import re
 import socket
@@ -149,22 +150,34 @@ def dashboard_client(conn: socket.socket, ctl: EmulatedController, stop: threadi
 _OFFSET = re.compile(rb"reg_offset_int\s*=\s*(\d+)")
 
 
+_script_ids = itertools.count(1)
+
+
 def script_client(conn: socket.socket, ctl: EmulatedController, stop: threading.Event) -> None:
-    """Take scripts sent to the script port; ur_rtde's control script starts the program."""
+    """Take scripts sent to the script port; ur_rtde's control script starts the program.
+
+    Each connection is one client (numbered from 1): the controller tells the clients that
+    upload a control script apart (a second one takes the robot from the first).
+    """
+    client = next(_script_ids)
+    ctl.script_client(client)
     pending = b""
-    while not stop.is_set():
-        chunk = conn.recv(65536)
-        if not chunk:
-            return
-        pending += chunk
-        if pending.lstrip().startswith(b"def ") and pending.rstrip().endswith(b"\nend"):
-            if b"def rtde_control" in pending:
-                match = _OFFSET.search(pending)
-                ctl.load_script(int(match.group(1)) if match else 0)
-            else:
-                ctl.end_program("a script the emulator does not run replaced the program")
-                ctl.text("custom scripts are not emulated")
-            pending = b""
+    try:
+        while not stop.is_set():
+            chunk = conn.recv(65536)
+            if not chunk:
+                return
+            pending += chunk
+            if pending.lstrip().startswith(b"def ") and pending.rstrip().endswith(b"\nend"):
+                if b"def rtde_control" in pending:
+                    match = _OFFSET.search(pending)
+                    ctl.load_script(int(match.group(1)) if match else 0, client)
+                else:
+                    ctl.end_program("a script the emulator does not run replaced the program")
+                    ctl.text("custom scripts are not emulated")
+                pending = b""
+    finally:
+        ctl.script_client(client, connected=False)
 
 
 class _RTDESession:
