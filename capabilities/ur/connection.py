@@ -299,13 +299,21 @@ class URConnection:
         """(I/O thread) Kick the control script's watchdog (at most every ``_KICK_PERIOD``
         s unless ``force``); a long wait on the I/O thread calls it to keep the arm going.
         """
-        control, now = self.control, time.monotonic()
+        control, receive, now = self.control, self.receive, time.monotonic()
         if (
             not self._watchdog
             or not self._ours  # a program that runs now may be another client's
             or control is None
             or (not force and now - self._last_kick < _KICK_PERIOD)
         ):
+            return
+        # The last refresh can be a few ms old. A link that dropped since has ur_rtde's
+        # control interface reconnecting on its own thread, where it replaces the state our
+        # call would read: that crashes the process. Our receive interface never reconnects
+        # by itself, so its link, asked just now, says whether the link is still the one
+        # the watchdog was set on.
+        if receive is None or not receive.isConnected():
+            self._watchdog = False
             return
         # A stall is time this thread could not run since its last kick ended, not time
         # spent inside a kick: ur_rtde waits in one for a script that just died (then the
