@@ -22,7 +22,7 @@ import numpy as np
 from capabilities.geometry import pose_to_matrix
 from engine.types import Pose
 
-__all__ = ["CameraSource", "RGBDFrame", "SOURCE_KINDS"]
+__all__ = ["CameraSource", "RGBDFrame", "SOURCE_KINDS", "stride_for"]
 
 SOURCE_KINDS = ("sim", "recorded", "realsense", "stream")
 
@@ -71,6 +71,29 @@ class RGBDFrame:
         v, u, _ = self._valid(stride)
         return self.rgb[v, u]
 
+    def at_most(self, max_width: int | None) -> RGBDFrame:
+        """This frame with every ``stride_for``-th pixel of each row and column, so that it
+        is at most ``max_width`` wide (itself when it is already; None: itself). Its points
+        are those of ``point_cloud(stride)``: K is scaled with the pixels.
+        """
+        stride = stride_for(int(self.depth.shape[1]), max_width)
+        if stride == 1:
+            return self
+        scale = np.diag([1.0 / stride, 1.0 / stride, 1.0])
+        return RGBDFrame(
+            rgb=np.ascontiguousarray(self.rgb[::stride, ::stride]),
+            depth=np.ascontiguousarray(self.depth[::stride, ::stride]),
+            K=scale @ self.K,
+            T_world_camera=self.T_world_camera,
+            stamp=self.stamp,
+            camera=self.camera,
+        )
+
+
+def stride_for(width: int, max_width: int | None) -> int:
+    """The pixel stride that brings a ``width`` wide image to at most ``max_width`` columns."""
+    return 1 if max_width is None or max_width >= width else -(-width // max(1, max_width))
+
 
 @runtime_checkable
 class CameraSource(Protocol):
@@ -89,8 +112,15 @@ class CameraSource(Protocol):
         """The 3x3 camera matrix K of the frames it gives."""
         ...
 
-    def capture(self) -> RGBDFrame:
-        """The next frame; blocks the calling (worker) thread."""
+    def capture(self, max_width: int | None = None) -> RGBDFrame:
+        """The next frame; blocks the calling (worker) thread.
+
+        Args:
+            max_width: a consumer that uses only so many columns (occupancy) asks for a
+                frame at most this wide: the same view with every n-th pixel (see
+                :meth:`RGBDFrame.at_most`). A simulated camera renders only those pixels, at
+                a fraction of a full frame's cost.
+        """
         ...
 
     def extrinsics(self) -> Pose:

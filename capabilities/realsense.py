@@ -89,7 +89,7 @@ class RealSenseCamera:
     def set_extrinsics(self, pose: Pose) -> None:
         self._pose = pose
 
-    def capture(self) -> RGBDFrame:
+    def capture(self, max_width: int | None = None) -> RGBDFrame:
         with self._lock:
             try:
                 frames = self._align.process(self._pipeline.wait_for_frames(_TIMEOUT_MS))
@@ -108,7 +108,7 @@ class RealSenseCamera:
                 T_world_camera=self._pose,
                 stamp=time.monotonic(),
                 camera=self.name,
-            )
+            ).at_most(max_width)
 
     def close(self) -> None:
         """Stop streaming."""

@@ -168,7 +168,7 @@ class RecordedCamera:
     def set_extrinsics(self, pose: Pose) -> None:
         self._calibrated = pose
 
-    def capture(self) -> RGBDFrame:
+    def capture(self, max_width: int | None = None) -> RGBDFrame:
         with self._lock:
             entry = self._frames[next(self._order)]
         bgr = cv2.imread(str(self.folder / entry["rgb"]), cv2.IMREAD_COLOR)
@@ -187,4 +187,4 @@ class RecordedCamera:
             T_world_camera=self._calibrated or entry["pose"],
             stamp=float(entry["stamp"]),
             camera=self.name,
-        )
+        ).at_most(max_width)

@@ -81,7 +81,7 @@ class StreamCamera:
     def set_extrinsics(self, pose: Pose) -> None:
         self._calibrated = pose
 
-    def capture(self) -> RGBDFrame:
+    def capture(self, max_width: int | None = None) -> RGBDFrame:
         """The camera's next frame (blocks the calling worker thread)."""
         with self._lock:
             try:
@@ -95,7 +95,7 @@ class StreamCamera:
                     f"{exc}"
                 ) from exc
         self._last = frame
-        return frame
+        return frame.at_most(max_width)
 
     def _fetch(self) -> RGBDFrame:
         if self._socket is None:

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from capabilities.camera_source import stride_for
 from engine.types import Pose
 
 __all__ = ["Capture", "CameraFeed", "RobotReader"]
@@ -117,10 +118,10 @@ class CameraFeed:
 
     def _take(self) -> Capture:
         before = self._robot() if self._robot is not None else None
-        frame = self._camera.capture()
+        # A frame only as wide as the clouds are (a simulated camera renders just that).
+        frame = self._camera.capture(max_width=self._max_width)
         after = self._robot() if self._robot is not None else None
-        width = int(frame.depth.shape[1])
-        stride = max(1, -(-width // self._max_width))
+        stride = stride_for(int(frame.depth.shape[1]), self._max_width)
         joints = tuple(r[0] for r in (before, after) if r is not None)
         return Capture(
             points=np.asarray(frame.point_cloud(stride), dtype=float),

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from capabilities.camera_source import CameraSource
+from capabilities.camera_source import CameraSource, stride_for
 from capabilities.camera_sources import open_source
 from capabilities.cell_features import CellStatus, ClosesOnExit
 from capabilities.collaboration.console import OperatorConsole
@@ -73,7 +73,7 @@ class SimCameraDevice:
         self.name = camera.name
         mount = camera.mount
         self.on_wrist = isinstance(mount, LinkMount)
-        self._preview: SimCamera | None = None
+        self._smaller: dict[tuple[int, int], SimCamera] = {}  # by (width, height)
         self.live: LiveView | None = None  # the session's mirror renderer, if it has one
         self._believed: Pose = (
             mount.T_link_camera if isinstance(mount, LinkMount) else mount.T_world_camera
@@ -93,10 +93,18 @@ class SimCameraDevice:
         """Store a calibration: the world pose (fixed camera) or the flange pose (wrist)."""
         self._believed = pose
 
-    def capture(self, size: tuple[int, int] | None = None) -> RGBDFrame:
+    def capture(
+        self, max_width: int | None = None, size: tuple[int, int] | None = None
+    ) -> RGBDFrame:
         """Render a frame; ``size`` (width, height) renders a smaller view of the same
-        camera (a live preview: the CPU renderer's cost grows with the pixels).
+        camera (a live preview: the CPU renderer's cost grows with the pixels), as does
+        ``max_width`` (the size of every n-th pixel, as a real camera's frame subsampled by
+        ``RGBDFrame.at_most``).
         """
+        if size is None and max_width is not None:
+            config = self.camera.config
+            stride = stride_for(config.width, max_width)
+            size = (config.width // stride, config.height // stride)
         camera = self.camera if size is None else self._resized(size)
 
         def render(client: int) -> RGBDFrame:
@@ -117,23 +125,24 @@ class SimCameraDevice:
             LiveViewError: the mirror stopped (the message says why).
         """
         if self.live is None:
-            return self.capture(size)
+            return self.capture(size=size)
         return self.live.capture(self.name, size, self.extrinsics, ahead)
 
     def _resized(self, size: tuple[int, int]) -> SimCamera:
         config = self.camera.config
         if (config.width, config.height) == tuple(size):
             return self.camera
-        if self._preview is None or self._preview.config.width != size[0]:
+        if size not in self._smaller:  # one each: each keeps its own noise going
             small = dataclasses.replace(config, width=int(size[0]), height=int(size[1]))
-            self._preview = SimCamera(self.camera.name, small, self.camera.mount)
-        return self._preview
+            self._smaller[size] = SimCamera(self.camera.name, small, self.camera.mount)
+        return self._smaller[size]
 
     def displace_for_test(self, true_pose: Pose) -> None:
         """TEST ONLY: physically move a fixed camera (its believed pose stays as it was)."""
         if self.on_wrist:
             raise ValueError("only a fixed camera can be displaced")
         self.camera = SimCamera(self.camera.name, self.camera.config, FixedMount(true_pose))
+        self._smaller.clear()
 
 
 class SimCellSession(ClosesOnExit):

@@ -51,6 +51,21 @@ def test_a_recording_reads_back_frame_for_frame(tmp_path: Path) -> None:
     assert camera.capture().T_world_camera == calibrated == camera.extrinsics()
 
 
+def test_a_frame_asked_at_most_so_wide_has_the_points_of_every_nth_pixel(
+    tmp_path: Path,
+) -> None:
+    frame = _frame()
+    assert frame.at_most(None) is frame and frame.at_most(32) is frame
+    small = frame.at_most(12)  # 32 columns: every 3rd, 11 wide
+    assert small.depth.shape == (8, 11) and small.rgb.shape == (8, 11, 3)
+    assert np.allclose(small.point_cloud(), frame.point_cloud(3))
+    assert np.array_equal(small.point_colors(), frame.point_colors(3))
+    FrameRecorder(tmp_path / "rec", "top").add(frame)
+    recorded = RecordedCamera(tmp_path / "rec").capture(max_width=16)
+    assert recorded.depth.shape == (12, 16)
+    assert np.allclose(recorded.point_cloud(), frame.point_cloud(2), atol=1e-4)
+
+
 def test_a_broken_recording_names_file_and_field(tmp_path: Path) -> None:
     FrameRecorder(tmp_path, "top").add(_frame())
     index = json.loads((tmp_path / "recording.json").read_text())

@@ -155,7 +155,7 @@ def test_is_occupied_is_not_running_forever_when_the_camera_fails() -> None:
     class Broken:
         name, on_wrist = "shoulder", False
 
-        def capture(self) -> object:
+        def capture(self, max_width: int | None = None) -> object:
             raise RuntimeError("no signal")
 
     class Cell:

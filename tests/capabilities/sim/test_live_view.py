@@ -82,7 +82,7 @@ def _body_ids(cell: SimCellSession, device: SimCameraDevice) -> np.ndarray:
 
 def _assert_same_picture(cell: SimCellSession, camera: str) -> None:
     device = _rendered(cell, camera)
-    live, exact = device.preview(SIZE), device.capture(SIZE)
+    live, exact = device.preview(SIZE), device.capture(size=SIZE)
     assert live.rgb.shape == exact.rgb.shape == (240, 320, 3)
     world = cell.sim.world
     bodies = _body_ids(cell, device)
@@ -177,6 +177,21 @@ def test_a_cell_that_did_not_move_is_not_rendered_again(cell: SimCellSession) ->
     assert cell.live_view.requests()["shoulder"] == asked  # the mirror rendered nothing
 
 
+def test_a_frame_at_most_320_wide_is_rendered_so_and_sees_what_the_full_one_does(
+    cell: SimCellSession,
+) -> None:
+    """Occupancy's frames: the simulated camera renders only the pixels asked for."""
+    device = _rendered(cell, "shoulder")
+    full, small = device.capture(), device.capture(max_width=320)
+    assert full.depth.shape == (480, 640) and small.depth.shape == (240, 320)
+    assert small.T_world_camera == full.T_world_camera
+    # The coarse pixels' centres lie between the fine ones': the two clouds agree to a
+    # few millimetres where the surfaces are smooth.
+    near = np.abs(small.depth - full.depth[::2, ::2])
+    assert np.nanmedian(near) < 0.005
+    assert abs(len(small.point_cloud()) - len(full.point_cloud(2))) < 0.02 * small.depth.size
+
+
 def test_the_mirrors_end_with_the_cell() -> None:
     with SimCellSession("cup_to_bin", seed=0) as session:
         _rendered(session, "shoulder").preview(SIZE)
@@ -228,7 +243,7 @@ def test_a_crashed_mirror_fails_its_pictures_and_the_cell_goes_on() -> None:
         now = session.clock()
         session.sim.wait_sim(0.1)
         assert session.clock() > now
-        assert camera.capture(SIZE).rgb.shape == (240, 320, 3)  # perception's frames go on
+        assert camera.capture(size=SIZE).rgb.shape == (240, 320, 3)  # perception's frames go on
 
 
 def test_closing_the_cell_while_a_mirror_starts_ends_it() -> None:
