@@ -111,7 +111,6 @@ class SimCell(ClosesOnExit):
         self.suction = SimSuctionTool(
             self._physics,
             self._suction,
-            self._suction_in_hand,
             self.config.holster_pose,
             self.config.handle_grasp,
             (self.config.tcp_offsets["gripper"], self.config.tcp_offsets["suction"]),
