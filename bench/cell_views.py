@@ -31,7 +31,6 @@ from __future__ import annotations
 
 import os
 import sys
-import tempfile
 import time
 from pathlib import Path
 from typing import Any
@@ -42,10 +41,10 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 if not os.environ.get("DISPLAY"):
     os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
-from PySide6.QtCore import QEventLoop, QSettings, QTimer
 from PySide6.QtWidgets import QApplication
 
 from bench._report import figures_parser, print_figures
+from bench._window import sim_window, wait
 from engine.tree import RunPolicy
 
 __all__ = ["measure_cell_views", "main"]
@@ -53,12 +52,6 @@ __all__ = ["measure_cell_views", "main"]
 PLAN = (
     Path(__file__).resolve().parents[1] / "resources" / "examples" / "cup_to_bin_vision.costar.json"
 )
-
-
-def _wait(seconds: float) -> None:
-    loop = QEventLoop()
-    QTimer.singleShot(int(seconds * 1000), loop.quit)
-    loop.exec()
 
 
 def _cpu_seconds(pid: int) -> float | None:
@@ -82,7 +75,7 @@ def _first_pictures(window: Any, timeout: float = 60.0) -> float:
     """
     cameras, started = window.cell_views.cameras, time.perf_counter()
     while len(cameras.shown) < len(cameras._pictures):
-        _wait(0.1)
+        wait(0.1)
         if time.perf_counter() - started > timeout:
             raise RuntimeError(f"the camera panel showed no picture within {timeout:g} s")
     return time.perf_counter() - started
@@ -114,7 +107,7 @@ def _phase(window: Any, shown: bool, seconds: float) -> dict[str, Any]:
         window.docks[name].setVisible(shown)
     if shown:  # shown again, the docks come back narrower: the column of a window this wide
         window.arrange_cell_views()
-    _wait(1.0)  # settle: the feed starts or stops, the docks lay out
+    wait(1.0)  # settle: the feed starts or stops, the docks lay out
     sizes = _on_screen(window) if shown else {}
     executor = window.controller._executor  # the bench reads the engine's tick counter
     cell = window.session.cell
@@ -123,7 +116,7 @@ def _phase(window: Any, shown: bool, seconds: float) -> dict[str, Any]:
     seq0 = {name: frame.seq for name, frame in views.cameras.shown.items()}
     cpu0 = {name: _cpu_seconds(pid) for name, pid in _renderers(cell).items()}
     app0 = _cpu_seconds(os.getpid())
-    _wait(seconds)
+    wait(seconds)
     wall = time.perf_counter() - wall0
     app1 = _cpu_seconds(os.getpid())
     cameras = max(len(views.cameras.shown), 1)
@@ -154,33 +147,15 @@ def measure_cell_views(seconds: float = 6.0) -> dict[str, Any]:
     """The camera panel's and the 3D scene's frame rates and the app's CPU while a plan runs,
     with the views on and off.
     """
-    from instructor_app.app import HeadlessDialogs
-    from instructor_app.main_window import MainWindow
-    from instructor_app.runtime.session import CellSession
-    from instructor_app.settings import AppSettings
-
     app = QApplication.instance() or QApplication([])
-    session = CellSession("sim", speed=1.0)
-    session.open()
-    with tempfile.TemporaryDirectory() as scratch:
-        settings = AppSettings(QSettings(str(Path(scratch, "s.ini")), QSettings.Format.IniFormat))
-        window = MainWindow(session, settings, HeadlessDialogs(), Path(scratch, "recovery"))
-        try:
-            window.resize(1920, 1080)
-            window.show()
-            window.document.open(PLAN)
-            window.document.set_run_policy(RunPolicy.FOREVER)
-            assert window.controller.run(), "the plan did not start"
-            first_picture = _first_pictures(window)
-            off = _phase(window, False, seconds)
-            on = _phase(window, True, seconds)
-            app.processEvents()
-        finally:
-            window.controller.shutdown()
-            window.cell_views.stop()
-            window.autosaver.stop()
-            window.hide()
-            session.close()
+    with sim_window() as window:
+        window.document.open(PLAN)
+        window.document.set_run_policy(RunPolicy.FOREVER)
+        assert window.controller.run(), "the plan did not start"
+        first_picture = _first_pictures(window)
+        off = _phase(window, False, seconds)
+        on = _phase(window, True, seconds)
+        app.processEvents()
     gl = window.cell_views.scene3d.available
     return {
         "camera_fps": round(on["camera_fps"], 1),

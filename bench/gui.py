@@ -219,54 +219,33 @@ def measure_idle(seconds: float, settle: float = 3.0) -> dict[str, Any]:
     nothing running and nothing moving (see the module doc); run in a process of its own.
     """
     import psutil
-    from PySide6.QtCore import QSettings
 
-    from instructor_app.app import HeadlessDialogs
-    from instructor_app.main_window import MainWindow
-    from instructor_app.runtime.session import CellSession
-    from instructor_app.settings import AppSettings
-
-    def wait(duration: float) -> None:
-        loop = QEventLoop()
-        QTimer.singleShot(int(duration * 1000), loop.quit)
-        loop.exec()
+    from bench._window import sim_window, wait
 
     _app = QApplication.instance() or QApplication([])
-    session = CellSession("sim", speed=1.0)
-    session.open()
     me = psutil.Process()
-    with tempfile.TemporaryDirectory() as scratch:
-        settings = AppSettings(QSettings(str(Path(scratch, "s.ini")), QSettings.Format.IniFormat))
-        window = MainWindow(session, settings, HeadlessDialogs(), Path(scratch, "recovery"))
-        try:
-            window.resize(1920, 1080)
-            window.show()
-            for name in ("cameras", "scene3d"):
-                window.docks[name].setVisible(True)
-            window.arrange_cell_views()
-            cameras, scene3d = window.cell_views.cameras, window.cell_views.scene3d
-            started = time.perf_counter()
-            while len(cameras.shown) < len(cameras._pictures):
-                wait(0.1)
-                if time.perf_counter() - started > 60.0:
-                    raise RuntimeError("the camera panel showed no picture within 60 s")
-            wait(settle)  # the arm and the objects come to rest, the views catch up
-            frames0, drawn0 = cameras.frames_shown, scene3d.frames_drawn
-            cpu0, wall0 = _tree_cpu_seconds(me), time.perf_counter()
-            wait(seconds)
-            cpu1, wall = _tree_cpu_seconds(me), time.perf_counter() - wall0
-            result = {
-                "idle_cpu_cores": round((cpu1 - cpu0) / wall, 3),
-                "idle_camera_frames": cameras.frames_shown - frames0,
-                "idle_scene3d_frames": scene3d.frames_drawn - drawn0 if scene3d.available else None,
-                "idle_seconds": round(wall, 1),
-                "idle_load_average": [round(v, 2) for v in os.getloadavg()],
-            }
-        finally:
-            window.cell_views.stop()
-            window.autosaver.stop()
-            window.hide()
-            session.close()
+    with sim_window() as window:
+        for name in ("cameras", "scene3d"):
+            window.docks[name].setVisible(True)
+        window.arrange_cell_views()
+        cameras, scene3d = window.cell_views.cameras, window.cell_views.scene3d
+        started = time.perf_counter()
+        while len(cameras.shown) < len(cameras._pictures):
+            wait(0.1)
+            if time.perf_counter() - started > 60.0:
+                raise RuntimeError("the camera panel showed no picture within 60 s")
+        wait(settle)  # the arm and the objects come to rest, the views catch up
+        frames0, drawn0 = cameras.frames_shown, scene3d.frames_drawn
+        cpu0, wall0 = _tree_cpu_seconds(me), time.perf_counter()
+        wait(seconds)
+        cpu1, wall = _tree_cpu_seconds(me), time.perf_counter() - wall0
+        result = {
+            "idle_cpu_cores": round((cpu1 - cpu0) / wall, 3),
+            "idle_camera_frames": cameras.frames_shown - frames0,
+            "idle_scene3d_frames": scene3d.frames_drawn - drawn0 if scene3d.available else None,
+            "idle_seconds": round(wall, 1),
+            "idle_load_average": [round(v, 2) for v in os.getloadavg()],
+        }
     return result
 
 

@@ -24,13 +24,13 @@ import numpy as np
 
 from capabilities.geometry import pose_to_matrix
 from capabilities.robot_body import (
+    Capsule,
     RobotBody,
     RobotBodyError,
     matrix_pose,
     pose_matrix,
     robot_base_from_arm,
 )
-from engine.types import Pose
 
 __all__ = ["HIDDEN_SHARE", "WORK_AREA", "ArmCover", "ArmView", "Glance"]
 
@@ -97,31 +97,23 @@ class ArmView:
             else:
                 flange = pose_matrix(self._body.flange_pose(q))
                 tcp = matrix_pose(np.linalg.inv(flange) @ pose_matrix(arm.tcp_pose()))
+            capsules = self._body.capsules(q, tcp, _INFLATE)
         except (RobotBodyError, AttributeError, TypeError, ValueError):
             return None
-        return Glance(self, str(camera.name), frame, self._body, q, tcp)
+        moving = [capsule for capsule in capsules if capsule.link not in _STILL]
+        return Glance(self, str(camera.name), frame, moving)
 
 
 class Glance:
-    """One frame of a fixed camera and the arm's joints when it was taken; the cover is
-    measured only when asked for (a look that found nothing).
+    """One frame of a fixed camera and the capsules of the arm's moving links when it was
+    taken; the cover is measured only when asked for (a look that found nothing).
     """
 
-    def __init__(
-        self,
-        view: ArmView,
-        camera: str,
-        frame: Any,
-        body: RobotBody,
-        q: tuple[float, ...],
-        tcp: Pose | None,
-    ) -> None:
+    def __init__(self, view: ArmView, camera: str, frame: Any, arm: list[Capsule]) -> None:
         self._view = view
         self.camera = camera
         self._frame = frame
-        self._body = body
-        self._q = q
-        self._tcp = tcp
+        self._arm = arm
         self._cover: ArmCover | None = None
 
     def cover(self) -> ArmCover:
@@ -144,9 +136,8 @@ class Glance:
             return 0.0
         low, high = self._view.low, self._view.high
         on_arm = np.zeros(len(points), dtype=bool)
-        for capsule in self._body.capsules(self._q, self._tcp, _INFLATE):
-            if capsule.link not in _STILL:
-                on_arm |= capsule.distance(points) <= 0.0
+        for capsule in self._arm:
+            on_arm |= capsule.distance(points) <= 0.0
         over = np.all((points[:, :2] >= low) & (points[:, :2] <= high), axis=1)
         rest = points[over & ~on_arm]
         if len(rest) == 0:

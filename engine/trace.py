@@ -40,47 +40,34 @@ class TraceError(EngineError):
 
 def _event_record(event: Event) -> dict[str, Any]:
     if isinstance(event, StatusChanged):
-        record: dict[str, Any] = {
-            "event": "status",
-            "tick": event.tick,
-            "node": event.node_id,
-            "old": event.old.value,
-            "new": event.new.value,
-        }
+        fields = {"node": event.node_id, "old": event.old.value, "new": event.new.value}
         if event.message:
-            record["message"] = event.message
+            fields["message"] = event.message
         if event.error:  # absent in traces written before error types: read as untyped
-            record["error"] = event.error
-        return record | {"time": event.time}
+            fields["error"] = event.error
+        return _ticked("status", event, **fields)
     if isinstance(event, BlackboardWritten):
-        return {
-            "event": "write",
-            "tick": event.tick,
-            "key": event.key,
-            "value": encode_value(event.value),
-            "node": event.node_id,
-            "time": event.time,
-        }
+        return _ticked(
+            "write", event, key=event.key, value=encode_value(event.value), node=event.node_id
+        )
     if isinstance(event, LogMessage):
-        return {
-            "event": "log",
-            "tick": event.tick,
-            "node": event.node_id,
-            "message": event.message,
-            "time": event.time,
-        }
+        return _ticked("log", event, node=event.node_id, message=event.message)
     if isinstance(event, RunFinished):
-        return {
-            "event": "finished",
-            "tick": event.tick,
-            "status": event.status.value,
-            "reason": event.reason,
-            "message": event.message,
-            "time": event.time,
-        }
+        return _ticked(
+            "finished",
+            event,
+            status=event.status.value,
+            reason=event.reason,
+            message=event.message,
+        )
     if isinstance(event, RunHeld):
-        return {"event": "held", "tick": event.tick, "reason": event.reason, "time": event.time}
+        return _ticked("held", event, reason=event.reason)
     return {"event": "started", "plan": event.plan, "time": event.time}
+
+
+def _ticked(name: str, event: Any, **fields: Any) -> dict[str, Any]:
+    """The record of an event of a tick: its name and tick, its own fields, then its time."""
+    return {"event": name, "tick": event.tick, **fields, "time": event.time}
 
 
 class TraceRecorder:

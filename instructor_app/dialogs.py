@@ -22,6 +22,19 @@ XML_FILTER = "BehaviorTree.CPP XML (*.xml);;All files (*)"
 SAVE, DISCARD, CANCEL = "save", "discard", "cancel"
 
 
+def _yes(
+    parent: QWidget,
+    question: str,
+    no: QMessageBox.StandardButton,
+    default: QMessageBox.StandardButton,
+) -> bool:
+    """Ask a question answered by Yes or by ``no`` (No, Cancel); True on Yes."""
+    answer = QMessageBox.question(
+        parent, APP_TITLE, question, QMessageBox.StandardButton.Yes | no, default
+    )
+    return answer == QMessageBox.StandardButton.Yes
+
+
 class Dialogs:
     """The window's questions and messages. Tests replace it, or patch :meth:`make_box`."""
 
@@ -43,27 +56,23 @@ class Dialogs:
 
     def ask_restore(self, parent: QWidget, description: str) -> bool:
         buttons = QMessageBox.StandardButton
-        answer = QMessageBox.question(
+        return _yes(
             parent,
-            APP_TITLE,
             f"The Instructor did not close properly. Restore the unsaved plan?\n\n{description}",
-            buttons.Yes | buttons.No,
-            buttons.Yes,
+            no=buttons.No,
+            default=buttons.Yes,
         )
-        return answer == buttons.Yes
 
     def ask_overwrite_waypoint(self, parent: QWidget, name: str, users: list[str]) -> bool:
         """Ask whether to teach again the waypoint ``name`` that the nodes ``users`` use too."""
         buttons = QMessageBox.StandardButton
         shown = ", ".join(repr(u) for u in users[:5]) + (" ..." if len(users) > 5 else "")
-        answer = QMessageBox.question(
+        return _yes(
             parent,
-            APP_TITLE,
             f"The waypoint {name!r} is also used by {shown}. Teach it again for all of them?",
-            buttons.Yes | buttons.Cancel,
-            buttons.Cancel,
+            no=buttons.Cancel,
+            default=buttons.Cancel,
         )
-        return answer == buttons.Yes
 
     def error(self, parent: QWidget, title: str, text: str) -> None:
         QMessageBox.critical(parent, title, text)

@@ -89,14 +89,7 @@ class PlanFiles(QObject):
             path = self.dialogs.open_path(self.window, self.settings.last_dir())
             if not path:
                 return False
-        try:
-            self.document.open(path)
-        except DocumentError as exc:
-            self.dialogs.error(self.window, "Cannot open the plan", str(exc))
-            return False
-        self.settings.add_recent(path)
-        self.show_message(f"Opened {path}")
-        return True
+        return self._open_or_save(self.document.open, path, "Cannot open the plan", "Opened")
 
     def save_plan(self) -> bool:
         """Save to the plan's file; asks for a new one (Save As) when it has none or when
@@ -126,13 +119,21 @@ class PlanFiles(QObject):
         return False
 
     def _save_to(self, path: Path) -> bool:
+        return self._open_or_save(self.document.save, path, "Cannot save the plan", "Saved")
+
+    def _open_or_save(
+        self, action: Callable[[str | Path], object], path: str | Path, failed: str, done: str
+    ) -> bool:
+        """Open or save the plan by ``action(path)``: the file joins the recent ones and the
+        status bar says ``done``, or a DocumentError is shown under the title ``failed``.
+        """
         try:
-            self.document.save(path)
+            action(path)
         except DocumentError as exc:
-            self.dialogs.error(self.window, "Cannot save the plan", str(exc))
+            self.dialogs.error(self.window, failed, str(exc))
             return False
         self.settings.add_recent(path)
-        self.show_message(f"Saved {path}")
+        self.show_message(f"{done} {path}")
         return True
 
     def offer_recoveries(self) -> bool:

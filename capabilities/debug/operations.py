@@ -6,12 +6,21 @@ tried without a robot, and every node kind has an example plan.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, ClassVar
 
-from capabilities.base import Capability, CapabilityEnv
-from capabilities.kit import InPort, OperationKind, flag, manifest, number, output, text
+from capabilities.base import Capability, CapabilityEnv, OperationClass
+from capabilities.kit import (
+    InPort,
+    OperationKind,
+    flag,
+    manifest,
+    number,
+    output,
+    text,
+    variant,
+)
 from engine.error_types import ErrorType
-from engine.operations import Job, OperationCall, OperationFailed
+from engine.operations import Job, OperationCall, OperationFailed, PortSpec
 from engine.status import FAILURE, RUNNING, SUCCESS, Status
 from engine.types import ParamType, Pose, Waypoint
 
@@ -128,40 +137,40 @@ class PretendMove(_Debug):
         return _TickJob(int(call.input(TICKS)), SUCCESS, "")
 
 
-class SetParam(_Debug):
-    """debug.set_param: writes its value to the parameter bound to ``name``."""
+class _Echo(_Debug):
+    """Writes its value to its one output: ``set_param`` to ``name``, ``query`` to ``result``."""
 
-    VALUE = InPort[Any]("value", ALL_TYPES, doc="the value")
-    MANIFEST = manifest(
-        CAP,
-        "set_param",
-        OperationKind.ACTION,
-        "Writes a value to a named parameter.",
-        VALUE,
-        output("name", ParamType.ANY, doc="the parameter written"),
-    )
+    VALUE: ClassVar[InPort[Any]]
+    OUTPUT: ClassVar[str]
+
+    @classmethod
+    def of(
+        cls, name: str, kind: OperationKind, doc: str, value_doc: str, output_port: PortSpec
+    ) -> OperationClass:
+        """The operation ``name`` that writes its ``value`` input to ``output_port``."""
+        value = InPort[Any]("value", ALL_TYPES, doc=value_doc)
+        made = manifest(CAP, name, kind, doc, value, output_port)
+        return variant(cls, made, VALUE=value, OUTPUT=output_port.name)
 
     def start(self, call: OperationCall) -> Job:
-        call.write("name", call.input(self.VALUE))
+        call.write(self.OUTPUT, call.input(self.VALUE))
         return Job.done()
 
 
-class Query(_Debug):
-    """debug.query: answers with its value."""
-
-    VALUE = InPort[Any]("value", ALL_TYPES, doc="the answer")
-    MANIFEST = manifest(
-        CAP,
-        "query",
-        OperationKind.QUERY,
-        "Answers with a given value (a stand-in query).",
-        VALUE,
-        output("result", ParamType.ANY, doc="where the answer goes"),
-    )
-
-    def start(self, call: OperationCall) -> Job:
-        call.write("result", call.input(self.VALUE))
-        return Job.done()
+SetParam = _Echo.of(
+    "set_param",
+    OperationKind.ACTION,
+    "Writes a value to a named parameter.",
+    "the value",
+    output("name", ParamType.ANY, doc="the parameter written"),
+)
+Query = _Echo.of(
+    "query",
+    OperationKind.QUERY,
+    "Answers with a given value (a stand-in query).",
+    "the answer",
+    output("result", ParamType.ANY, doc="where the answer goes"),
+)
 
 
 class CheckParam(_Debug):

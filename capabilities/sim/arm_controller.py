@@ -30,6 +30,7 @@ from capabilities.sim.trajectory import (
     plan_linear,
 )
 from capabilities.sim.transforms import rotation_angle
+from capabilities.sim.world import World
 
 __all__ = ["MOVING_SPEED", "ArmController"]
 
@@ -58,25 +59,32 @@ class _Motion:
 
 
 class ArmController:
-    """Plays joint trajectories on the UR5's motors, handles stop and freedrive."""
+    """Plays joint trajectories on the UR5's motors, handles stop and freedrive.
+
+    Args:
+        client: the pybullet client.
+        world: the cell's built world: the robot's body and its arm's joints.
+        kin: the UR5's kinematics.
+        dt: the physics time step (s).
+        tcp: the TCP in the flange frame of the tool held now (4 x 4 matrix).
+    """
 
     def __init__(
         self,
         client: int,
-        body: int,
-        joints: tuple[int, ...],
+        world: World,
         kin: UR5Kinematics,
         dt: float,
         tcp: Callable[[], np.ndarray],
     ) -> None:
         self._client = client
-        self._body = body
-        self._joints = joints
+        self._body = world.robot
+        self._joints = world.arm_joints
         self._kin = kin
         self._dt = dt
         self._tcp = tcp
         self.q_actual: tuple[float, ...] = tuple(
-            s[0] for s in pybullet.getJointStates(body, joints, physicsClientId=client)
+            s[0] for s in pybullet.getJointStates(self._body, self._joints, physicsClientId=client)
         )
         self.qd_actual: tuple[float, ...] = (0.0,) * 6
         self.q_cmd = np.asarray(self.q_actual)

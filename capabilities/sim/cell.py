@@ -111,7 +111,6 @@ class SimCell(ClosesOnExit):
         self.suction = SimSuctionTool(
             self._physics,
             self._suction,
-            self._suction_in_hand,
             self.config.holster_pose,
             self.config.handle_grasp,
             (self.config.tcp_offsets["gripper"], self.config.tcp_offsets["suction"]),
@@ -259,9 +258,7 @@ class SimCell(ClosesOnExit):
     def _build(self, client: int) -> None:
         world = build_world(client, self.config)
         self._world = world
-        self._arm = ArmController(
-            client, world.robot, world.arm_joints, self.kinematics, TIME_STEP, self._tcp_matrix
-        )
+        self._arm = ArmController(client, world, self.kinematics, TIME_STEP, self._tcp_matrix)
         self._gripper = GripperController(
             client, world.robot, world.gripper_link, world.finger_joints
         )

@@ -33,7 +33,7 @@ class SuctionController:
         self._client = client
         self.tool = tool
         self._robot = robot
-        self._in_hand = in_hand
+        self.in_hand = in_hand  # True while the gripper holds the tool (any thread may ask)
         self.on = False
         self.part: int | None = None
         self._constraint: int | None = None
@@ -41,7 +41,7 @@ class SuctionController:
 
     def set_vacuum(self, handle: CommandHandle, on: bool) -> None:
         """Switch the vacuum; switching on needs the tool in the gripper."""
-        if on and not self._in_hand():
+        if on and not self.in_hand():
             handle.resolve(False, "suction_on refused: the suction tool is not in the gripper")
             return
         self.on = on
@@ -117,14 +117,12 @@ class SimSuctionTool:
         self,
         physics: PhysicsThread,
         controller: SuctionController,
-        in_hand: Callable[[], bool],
         holster_pose: Pose,
         handle_grasp: Pose,
         tcp_offsets: tuple[Pose, Pose],
     ) -> None:
         self._physics = physics
         self._ctl = controller
-        self._in_hand = in_hand
         self._holster = holster_pose
         self._grasp = handle_grasp
         gripper_tcp, suction_tcp = tcp_offsets
@@ -152,7 +150,7 @@ class SimSuctionTool:
 
     def in_hand(self) -> bool:
         """True while the gripper holds the suction tool (the TCP is then the cup tip)."""
-        return self._in_hand()
+        return self._ctl.in_hand()
 
     def holster_pose(self) -> Pose:
         """World pose of the holster (configured fixture pose)."""

@@ -8,7 +8,7 @@ so undo and redo are the document's.
 from __future__ import annotations
 
 import json
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 
 from PySide6.QtCore import QMimeData, QPoint, QPointF, QRectF, Signal
 from PySide6.QtGui import QAction
@@ -102,23 +102,16 @@ class CanvasView(QWidget):
 
     def set_statuses(self, mapping: Mapping[str, Status]) -> None:
         """Recolour the named nodes only (cheap: one item update each, no relayout)."""
-        nodes = self.mirror.nodes
-        for node_id, status in mapping.items():
-            node = nodes.get(node_id)
-            if node is not None:
-                node.item.set_status(status)
-                if status is Status.RUNNING or status is Status.SUCCESS:
-                    node.item.set_status_tip("")  # tried again: the old failure is gone
-                self._statused.add(node_id)
+        for node_id, item in self._run_state_items(mapping):
+            status = mapping[node_id]
+            item.set_status(status)
+            if status is Status.RUNNING or status is Status.SUCCESS:
+                item.set_status_tip("")  # tried again: the old failure is gone
 
     def set_failure_tips(self, mapping: Mapping[str, str]) -> None:
         """Node id -> "error type: message": shown in the tooltips of the failed nodes."""
-        nodes = self.mirror.nodes
-        for node_id, text in mapping.items():
-            node = nodes.get(node_id)
-            if node is not None:
-                node.item.set_status_tip(text)
-                self._statused.add(node_id)
+        for node_id, item in self._run_state_items(mapping):
+            item.set_status_tip(mapping[node_id])
 
     def failure_tip(self, node_id: str) -> str:
         """Why the node failed in the last run, as its tooltip shows it ("" : it did not)."""
@@ -136,12 +129,19 @@ class CanvasView(QWidget):
 
     def set_halted(self, node_ids: Sequence[str]) -> None:
         """Show the named nodes as halted: they were running when the run was stopped."""
+        for _node_id, item in self._run_state_items(node_ids):
+            item.set_halted()
+
+    def _run_state_items(self, node_ids: Iterable[str]) -> Iterator[tuple[str, TreeNodeItem]]:
+        """The items of the named nodes on the canvas (others are skipped), each remembered
+        as showing a run's state, which :meth:`clear_statuses` takes back.
+        """
         nodes = self.mirror.nodes
         for node_id in node_ids:
             node = nodes.get(node_id)
             if node is not None:
-                node.item.set_halted()
                 self._statused.add(node_id)
+                yield node_id, node.item
 
     def is_halted(self, node_id: str) -> bool:
         """True when the node shows as halted by a stop."""

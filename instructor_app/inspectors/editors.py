@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from PySide6.QtCore import QSignalBlocker
 from PySide6.QtWidgets import QCheckBox, QComboBox, QLineEdit, QWidget
 
 from engine.operations import PortSpec
@@ -103,9 +104,8 @@ class BoolEditor(ParamEditor):
         self._value = False
 
     def _show(self, value: Any) -> None:
-        self.check.blockSignals(True)
-        self.check.setChecked(bool(value))
-        self.check.blockSignals(False)
+        with QSignalBlocker(self.check):
+            self.check.setChecked(bool(value))
 
 
 class ObjectModelEditor(ParamEditor):
@@ -130,19 +130,17 @@ class ObjectModelEditor(ParamEditor):
 
     def set_context(self, context: EditorContext) -> None:
         current = self.combo.currentText()
-        self.combo.blockSignals(True)
-        self.combo.clear()
-        self.combo.addItems(list(context.object_names))
-        self.combo.setEditText(current)
-        self.combo.blockSignals(False)
+        with QSignalBlocker(self.combo):
+            self.combo.clear()
+            self.combo.addItems(list(context.object_names))
+            self.combo.setEditText(current)
         if self._value is None and context.object_names:
             self._value = ObjectModel(context.object_names[0])
             self._show(self._value)
 
     def _show(self, value: Any) -> None:
-        self.combo.blockSignals(True)
-        self.combo.setEditText(value.name if isinstance(value, ObjectModel) else "")
-        self.combo.blockSignals(False)
+        with QSignalBlocker(self.combo):
+            self.combo.setEditText(value.name if isinstance(value, ObjectModel) else "")
 
 
 class WaypointEditor(ParamEditor):
@@ -157,11 +155,10 @@ class WaypointEditor(ParamEditor):
         self._layout.addWidget(self.combo)
 
     def set_context(self, context: EditorContext) -> None:
-        self.combo.blockSignals(True)
-        self.combo.clear()
-        for waypoint in context.waypoints:
-            self.combo.addItem(f"{waypoint.name} ({waypoint.frame.value})", waypoint)
-        self.combo.blockSignals(False)
+        with QSignalBlocker(self.combo):
+            self.combo.clear()
+            for waypoint in context.waypoints:
+                self.combo.addItem(f"{waypoint.name} ({waypoint.frame.value})", waypoint)
         if self._value is None and context.waypoints:
             self._value = context.waypoints[0]
         self._show(self._value)
@@ -177,6 +174,5 @@ class WaypointEditor(ParamEditor):
             # A waypoint bound before it left the plan's list: still shown, still kept.
             self.combo.addItem(f"{value.name} (not in the plan)", value)
             index = self.combo.count() - 1
-        self.combo.blockSignals(True)
-        self.combo.setCurrentIndex(index)
-        self.combo.blockSignals(False)
+        with QSignalBlocker(self.combo):
+            self.combo.setCurrentIndex(index)

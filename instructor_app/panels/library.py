@@ -199,27 +199,14 @@ class LibraryPanel(QWidget):
 
     # ------------------------------------------------------------------ inside
 
-    def _folders(self) -> list[QTreeWidgetItem]:
-        items = (self.tree.topLevelItem(i) for i in range(self.tree.topLevelItemCount()))
-        return [item for item in items if item is not None]
-
-    @staticmethod
-    def _children(folder: QTreeWidgetItem) -> list[QTreeWidgetItem]:
-        items = (folder.child(i) for i in range(folder.childCount()))
-        return [item for item in items if item is not None]
-
     def _rows(self) -> list[tuple[QTreeWidgetItem, LibraryEntry]]:
-        return [
-            (row, row.data(0, _ENTRY_ROLE))
-            for folder in self._folders()
-            for row in self._children(folder)
-        ]
+        return self.tree.leaves(_ENTRY_ROLE)
 
     def _filter(self, text: str) -> None:
         found = {id(e) for e in self.library.search(text)} if self.library is not None else set()
-        for folder in self._folders():
+        for folder in self.tree.groups():
             shown = 0
-            for row in self._children(folder):
+            for row in self.tree.members(folder):
                 hidden = id(row.data(0, _ENTRY_ROLE)) not in found
                 row.setHidden(hidden)
                 shown += not hidden

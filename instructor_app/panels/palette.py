@@ -215,7 +215,7 @@ class PalettePanel(QWidget):
 
     def groups(self) -> list[str]:
         """Titles of the sections, in order."""
-        return [group.text(0) for group in self._group_rows()]
+        return [group.text(0) for group in self.tree.groups()]
 
     # ------------------------------------------------------------------ building
 
@@ -262,21 +262,8 @@ class PalettePanel(QWidget):
         assert isinstance(item, PaletteItem)
         return item
 
-    def _group_rows(self) -> list[QTreeWidgetItem]:
-        count = self.tree.topLevelItemCount()
-        return [g for g in (self.tree.topLevelItem(i) for i in range(count)) if g is not None]
-
-    @staticmethod
-    def _children(group: QTreeWidgetItem) -> list[QTreeWidgetItem]:
-        count = group.childCount()
-        return [c for c in (group.child(i) for i in range(count)) if c is not None]
-
     def _rows(self) -> list[tuple[QTreeWidgetItem, PaletteItem]]:
-        return [
-            (child, child.data(0, _ITEM_ROLE))
-            for group in self._group_rows()
-            for child in self._children(group)
-        ]
+        return self.tree.leaves(_ITEM_ROLE)
 
     # ------------------------------------------------------------------ behaviour
 
@@ -297,8 +284,8 @@ class PalettePanel(QWidget):
             self.hits.setCurrentRow(first_hit)
         for row, item in self._rows():
             row.setHidden(not item.matches(text))
-        for group in self._group_rows():
-            shown = any(not child.isHidden() for child in self._children(group))
+        for group in self.tree.groups():
+            shown = any(not child.isHidden() for child in self.tree.members(group))
             group.setHidden(not shown)
             if text and shown:
                 group.setExpanded(True)

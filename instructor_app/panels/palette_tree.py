@@ -1,5 +1,6 @@
 """The tree the palette and the library panel share: its items drag onto the canvas as
-palette items, and Enter chooses the current one.
+palette items, Enter chooses the current one, and its rows are read as groups (top level)
+of members.
 """
 
 from __future__ import annotations
@@ -42,6 +43,21 @@ class PaletteDragTree(QTreeWidget):
 
     def mimeTypes(self) -> list[str]:
         return [PALETTE_MIME]
+
+    def groups(self) -> list[QTreeWidgetItem]:
+        """The top-level rows (the palette's groups, the library's folders)."""
+        rows = (self.topLevelItem(i) for i in range(self.topLevelItemCount()))
+        return [row for row in rows if row is not None]
+
+    @staticmethod
+    def members(group: QTreeWidgetItem) -> list[QTreeWidgetItem]:
+        """The rows under a top-level row."""
+        rows = (group.child(i) for i in range(group.childCount()))
+        return [row for row in rows if row is not None]
+
+    def leaves(self, role: int) -> list[tuple[QTreeWidgetItem, Any]]:
+        """Every row under a top-level row, with what it holds under ``role``."""
+        return [(row, row.data(0, role)) for group in self.groups() for row in self.members(group)]
 
     def keyPressEvent(self, event: QKeyEvent) -> None:
         if event.key() in (Qt.Key.Key_Return, Qt.Key.Key_Enter) and self.currentItem():
