@@ -159,7 +159,14 @@ class UREmulator(ClosesOnExit):
         """The control script stops (as after a script error); safety stays normal."""
         self.ctl.end_program("the control script died")
 
-    def disconnect(self) -> None:
-        """Close every client connection; the servers keep listening (clients may reconnect)."""
+    def disconnect(self, outage: float = 1.0) -> None:
+        """Close every client connection, as a network outage of ``outage`` s does: the
+        servers keep listening, but close what connects before it is over.
+
+        A real outage lasts longer than ur_rtde's first attempt to reconnect, made on its
+        own thread at once; ur_rtde 1.6.5 aborts the process when that attempt succeeds
+        (its reconnect replaces the running receive thread's handle), so an emulated drop
+        that lets it succeed would test what a cell does not meet.
+        """
         for server in self._servers:
-            server.drop_clients()
+            server.drop_clients(outage)

@@ -64,6 +64,7 @@ class Server:
         self._closing = threading.Event()
         self._clients: list[socket.socket] = []
         self._lock = threading.Lock()
+        self._refuse_until = 0.0  # monotonic s: a network outage until then (see drop_clients)
         self._listener = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
         self._listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         try:
@@ -83,6 +84,9 @@ class Server:
                 conn, _ = self._listener.accept()
             except OSError:
                 return
+            if time.monotonic() < self._refuse_until:  # the outage: nothing gets through
+                _close(conn)
+                continue
             conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
             with self._lock:
                 if self._closing.is_set():
@@ -106,8 +110,11 @@ class Server:
                 if conn in self._clients:
                     self._clients.remove(conn)
 
-    def drop_clients(self) -> None:
-        """Close every client connection (the listener stays)."""
+    def drop_clients(self, outage: float = 0.0) -> None:
+        """Close every client connection (the listener stays); for ``outage`` s after, a
+        connection is closed as soon as it is made, as if the network were still down.
+        """
+        self._refuse_until = time.monotonic() + outage
         with self._lock:
             clients, self._clients = self._clients, []
         for conn in clients:
