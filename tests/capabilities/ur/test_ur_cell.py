@@ -309,7 +309,10 @@ def test_a_dropped_connection_holds_the_run_and_it_goes_on_once_reconnected(
         executor = _run(cell, plan, events)
         second = _ids(plan)[1]
         assert wait_for(lambda: executor.tree.nodes[second].status is RUNNING, 20)
-        emulator.disconnect()  # every socket drops; the controller is still there
+        # The move is under way (its send is over: a link that drops inside a send leaves
+        # ur_rtde waiting up to its 300 s timeout for the answer, see the closing note).
+        assert wait_for(lambda: cell.connection.state.moving, 20)
+        emulator.disconnect()  # every socket drops for 1 s; the controller is still there
         assert wait_for(lambda: executor.held.startswith("connection lost"), 20), executor.held
         result = executor.wait(60)  # the cell reconnects by itself, the run goes on
         assert result is not None and result.status is SUCCESS, (result, executor.held)
