@@ -5,8 +5,8 @@ Layout only: the window creates the panels and wires them; these functions place
 
 from __future__ import annotations
 
-from PySide6.QtCore import QSize, Qt
-from PySide6.QtWidgets import QDockWidget, QMainWindow, QScrollArea, QWidget
+from PySide6.QtCore import QEvent, QObject, QSize, Qt
+from PySide6.QtWidgets import QDockWidget, QMainWindow, QScrollArea, QTabBar, QWidget
 
 from instructor_app.panels.cell_views import CellViews
 from instructor_app.views import Views
@@ -29,6 +29,34 @@ def _scrolled(widget: QWidget) -> QScrollArea:
     return area
 
 
+def _whole_labels(bar: QTabBar) -> None:
+    """A tab bar of docks shows its labels whole: never elided, scroll buttons when the
+    tabs are wider than the bar.
+    """
+    bar.setElideMode(Qt.TextElideMode.ElideNone)
+    bar.setUsesScrollButtons(True)
+    bar.setExpanding(False)
+
+
+class _WholeTabLabels(QObject):
+    """Gives each tab bar the main window makes for its tabbed docks whole labels; the
+    window makes them when docks are tabbed together (also later, by the user).
+    """
+
+    def eventFilter(self, watched: QObject, event: QEvent) -> bool:
+        if event.type() in (QEvent.Type.ChildAdded, QEvent.Type.ChildPolished):
+            child = event.child()  # type: ignore[attr-defined]
+            if isinstance(child, QTabBar):
+                _whole_labels(child)
+        return False
+
+
+def whole_tab_labels(window: QMainWindow) -> None:
+    """Every tab bar of ``window``'s docks, now and later, shows its labels whole."""
+    for bar in window.findChildren(QTabBar):
+        _whole_labels(bar)
+
+
 def place_docks(
     window: QMainWindow,
     views: Views,
@@ -42,6 +70,12 @@ def place_docks(
     no saved layout is restored), as their place depends on the window's width.
     """
     docks: dict[str, QDockWidget] = {}
+    window._whole_tab_labels = _WholeTabLabels(window)  # type: ignore[attr-defined]
+    window.installEventFilter(window._whole_tab_labels)  # type: ignore[attr-defined]
+    # The side columns reach down to the status bar: the bottom tabs need less height than
+    # the inspector and the cameras.
+    window.setCorner(Qt.Corner.BottomLeftCorner, Qt.DockWidgetArea.LeftDockWidgetArea)
+    window.setCorner(Qt.Corner.BottomRightCorner, Qt.DockWidgetArea.RightDockWidgetArea)
 
     def dock(name: str, title: str, widget: QWidget, area: Qt.DockWidgetArea) -> None:
         docks[name] = QDockWidget(title, window)
@@ -94,17 +128,30 @@ def place_docks(
 def arrange_cell_views(window: QMainWindow, docks: dict[str, QDockWidget]) -> None:
     """Cameras above the 3D scene in a column of their own right of the inspector when
     the window is wide enough for it (1700 px); tabs beside Plan, Waypoints and Operator
-    otherwise (the canvas and the inspector keep their room).
+    otherwise (the canvas and the inspector keep their room). The columns' widths follow
+    the window's: the palette's tabs, the inspector's fields and the right-hand tabs read
+    whole at 1366 px, the camera pictures are pictures at 1920 px.
     """
-    if window.width() >= 1700:
-        right, across = Qt.DockWidgetArea.RightDockWidgetArea, Qt.Orientation.Horizontal
+    width, across = window.width(), Qt.Orientation.Horizontal
+    if width >= 1700:
+        right = Qt.DockWidgetArea.RightDockWidgetArea
         window.addDockWidget(right, docks["cameras"], across)  # a full-height column
         window.splitDockWidget(docks["cameras"], docks["scene3d"], Qt.Orientation.Vertical)
         window.resizeDocks(
-            [docks["cameras"], docks["scene3d"]], [420, 480], Qt.Orientation.Vertical
+            [docks["cameras"], docks["scene3d"]], [520, 480], Qt.Orientation.Vertical
         )
-        window.resizeDocks([docks["palette"], docks["cameras"]], [240, 560], across)
+        window.resizeDocks(
+            [docks["palette"], docks["inspector"], docks["cameras"]],
+            [round(width * 0.14), round(width * 0.2), round(width * 0.3)],
+            across,
+        )
     else:
         window.tabifyDockWidget(docks["operator"], docks["cameras"])
         window.tabifyDockWidget(docks["cameras"], docks["scene3d"])
         docks["plan"].raise_()
+        window.resizeDocks(
+            [docks["palette"], docks["inspector"]],
+            [round(width * 0.195), round(width * 0.29)],
+            across,
+        )
+    whole_tab_labels(window)

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from PySide6.QtCore import Signal
+from PySide6.QtCore import QSize, Signal
 from PySide6.QtWidgets import QDoubleSpinBox, QHBoxLayout, QWidget
 
 from engine.operations import PortSpec
@@ -98,6 +98,31 @@ class UnitSpinBox(QDoubleSpinBox):
         if unit.suffix:
             self.setSuffix(" " + unit.suffix)
         self.setSingleStep(1.0 if unit.factor != 1.0 else 0.1)
+
+    # The widest value a field sizes itself for (more still shows, scrolled in its field):
+    # sized for its whole range (1e9), three fields of a pose would not fit the inspector.
+    TYPICAL = 9999.99
+
+    def _fitted(self, hint: QSize) -> QSize:
+        """``hint`` (sized by Qt for the range's widest value) for the widest of a typical
+        value and the value shown instead.
+        """
+        metrics = self.fontMetrics()
+
+        def advance(value: float) -> int:
+            text = self.prefix() + self.textFromValue(value) + self.suffix()
+            return metrics.horizontalAdvance(text)
+
+        widest = max(advance(self.minimum()), advance(self.maximum()))
+        typical = max(self.minimum(), -self.TYPICAL)
+        needed = max(advance(typical), advance(self.value()))
+        return QSize(hint.width() - max(0, widest - needed), hint.height())
+
+    def sizeHint(self) -> QSize:
+        return self._fitted(super().sizeHint())
+
+    def minimumSizeHint(self) -> QSize:
+        return self._fitted(super().minimumSizeHint())
 
     def show_si(self, value: float) -> None:
         """Show an SI value converted, without signals."""

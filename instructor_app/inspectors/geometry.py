@@ -50,12 +50,13 @@ def _kept(spins: list[UnitSpinBox], stored: tuple[float, ...]) -> list[float]:
 def _spins(
     grid: QGridLayout, row: int, labels: str, unit: Any, on_change: Any
 ) -> list[UnitSpinBox]:
+    # Each name above its field: three fields side by side fit a narrow inspector.
     spins = []
     for column, label in enumerate(labels.split()):
         spin = UnitSpinBox(unit)
         spin.valueChanged.connect(lambda _v: on_change())
-        grid.addWidget(QLabel(label), row, 2 * column)
-        grid.addWidget(spin, row, 2 * column + 1)
+        grid.addWidget(QLabel(label), 2 * row, column)
+        grid.addWidget(spin, 2 * row + 1, column)
         spins.append(spin)
     return spins
 

@@ -17,6 +17,7 @@ from typing import Any
 from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import (
     QHBoxLayout,
+    QHeaderView,
     QLabel,
     QLineEdit,
     QPushButton,
@@ -114,6 +115,12 @@ class LibraryPanel(QWidget):
         self.search_field.textChanged.connect(self._filter)
         self.tree = _SubtreeTree(self)
         self.tree.setHeaderLabels(["Subtree", "Version"])
+        # The names take the width the version leaves; a name still too long says itself
+        # whole in its tooltip.
+        header = self.tree.header()
+        header.setStretchLastSection(False)
+        header.setSectionResizeMode(0, QHeaderView.ResizeMode.Stretch)
+        header.setSectionResizeMode(1, QHeaderView.ResizeMode.ResizeToContents)
         self.tree.setDragEnabled(True)
         self.tree.currentItemChanged.connect(self._current_changed)
         self.tree.itemDoubleClicked.connect(lambda item, _col: self._insert(item))
@@ -156,7 +163,8 @@ class LibraryPanel(QWidget):
                 folders[title].setFlags(Qt.ItemFlag.ItemIsEnabled)
             row = QTreeWidgetItem(folders[title], [entry.subtree.name, str(entry.subtree.version)])
             row.setData(0, _ENTRY_ROLE, entry)
-            row.setToolTip(0, entry.subtree.description)
+            about = entry.subtree.description
+            row.setToolTip(0, f"{entry.subtree.name}: {about}" if about else entry.subtree.name)
             row.setFlags(
                 Qt.ItemFlag.ItemIsEnabled
                 | Qt.ItemFlag.ItemIsSelectable
