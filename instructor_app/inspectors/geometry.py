@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from PySide6.QtWidgets import QGridLayout, QLabel, QWidget
+from PySide6.QtWidgets import QAbstractSpinBox, QGridLayout, QLabel, QWidget
 
 from engine.operations import PortSpec
 from engine.types import JointConfig, ParamType, Pose, Region
@@ -28,7 +28,7 @@ def _grid(owner: ParamEditor) -> QGridLayout:
     holder = QWidget()
     grid = QGridLayout(holder)
     grid.setContentsMargins(0, 0, 0, 0)
-    grid.setHorizontalSpacing(4)
+    grid.setHorizontalSpacing(2)
     grid.setVerticalSpacing(2)
     owner._layout.addWidget(holder)
     return grid
@@ -50,10 +50,12 @@ def _kept(spins: list[UnitSpinBox], stored: tuple[float, ...]) -> list[float]:
 def _spins(
     grid: QGridLayout, row: int, labels: str, unit: Any, on_change: Any
 ) -> list[UnitSpinBox]:
-    # Each name above its field: three fields side by side fit a narrow inspector.
+    # Each name above its field, and no arrow buttons (the arrow keys and the wheel still
+    # step): three fields side by side fit the inspector of a 1366 px wide window.
     spins = []
     for column, label in enumerate(labels.split()):
         spin = UnitSpinBox(unit)
+        spin.setButtonSymbols(QAbstractSpinBox.ButtonSymbols.NoButtons)
         spin.valueChanged.connect(lambda _v: on_change())
         grid.addWidget(QLabel(label), 2 * row, column)
         grid.addWidget(spin, 2 * row + 1, column)

@@ -99,6 +99,7 @@ class InspectorPanel(QWidget):
         # natural height and the space left stays below them.
         self.form.setRowWrapPolicy(QFormLayout.RowWrapPolicy.WrapLongRows)
         self.form.setFieldGrowthPolicy(QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
+        self.form.setContentsMargins(2, 2, 2, 2)  # the fields, not margins, get the width
         holder_layout.addWidget(form_widget)
         holder_layout.addStretch(1)
         # The parameter area takes every pixel the panel has below the name and the doc line.

@@ -26,8 +26,8 @@ from tests.instructor_app.conftest import EXAMPLES
 from tests.instructor_app.gui_driver import make_window
 
 # (width, height, the least width of a camera picture in pixels there, 0: not checked)
-# At 1366x768 the cameras are a tab: their pictures are not checked there yet (a tab raised
-# late keeps tiny pictures until the panel lays them out again; issue 26 item 6, left open).
+# At 1366x768 the cameras are a tab below the canvas: their pictures are not checked there
+# (a tab raised late keeps tiny pictures until the panel lays them out again).
 SIZES = [(1920, 1080, 240), (1366, 768, 0)]
 
 

@@ -116,6 +116,7 @@ def main() -> int:
     window.resize(1600, 1000)
     window.show()
     QTest.qWaitForWindowExposed(window)
+    window.docks["scene3d"].raise_()  # a tab below the canvas at this width: brought forward
     scene, teacher, panel = window.cell_views.scene3d, window.views.teacher, window.views.waypoints
     arm = session.cell.interfaces()["arm"]
     out["available"] = scene.available
