@@ -1,5 +1,5 @@
-"""Fixtures of the Instructor's tests: a cell session without a robot, temporary settings
-and recovery folders, and dialogs that answer without a person.
+"""Fixtures of the Instructor's tests: a cell session without a robot or with the simulated
+one, temporary settings and recovery folders, and dialogs that answer without a person.
 """
 
 from __future__ import annotations
@@ -19,6 +19,15 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "resources" / "examples"
 @pytest.fixture
 def figure3_path() -> Path:
     return EXAMPLES / "figure3_debug.costar.json"
+
+
+@pytest.fixture
+def fast_sim(qapp: object) -> Iterator[CellSession]:
+    """The simulated cell, as fast as possible (for the tests in ``sim`` folders)."""
+    session = CellSession("sim", speed=None)
+    assert session.open(), "the simulated cell did not open"
+    yield session
+    session.close()
 
 
 @pytest.fixture
