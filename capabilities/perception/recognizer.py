@@ -25,7 +25,7 @@ from capabilities.perception.geometry import (
 )
 from capabilities.perception.models import ModelCloud, ModelSet
 from capabilities.perception.plates import classify_plate, top_view
-from capabilities.perception.registration import Fit, fit_model
+from capabilities.perception.registration import best_fit
 from capabilities.perception.scene_cloud import Cluster, FrameLike, SceneCloud, segment_scene
 from capabilities.perception.symmetry import canonical_yaw
 from engine.types import Pose
@@ -105,17 +105,15 @@ class Recognizer:
     def _shape(
         self, scene: SceneCloud, cluster: Cluster, shapes: list[ModelCloud]
     ) -> Recognition | None:
-        best: Fit | None = None
         extent = float(np.ptp(cluster.points[:, :2], axis=0).max())
+        plausible = []
         for model in shapes:
             dims = model.spec.dimensions
             too_tall = cluster.top > model.height + _HEIGHT_SLACK
             too_wide = extent > float(np.hypot(dims[0], dims[1])) + 0.03
-            if too_tall or too_wide or cluster.top < 0.4 * model.height:
-                continue
-            fit = fit_model(scene, cluster, model, self.config)
-            if best is None or fit.score > best.score:
-                best = fit
+            if not (too_tall or too_wide or cluster.top < 0.4 * model.height):
+                plausible.append(model)
+        best = best_fit(scene, cluster, plausible, self.config) if plausible else None
         cfg = self.config
         if best is None or best.fitness < cfg.min_fitness or best.consistency < cfg.min_consistency:
             return None

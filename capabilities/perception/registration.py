@@ -27,7 +27,7 @@ from capabilities.perception.geometry import upright_matrix, yaw_of
 from capabilities.perception.models import ModelCloud, fpfh
 from capabilities.perception.scene_cloud import Cluster, SceneCloud
 
-__all__ = ["Fit", "fit_model", "free_space_consistency", "planar_icp"]
+__all__ = ["Fit", "best_fit", "free_space_consistency", "planar_icp"]
 
 _COARSE, _FINE = 0.03, 0.012  # m: correspondence gates of the first and last ICP rounds
 _POINT_WEIGHT = 0.3  # weight of the point-to-point rows next to the point-to-plane ones
@@ -188,20 +188,27 @@ def _score(
     return Fit(model.name, x, y, yaw, float(inliers.mean()), rmse, consistency)
 
 
-def fit_model(
-    scene: SceneCloud, cluster: Cluster, model: ModelCloud, config: RecognitionConfig
+def best_fit(
+    scene: SceneCloud, cluster: Cluster, models: list[ModelCloud], config: RecognitionConfig
 ) -> Fit:
-    """The best placement of ``model`` on ``cluster`` over all hypotheses, after ICP."""
-    best = _refine_best(scene, cluster, model, _footprint_hypotheses(cluster, model), config)
-    # Global registration costs more than the rest together: only when the footprint did
-    # not give a good fit (an object half hidden, an odd outline).
-    if config.global_registration and best.score < _GOOD_SCORE:
-        with o3d.utility.VerbosityContextManager(o3d.utility.VerbosityLevel.Error):
-            found = _global_hypothesis(cluster, model, config.voxel)
-        if found is not None:
-            other = _refine_best(scene, cluster, model, [found], config)
-            best = other if other.score > best.score else best
-    return best
+    """The best placement of any of ``models`` (at least one) on ``cluster``, after ICP.
+
+    Global registration costs more than the rest together, so it is tried only when no
+    model's footprint hypotheses gave a good fit (an object half hidden, an odd outline):
+    a cluster one model explains well is not registered against every other model the
+    library holds.
+    """
+    fits = [
+        _refine_best(scene, cluster, m, _footprint_hypotheses(cluster, m), config) for m in models
+    ]
+    if config.global_registration and max(f.score for f in fits) < _GOOD_SCORE:
+        for i, model in enumerate(models):
+            with o3d.utility.VerbosityContextManager(o3d.utility.VerbosityLevel.Error):
+                found = _global_hypothesis(cluster, model, config.voxel)
+            if found is not None:
+                other = _refine_best(scene, cluster, model, [found], config)
+                fits[i] = other if other.score > fits[i].score else fits[i]
+    return max(fits, key=lambda f: f.score)
 
 
 def _refine_best(
