@@ -36,6 +36,7 @@ UR5_JOINT_LIMITS: tuple[tuple[float, float], ...] = tuple(
     for name in UR5_JOINT_NAMES
 )
 _TWO_PI = 2.0 * math.pi
+_TURNS = np.array([0.0, -1.0, 1.0])  # extra turns tried per joint, in tie-break order
 
 
 class UR5Kinematics:
@@ -51,6 +52,8 @@ class UR5Kinematics:
         self.limits = tuple(limits)
         self._base_m = pose_to_matrix(base)
         self._base_inv = np.linalg.inv(self._base_m)
+        self._lo = np.array([lo for lo, _ in self.limits], dtype=float)[None, :, None]
+        self._hi = np.array([hi for _, hi in self.limits], dtype=float)[None, :, None]
 
     def flange_matrix(self, q: Joints) -> np.ndarray:
         """World 4x4 matrix of tool0 for joints ``q``."""
@@ -82,30 +85,26 @@ class UR5Kinematics:
         Each joint may be shifted by a multiple of 2 pi to come closest to ``near`` while
         staying inside its limits, since the UR joints turn more than one revolution.
         """
+        found = self.solutions(tcp_world, tcp)
+        if not found:
+            return None
+        sols = np.asarray(found, dtype=float).reshape(-1, 6)
         near_arr = np.asarray(near, dtype=float)
-        best: np.ndarray | None = None
-        best_cost = math.inf
-        for sol in self.solutions(tcp_world, tcp):
-            if not np.all(np.isfinite(sol)):
-                continue
-            candidate = self._unwrap_near(sol, near_arr)
-            if candidate is None:
-                continue
-            cost = float(np.sum((candidate - near_arr) ** 2))
-            if cost < best_cost:
-                best, best_cost = candidate, cost
-        return best
-
-    def _unwrap_near(self, sol: np.ndarray, near: np.ndarray) -> np.ndarray | None:
-        out = np.empty(6)
-        for j, (lo, hi) in enumerate(self.limits):
-            k = round((near[j] - sol[j]) / _TWO_PI)
-            options = [sol[j] + (k + d) * _TWO_PI for d in (0, -1, 1)]
-            valid = [v for v in options if lo - 1e-9 <= v <= hi + 1e-9]
-            if not valid:
-                return None
-            out[j] = min(valid, key=lambda v: abs(v - near[j]))
-        return out
+        sols = sols[np.all(np.isfinite(sols), axis=1)]
+        # Numpy over every solution at once: a linear move solves this at each control step.
+        # For each joint the turn nearest ``near``, then one less and one more (the order a
+        # tie is broken in), and of those inside the limits the one closest to ``near``.
+        k = np.round((near_arr - sols) / _TWO_PI)
+        options = sols[:, :, None] + (k[:, :, None] + _TURNS) * _TWO_PI
+        inside = (options >= self._lo - 1e-9) & (options <= self._hi + 1e-9)
+        distance = np.where(inside, np.abs(options - near_arr[None, :, None]), np.inf)
+        pick = np.argmin(distance, axis=2)
+        ok = np.all(inside.any(axis=2), axis=1)
+        if not ok.any():
+            return None
+        unwrapped = np.take_along_axis(options, pick[:, :, None], axis=2)[:, :, 0][ok]
+        costs = np.sum((unwrapped - near_arr) ** 2, axis=1)
+        return unwrapped[int(np.argmin(costs))].copy()
 
     def inverse(
         self, pose: Pose, near: Joints, tcp: Pose | None = None
