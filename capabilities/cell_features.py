@@ -14,6 +14,8 @@ methods' names and types, and mypy checks both sides.
 - :class:`ClearsStop`: the operator's clear of what the status names.
 - :class:`ShowsGroundTruth`: the simulator's ground truth, for its tests, scores and the 3D
   view's truth overlay only, never for an operation.
+- :class:`RunsInLockstep`: a cell whose world goes on only with the engine's clock during a
+  run (a simulated cell run as fast as it can); :func:`lockstep_of` gives the executor's.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from types import TracebackType
 from typing import Protocol, Self, runtime_checkable
 
 from capabilities.base import Cell
+from engine.executor import Lockstep
 from engine.types import Pose
 
 __all__ = [
@@ -33,8 +36,10 @@ __all__ = [
     "ClosesOnExit",
     "HoldsRuns",
     "ReportsStatus",
+    "RunsInLockstep",
     "SceneObjects",
     "ShowsGroundTruth",
+    "lockstep_of",
 ]
 
 
@@ -151,3 +156,17 @@ class ShowsGroundTruth(Protocol):
     def truth_pose(self, name: str) -> Pose:
         """GROUND TRUTH of an object's pose."""
         ...
+
+
+@runtime_checkable
+class RunsInLockstep(Protocol):
+    """A cell whose world can go on only with the engine's clock (``engine.executor``)."""
+
+    def run_lockstep(self) -> Lockstep | None:
+        """The lockstep a run's executor drives (None: the world goes on by itself)."""
+        ...
+
+
+def lockstep_of(cell: object) -> Lockstep | None:
+    """The executor's lockstep with ``cell`` (None for a cell that is not in one)."""
+    return cell.run_lockstep() if isinstance(cell, RunsInLockstep) else None

@@ -69,6 +69,7 @@ def open_cell(
     start: bool = True,
     scene: str | None = None,
     speed: float | None = None,
+    still_until_run: bool = False,
 ) -> ClosableCell:
     """The cell called ``name``, as a context manager.
 
@@ -80,18 +81,28 @@ def open_cell(
             physics thread to answer anything).
         scene: scene name or path for the simulated cell (default: cup_to_bin).
         speed: real-time factor of the simulated cell (None: as fast as possible).
+        still_until_run: a simulated cell run as fast as possible (in lockstep) stands still
+            until a run's executor drives it (``SimCellSession``): a run then begins at
+            simulated time 0 whatever its set-up took.
     """
     if name == "none":
         return ManagedCell()
     if is_cell_file(name):
-        return _open_cell_file(Path(name), seed, scene, speed)
+        return _open_cell_file(Path(name), seed, scene, speed, still_until_run)
     if name == "sim":
         try:
             from capabilities.sim.session import SimCellSession
         except ImportError as exc:
             raise CellError(f"the simulated cell cannot load: {exc}") from exc
         try:
-            return SimCellSession(scene or DEFAULT_SCENE, seed, speed, lockstep=_lockstep(speed))
+            lockstep = _lockstep(speed)
+            return SimCellSession(
+                scene or DEFAULT_SCENE,
+                seed,
+                speed,
+                lockstep=lockstep,
+                still_until_run=still_until_run,
+            )
         except Exception as exc:  # scene or model errors: say which, do not crash the CLI/GUI
             raise CellError(f"the simulated cell did not start: {exc}") from exc
     raise CellError(
@@ -133,7 +144,9 @@ def is_cell_file(name: str) -> bool:
     return name not in CELL_NAMES and (name.endswith(".json") or Path(name).exists())
 
 
-def _open_cell_file(path: Path, seed: int, scene: str | None, speed: float | None) -> ClosableCell:
+def _open_cell_file(
+    path: Path, seed: int, scene: str | None, speed: float | None, still_until_run: bool
+) -> ClosableCell:
     from capabilities.robot.cell_file import CellConfig, CellConfigError
 
     try:
@@ -155,7 +168,12 @@ def _open_cell_file(path: Path, seed: int, scene: str | None, speed: float | Non
         raise CellError(f"the simulated cell cannot load: {exc}") from exc
     try:
         return SimCellSession(
-            scene or DEFAULT_SCENE, seed, speed, config=config, lockstep=_lockstep(speed)
+            scene or DEFAULT_SCENE,
+            seed,
+            speed,
+            config=config,
+            lockstep=_lockstep(speed),
+            still_until_run=still_until_run,
         )
     except Exception as exc:
         raise CellError(f"{path}: the simulated cell did not start: {exc}") from exc

@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any, NamedTuple, TextIO
 
 from capabilities.base import CapabilityError, CapabilityRegistry
-from capabilities.cell_features import ClosableCell
+from capabilities.cell_features import ClosableCell, lockstep_of
 from capabilities.cells import CellError, cell_argument, open_cell
 from capabilities.collaboration.answers import CONFIRM_MODES, PromptAnswerer
 from capabilities.doctor import cmd_doctor
@@ -67,12 +67,15 @@ def _load(path: str, registry: CapabilityRegistry, err: TextIO) -> PlanSpec | No
 
 def _open(args: argparse.Namespace, err: TextIO, start: bool) -> ClosableCell | None:
     """The cell the command asked for, or None after saying why it could not be opened.
-    The simulated cell opens ``--scene``, else the scene the plan was taught on.
+    The simulated cell opens ``--scene``, else the scene the plan was taught on; for a run
+    its world waits for the run (lockstep from simulated time 0: the same seed gives the
+    same run).
     """
     plan = getattr(args, "plan", None)
     scene = args.scene or (plan_scene(plan) if plan else None)
+    run = args.command == "run"
     try:
-        return open_cell(args.cell, seed=args.seed, start=start, scene=scene)
+        return open_cell(args.cell, seed=args.seed, start=start, scene=scene, still_until_run=run)
     except CellError as exc:
         print(f"error: {exc}", file=err)
         return None
@@ -206,7 +209,14 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         listeners += [failures, holds]
         if args.verbose:
             listeners.append(_VerbosePrinter(plan, out))
-        executor = Executor(tree, args.rate, listeners, plan_name=plan.name, hold=hold_check(cell))
+        executor = Executor(
+            tree,
+            args.rate,
+            listeners,
+            plan_name=plan.name,
+            hold=hold_check(cell),
+            lockstep=lockstep_of(cell),
+        )
         restore = _install_interrupt(executor)
         console = cell.interfaces().get("operator")
         answerer = PromptAnswerer(console, args.confirm, args.stdin, out) if console else None

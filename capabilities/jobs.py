@@ -7,17 +7,24 @@ that the engine polls and can cancel.
 
 from __future__ import annotations
 
+import functools
 import threading
 from collections.abc import Callable, Mapping
 from concurrent.futures import Future, ThreadPoolExecutor
-from contextlib import AbstractContextManager, nullcontext
 from typing import Any, Protocol
 
 from capabilities.faults import fault_error
 from engine.error_types import ErrorType
 from engine.operations import Job, OperationFailed
 
-__all__ = ["CommandHandleLike", "job_from_handle", "WorkerPool", "chain_jobs"]
+__all__ = [
+    "CommandHandleLike",
+    "JobEnd",
+    "JobPacing",
+    "WorkerPool",
+    "chain_jobs",
+    "job_from_handle",
+]
 
 
 class CommandHandleLike(Protocol):
@@ -61,6 +68,25 @@ def job_from_handle(
     return job
 
 
+JobEnd = Callable[[Callable[[], None]], None]
+"""A job's end under a pacing: called on the worker thread once the function ran, with what
+hands its result to the engine (it calls it now, or at a set simulated time)."""
+
+
+class JobPacing(Protocol):
+    """How a cell's clock goes on while its jobs compute (a simulated cell's lockstep)."""
+
+    def begin(self) -> JobEnd:
+        """A job begins: called on the submitting thread (the engine's, inside a tick) before
+        the job runs; returns its end.
+        """
+        ...
+
+
+def _hand_over_now(deliver: Callable[[], None]) -> None:
+    deliver()
+
+
 class WorkerPool:
     """Runs blocking work (camera frames, perception) off the engine thread.
 
@@ -70,17 +96,15 @@ class WorkerPool:
     Args:
         workers: threads.
         name: their name prefix.
-        around: a context manager each function runs in (a simulated cell's lockstep: its
-            simulated time stands still while perception computes).
+        pacing: how the cell's clock goes on while a job computes (a simulated cell in
+            lockstep holds its world from the job's tick and hands the result over at a set
+            simulated time); None: results are handed over when they are ready.
     """
 
     def __init__(
-        self,
-        workers: int = 2,
-        name: str = "costar-worker",
-        around: Callable[[], AbstractContextManager[Any]] | None = None,
+        self, workers: int = 2, name: str = "costar-worker", pacing: JobPacing | None = None
     ) -> None:
-        self._around = around or nullcontext
+        self._pacing = pacing
         self._pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix=name)
         self._closed = False
         self._lock = threading.Lock()
@@ -89,23 +113,33 @@ class WorkerPool:
         cancelled = threading.Event()
         job = Job(on_cancel=cancelled.set)
 
-        def run() -> None:
+        def succeed(outputs: Mapping[str, Any] | None) -> None:
+            if not cancelled.is_set():
+                job.succeed(outputs=outputs or None)
+
+        def run(end: JobEnd) -> None:
+            result: Callable[[], None]
             try:
-                with self._around():
-                    outputs = fn()
+                outputs = fn()
             except OperationFailed as exc:
-                job.fail(str(exc), exc.error)
+                result = functools.partial(job.fail, str(exc), exc.error)
             except Exception as exc:  # a perception bug fails the node, never the engine
                 prefix = f"{describe}: " if describe else ""
-                job.fail(f"{prefix}{type(exc).__name__}: {exc}", ErrorType.ERROR)
+                text = f"{prefix}{type(exc).__name__}: {exc}"
+                result = functools.partial(job.fail, text, ErrorType.ERROR)
             else:
-                if not cancelled.is_set():
-                    job.succeed(outputs=outputs or None)
+                result = functools.partial(succeed, outputs)
+            end(result)
 
         with self._lock:
             if self._closed:
                 raise OperationFailed("the cell is shut down")
-            future: Future[None] = self._pool.submit(run)
+            end = self._pacing.begin() if self._pacing is not None else _hand_over_now
+            try:
+                future: Future[None] = self._pool.submit(run, end)
+            except BaseException:
+                end(lambda: None)  # nothing will run: release what the pacing holds
+                raise
         del future
         return job
 

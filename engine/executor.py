@@ -13,6 +13,12 @@ stop does not hold the run while it lasts (the handler is clearing it). Otherwis
 held (the running leaves are halted, nothing is ticked, a RunHeld event says why); once the
 cell is clear again the run goes on, and the composites tick the halted leaves afresh
 (PolyScope). A stop of no known type (``failed``: power off, a stopped script) is always held.
+
+In lockstep (a :class:`Lockstep`: a simulated cell run as fast as it can) the world goes on
+only with the engine's clock: after each tick the executor lets it run one period and waits
+until it has, and the next tick comes then, not earlier (a job that finishes does not bring
+it forward). The same plan, scene and seed then give the same ticks, however busy the
+machine is.
 """
 
 from __future__ import annotations
@@ -21,6 +27,7 @@ import collections
 import enum
 import threading
 import time
+from typing import Protocol
 
 from engine.error_types import ErrorType
 from engine.events import (
@@ -38,7 +45,21 @@ from engine.node import Node
 from engine.status import FAILURE, RUNNING, Status
 from engine.tree import BehaviorTree
 
-__all__ = ["Executor", "ExecutorState", "run_to_end"]
+__all__ = ["Executor", "ExecutorState", "Lockstep", "run_to_end"]
+
+
+class Lockstep(Protocol):
+    """A world that goes on only with the engine's clock (a simulated cell, run as fast as
+    it can).
+    """
+
+    def advance(self, seconds: float) -> None:
+        """Let the world go ``seconds`` further; return once it has."""
+        ...
+
+    def release(self) -> None:
+        """The run is over: the world goes on by itself again."""
+        ...
 
 
 class ExecutorState(str, enum.Enum):
@@ -105,6 +126,8 @@ class Executor:
         plan_name: for the RunStarted event.
         hold: asked before every tick; a Hold (why, and its error type) stops the run: it is
             thrown into the plan's Catch nodes that take it, else the run is held.
+        lockstep: the world to advance one period after each tick (see the module doc);
+            None: ticks come by the wall clock.
     """
 
     def __init__(
@@ -114,6 +137,7 @@ class Executor:
         listeners: list[Listener] | None = None,
         plan_name: str = "",
         hold: HoldCheck | None = None,
+        lockstep: Lockstep | None = None,
     ) -> None:
         if rate_hz <= 0:
             raise ValueError(f"rate must be above 0 Hz, not {rate_hz}")
@@ -128,6 +152,7 @@ class Executor:
         self._stop_reason: str | None = None
         self._state = ExecutorState.READY
         self._hold = hold
+        self._lockstep = lockstep
         self._held = ""  # the reason the run is held now ("" when it is not)
         self._thrown: Hold | None = None  # a stop thrown into the plan, while it lasts
         self._failures: list[str] = []  # leaf failure messages since the cell was last clear
@@ -262,18 +287,32 @@ class Executor:
                 if stop is not None:
                     reason = stop
                     break
-                next_tick = time.monotonic() + self.period
-                if self._held_now():
-                    continue
-                status = self.tree.tick()
-                if status is not RUNNING:
-                    message = self.tree.root.message
-                    break
+                # In lockstep the next tick is due once the world has gone one period on.
+                next_tick = 0.0 if self._lockstep else time.monotonic() + self.period
+                if not self._held_now():
+                    status = self.tree.tick()
+                    if status is not RUNNING:
+                        message = self.tree.root.message
+                        break
+                if self._lockstep is not None:
+                    self._lockstep.advance(self.period)
         except Exception as exc:  # a bug in the engine itself: end the run, keep the app
             reason, message = "error", f"{type(exc).__name__}: {exc}"
-        if status is RUNNING or reason != "finished":
-            self._halt_all()
+        try:
+            if status is RUNNING or reason != "finished":
+                self._halt_all()
+        finally:
+            if self._lockstep is not None:
+                self._release(self._lockstep)
         self._finish(status, reason, message)
+
+    def _release(self, lockstep: Lockstep) -> None:
+        try:
+            lockstep.release()
+        except Exception as exc:  # a closed cell: nothing to release
+            self._dispatcher.put(
+                LogMessage(0, "root", f"error ending the lockstep: {exc}", time.monotonic())
+            )
 
     @property
     def held(self) -> str:
@@ -352,9 +391,10 @@ def run_to_end(
     rate_hz: float = 20.0,
     timeout: float | None = None,
     listeners: list[Listener] | None = None,
+    lockstep: Lockstep | None = None,
 ) -> RunFinished:
     """Run a tree in an executor until it finishes or ``timeout`` seconds pass."""
-    executor = Executor(tree, rate_hz, listeners)
+    executor = Executor(tree, rate_hz, listeners, lockstep=lockstep)
     executor.start()
     result = executor.wait(timeout)
     if result is None:

@@ -4,20 +4,20 @@
 searches only the part of the image where the region (grown by the object's size) can
 appear: the crop is an exact change of the principal point, so poses are unchanged, and a
 crop of a fifth of the image is detected about five times faster, which is most of the
-latency of a handoff. :class:`HandoffJob` polls a camera at a fixed interval of the cell's
-clock on its own thread until the object is seen inside the region and still.
+latency of a handoff. :class:`HandoffJob` looks at a camera at a fixed interval of the cell's
+clock until the object is seen inside the region and still.
 """
 
 from __future__ import annotations
 
 import math
-import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from capabilities.jobs import WorkerPool
 from capabilities.markers.backend import CameraDevice, FrameLike
 from capabilities.markers.depth import refine_with_depth
 from capabilities.markers.detection import (
@@ -28,6 +28,7 @@ from capabilities.markers.detection import (
 from capabilities.world_model import Detection, WorldModel
 from engine.error_types import ErrorType
 from engine.operations import Job
+from engine.status import RUNNING, SUCCESS, Status
 from engine.types import Pose, Region
 
 __all__ = [
@@ -44,8 +45,6 @@ __all__ = [
 MIN_CONFIDENCE = 0.05
 # Pixels added around the projected region: marker corners near the crop edge get lost.
 CROP_MARGIN_PX = 12
-# The poll thread checks the cell's clock this often (wall seconds) while it waits.
-WAIT_SLICE_S = 0.002
 
 
 @dataclass(frozen=True)
@@ -143,10 +142,13 @@ class HandoffSettings:
 
 
 class HandoffJob(Job):
-    """Watches a camera on its own thread until the object lies still inside the region.
+    """Watches a camera until the object lies still inside the region.
 
-    A dedicated thread, not the cell's worker pool: a handoff may be awaited for minutes and
-    would hold one of the pool's few threads all that time.
+    Polled by the engine at every tick: once a frame is due (every ``interval`` of the
+    cell's clock) it is taken and searched on the cell's worker pool, one at a time, and
+    what it shows is weighed here, on the engine's thread. A handoff may be awaited for
+    minutes without holding a pool thread between frames, and a simulated cell in lockstep
+    sees every frame at the same tick however busy the machine is.
 
     On success the output is ``pose`` (the object's detected pose); ``decided`` holds the
     frame's cell time. Every frame's sighting replaces what the source said before in the
@@ -161,58 +163,71 @@ class HandoffJob(Job):
         world: WorldModel,
         clock: Callable[[], float],
         settings: HandoffSettings,
+        workers: WorkerPool,
         log: Callable[[str], None] = lambda _text: None,
     ) -> None:
-        self._stop = threading.Event()
-        super().__init__(on_cancel=self._stop.set)
+        super().__init__(on_cancel=self._cancel_frame)
         self._camera, self._target, self._region = camera, target, region
         self._world, self._clock, self._settings, self._log = world, clock, settings, log
+        self._workers = workers
         self.source = f"collaboration:{camera.name}"
         self.frames = 0
         self.decided: float | None = None
-        self._thread = threading.Thread(target=self._run, name="costar-handoff", daemon=True)
-        self._thread.start()
+        self._start = clock()
+        self._next_frame = self._start
+        self._frame: Job | None = None  # the frame being taken and searched
+        self._since: Detection | None = None  # first sighting of the current still stretch
 
-    def _run(self) -> None:
-        try:
-            self._watch()
-        except Exception as exc:  # a camera or perception failure fails the node, not the engine
-            self.fail(f"watching for {self._target.name}: {type(exc).__name__}: {exc}")
+    def poll(self) -> Status:
+        if not self.finished:
+            try:
+                self._watch()
+            except Exception as exc:  # a camera or perception failure fails the node
+                self.fail(f"watching for {self._target.name}: {type(exc).__name__}: {exc}")
+        return super().poll()
 
     def _watch(self) -> None:
+        frame = self._frame
+        if frame is not None:
+            if frame.poll() is RUNNING:
+                return
+            self._frame = None
+            if frame.poll() is not SUCCESS:
+                self.fail(f"watching for {self._target.name}: {frame.message}", frame.error)
+                return
+            if self._weigh(frame.outputs.get("seen")):
+                return
         settings = self._settings
-        start = self._clock()
-        since: Detection | None = None  # first sighting of the current still stretch
-        next_frame = start
-        while not self._stop.is_set():
-            self._wait_until(next_frame)
-            if self._stop.is_set():
-                return
-            next_frame = self._clock() + settings.interval
-            frame = self._camera.capture()
-            self.frames += 1
-            seen = find_object(frame, self._target, self.source, self._region)
-            self._world.replace(self.source, [seen] if seen is not None else [])
-            since = self._still_since(since, seen)
-            if (
-                seen is not None
-                and since is not None
-                and seen.stamp - since.stamp >= settings.settle
-            ):
-                self._log(
-                    f"{self._target.name} handed over at {_xyz(seen.pose)} "
-                    f"(frame at {seen.stamp:.2f} s)"
-                )
-                self.decided = seen.stamp
-                self.succeed(outputs={"pose": seen.pose})
-                return
-            if settings.timeout > 0 and self._clock() - start >= settings.timeout:
-                self.fail(
-                    f"timed out: no {self._target.name} put down in the region "
-                    f"within {settings.timeout:g} s",
-                    ErrorType.TIMEOUT,
-                )
-                return
+        now = self._clock()
+        if settings.timeout > 0 and now - self._start >= settings.timeout:
+            self.fail(
+                f"timed out: no {self._target.name} put down in the region "
+                f"within {settings.timeout:g} s",
+                ErrorType.TIMEOUT,
+            )
+        elif now >= self._next_frame:
+            self._next_frame = now + settings.interval
+            what = f"watching for {self._target.name} ({self._camera.name} camera)"
+            self._frame = self._workers.submit(self._look, what)
+
+    def _look(self) -> dict[str, Detection | None]:
+        """On a pool thread: a frame, searched where the region appears."""
+        frame = self._camera.capture()
+        self.frames += 1
+        return {"seen": find_object(frame, self._target, self.source, self._region)}
+
+    def _weigh(self, seen: Detection | None) -> bool:
+        """What a frame showed; True when the object was put down (the job succeeded)."""
+        self._world.replace(self.source, [seen] if seen is not None else [])
+        self._since = since = self._still_since(self._since, seen)
+        if seen is None or since is None or seen.stamp - since.stamp < self._settings.settle:
+            return False
+        self._log(
+            f"{self._target.name} handed over at {_xyz(seen.pose)} (frame at {seen.stamp:.2f} s)"
+        )
+        self.decided = seen.stamp
+        self.succeed(outputs={"pose": seen.pose})
+        return True
 
     def _still_since(self, since: Detection | None, seen: Detection | None) -> Detection | None:
         if seen is None or not in_region(seen.pose, self._region):
@@ -222,19 +237,10 @@ class HandoffJob(Job):
         moved = math.dist(seen.pose.position, since.pose.position)
         return since if moved <= self._settings.still_tolerance else seen
 
-    def _wait_until(self, cell_time: float) -> None:
-        # The cell's clock may run faster or slower than the wall clock: watch it in slices.
-        while self._clock() < cell_time and not self._stop.wait(WAIT_SLICE_S):
-            pass
-
-    @property
-    def watching(self) -> bool:
-        """True while the poll thread runs."""
-        return self._thread.is_alive()
-
-    def join(self, timeout: float | None = None) -> None:
-        """Wait for the poll thread to end (tests; after cancel or finish)."""
-        self._thread.join(timeout)
+    def _cancel_frame(self) -> None:
+        frame = self._frame
+        if frame is not None:
+            frame.cancel()
 
 
 def _xyz(pose: Pose) -> str:

@@ -255,7 +255,8 @@ class WaitForHandoff:
             timeout=_seconds(call, TIMEOUT),
         )
         where = call.input(REGION)
-        return HandoffJob(device, target, where, world, call.clock, settings, call.log)
+        workers = _interface(self._env, "workers", what)
+        return HandoffJob(device, target, where, world, call.clock, settings, workers, call.log)
 
 
 def latest(world: WorldModel, name: str) -> Detection | None:

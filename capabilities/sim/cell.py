@@ -13,8 +13,8 @@ Example::
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
-from contextlib import AbstractContextManager, contextmanager
+from collections.abc import Callable
+from contextlib import AbstractContextManager
 from pathlib import Path
 from typing import Self, TypeVar
 
@@ -22,6 +22,7 @@ import numpy as np
 
 from capabilities.bullet import pybullet
 from capabilities.cell_features import ClosesOnExit
+from capabilities.jobs import JobEnd, JobPacing
 from capabilities.robot.cell_file import DEFAULT_CONFIG_PATH, CellConfig
 from capabilities.robot.kinematics import UR5Kinematics
 from capabilities.sim.arm_controller import ArmController
@@ -60,10 +61,16 @@ class SimCell(ClosesOnExit):
         driven: step only while a command runs or a thread waits for simulated time
             (``PhysicsThread.waited_on``): what happens no longer depends on how long the
             thread that drives the cell takes between two commands (tests).
+        still: the world stands still from its start until a run's executor drives it
+            (:meth:`advance`) or :meth:`release` lets it go (``PhysicsThread``'s ``still``).
     """
 
     def __init__(
-        self, config: CellConfig | None = None, speed: float | None = None, driven: bool = False
+        self,
+        config: CellConfig | None = None,
+        speed: float | None = None,
+        driven: bool = False,
+        still: bool = False,
     ) -> None:
         if config is None:
             config = (
@@ -73,7 +80,7 @@ class SimCell(ClosesOnExit):
             )
         self.config = config
         self.kinematics = UR5Kinematics(config.robot_base)
-        self._physics = PhysicsThread(self._build, speed, TIME_STEP)
+        self._physics = PhysicsThread(self._build, speed, TIME_STEP, still)
         if driven:
             self._physics.add_gate(self._physics.waited_on)
         self._tcp_matrices = {k: pose_to_matrix(v) for k, v in config.tcp_offsets.items()}
@@ -163,18 +170,27 @@ class SimCell(ClosesOnExit):
         """
         return self._physics.sharing()
 
-    @contextmanager
-    def perceiving(self, latency: float) -> Iterator[None]:
-        """A perception job in lockstep (another thread): simulated time stands still while
-        the block runs, then goes on until ``latency`` simulated seconds have passed since it
-        began (so that perception polled without pause still lets time pass).
+    def job_pacing(self, latency: float | None) -> JobPacing:
+        """How the world goes on while a job (perception) computes on another thread.
+
+        None: it goes on, sharing the GIL with the job every step. A number (lockstep): it
+        stands still from the tick that began the job until the job is done, and the job's
+        result is handed over ``latency`` simulated seconds after it began (perception
+        polled without pause still lets time pass), on the physics thread: a run sees the
+        same results at the same ticks however busy the machine is.
         """
-        started = self.time()
-        with self._physics.standing_still():
-            yield
-        left = started + latency - self.time()
-        if left > 0 and not self._physics.wait_sim(left, timeout=max(60.0, left * 10)):
-            raise SimError(f"simulated time did not advance by {left:.3f} s")
+        if latency is None:
+            return _SharingPacing(self._physics)
+        return _LockstepPacing(self._physics, latency)
+
+    def advance(self, seconds: float) -> None:
+        """Lockstep with an engine: step the world ``seconds`` further, then stand still."""
+        if not self._physics.advance(seconds, timeout=max(60.0, seconds * 100)):
+            raise SimError(f"simulated time did not advance by {seconds} s")
+
+    def release(self) -> None:
+        """End the lockstep of :meth:`advance`: the world runs free again."""
+        self._physics.release()
 
     def add_gate(self, may_step: Callable[[], bool]) -> None:
         """Step only while ``may_step()`` says True (see ``PhysicsThread.add_gate``)."""
@@ -276,3 +292,39 @@ class SimCell(ClosesOnExit):
         )
         physics.add_hooks(pre=suction.pre_step, may_rest=True)
         physics.add_rest_check(lambda: self._still(client))
+
+
+class _SharingPacing:
+    """The world goes on while a job computes, handing it the GIL every step."""
+
+    def __init__(self, physics: PhysicsThread) -> None:
+        self._physics = physics
+
+    def begin(self) -> JobEnd:
+        block = self._physics.sharing()
+        block.__enter__()
+
+        def end(deliver: Callable[[], None]) -> None:
+            block.__exit__(None, None, None)
+            deliver()
+
+        return end
+
+
+class _LockstepPacing:
+    """The world stands still from a job's start; its result comes ``latency`` later."""
+
+    def __init__(self, physics: PhysicsThread, latency: float) -> None:
+        self._physics = physics
+        self._latency = latency
+
+    def begin(self) -> JobEnd:
+        release = self._physics.hold()
+        started = self._physics.time()
+
+        def end(deliver: Callable[[], None]) -> None:
+            # Scheduled before the world may step again: it cannot be late.
+            self._physics.at(started + self._latency, deliver)
+            release()
+
+        return end

@@ -10,6 +10,13 @@ computes in Python: perception). Inside :meth:`PhysicsThread.standing_still` (lo
 perception computing on another thread) the world is not stepped and simulated time stands
 still, as it already does while a call (a camera render) is served.
 
+In lockstep (:meth:`PhysicsThread.advance`, a run's executor drives it): the world steps only as far as
+the engine's clock lets it, one tick's period at a time, and stands still in between while
+the engine ticks; :meth:`PhysicsThread.release` lets it run free again. A job that began at a
+tick holds the world from that tick (:meth:`PhysicsThread.hold`) and hands its result over at
+a set simulated time (:meth:`PhysicsThread.at`), on this thread: what the engine sees at
+each tick does not depend on how busy the machine is.
+
 At rest: a loop paced against the wall clock stops stepping once nothing has moved for
 ``REST_AFTER_S`` of simulated time (every rest check the cell registered says so: all bodies
 and joints slower than a crawl, no command under way), no command is in flight, no thread
@@ -60,6 +67,9 @@ class PhysicsThread:
             (builds the world); an exception there makes ``start`` raise.
         speed: real-time factor (1.0 real time); None runs as fast as possible.
         time_step: seconds per physics step (1/240 by default).
+        still: the world stands still once built, as between two :meth:`advance` calls,
+            until the first advance or :meth:`release` (a run in lockstep then begins at
+            simulated time 0, however long its set-up took).
     """
 
     def __init__(
@@ -67,6 +77,7 @@ class PhysicsThread:
         setup: Callable[[int], None],
         speed: float | None = None,
         time_step: float = 1.0 / 240.0,
+        still: bool = False,
     ) -> None:
         if speed is not None and not speed > 0:
             raise SimError(f"speed must be above 0 or None, got {speed}")
@@ -81,13 +92,18 @@ class PhysicsThread:
         self._serving_s = 0.0  # wall seconds spent running posted calls (not simulated time)
         self._pre_hooks: list[StepHook] = []
         self._post_hooks: list[StepHook] = []
-        self._timers: list[tuple[float, int, threading.Event]] = []
+        # (simulated time, order, what to run then, run it also when the cell closes): the
+        # events of threads waiting for simulated time, and results handed over at a time.
+        self._timers: list[tuple[float, int, Callable[[], None], bool]] = []
         self._timer_ids = itertools.count()
         self._timer_lock = threading.Lock()
         self._holds = 0  # blocks in standing_still: while above 0 the world is not stepped
         self._hold_lock = threading.Lock()
         self._sharers = 0  # blocks in sharing: while above 0 the GIL is handed over every step
         self._in_flight = 0  # commands posted and not finished (see waited_on)
+        self._lockstep = still  # in lockstep with an engine: step only within the budget
+        self._budget = 0  # steps the engine's clock still allows (driven)
+        self._budget_spent = threading.Event()
         self._gates: list[Callable[[], bool]] = []  # all must say True for a step
         self._rest_checks: list[Callable[[], bool]] = []  # all must say True for a rest
         self._restless: list[StepHook] = []  # hooks that may act by themselves: no rest
@@ -199,9 +215,68 @@ class PhysicsThread:
         if self.in_thread():
             raise SimError("wait_sim would block the physics thread")
         event = threading.Event()
-        with self._timer_lock:
-            heapq.heappush(self._timers, (self._time + seconds, next(self._timer_ids), event))
+        self._schedule(self._time + seconds, event.set, on_close=True)
         return event.wait(timeout)
+
+    def at(self, when: float, fn: Callable[[], None]) -> None:
+        """Run ``fn()`` on this thread once simulated time reaches ``when`` (at the next step
+        boundary when it already has); dropped when the cell closes first.
+        """
+        self._schedule(when, fn, on_close=False)
+        self.nudge()
+
+    def _schedule(self, when: float, fn: Callable[[], None], on_close: bool) -> None:
+        with self._timer_lock:
+            heapq.heappush(self._timers, (when, next(self._timer_ids), fn, on_close))
+
+    def advance(self, seconds: float, timeout: float | None = None) -> bool:
+        """Lockstep with an engine: let the world step ``seconds`` further (whole steps, at
+        least one) and return once it has; until then, and from then until the next call,
+        it stands still (calls are served). False on a wall-clock timeout.
+        """
+        if self.in_thread():
+            raise SimError("advance would block the physics thread")
+        steps = max(1, round(seconds / self.time_step))
+        with self._hold_lock:
+            self._lockstep = True
+            self._budget += steps
+            self._budget_spent.clear()
+        self.nudge()
+        return self._budget_spent.wait(timeout)
+
+    def release(self) -> None:
+        """End the lockstep of :meth:`advance`: the world runs free again."""
+        with self._hold_lock:
+            self._lockstep = False
+            self._budget = 0
+            self._budget_spent.set()
+        self.nudge()
+
+    def hold(self) -> Callable[[], None]:
+        """Stand the world still from now until the returned release is called (once, from
+        any thread): the start of a job that must see the world as at the tick that began
+        it. See :meth:`standing_still` for a block.
+        """
+        if self.in_thread():
+            raise SimError("hold is for other threads than the physics thread")
+        with self._hold_lock:
+            self._holds += 1
+        # A step already under way when the hold began would still advance the clock: a
+        # call served after it means the loop has seen the hold.
+        if self.running:
+            with contextlib.suppress(SimError):
+                self.call(lambda _client: None)
+        released = threading.Event()
+
+        def release() -> None:
+            if released.is_set():
+                return
+            released.set()
+            with self._hold_lock:
+                self._holds -= 1
+            self.nudge()  # wake a loop waiting on calls
+
+        return release
 
     @contextmanager
     def standing_still(self) -> Iterator[None]:
@@ -212,19 +287,11 @@ class PhysicsThread:
         """
         if self.in_thread():
             raise SimError("standing_still is for other threads than the physics thread")
-        with self._hold_lock:
-            self._holds += 1
+        release = self.hold()
         try:
-            # A step already under way when the hold began would still advance the clock
-            # inside the block: a call served after it means the loop has seen the hold.
-            if self.running:
-                with contextlib.suppress(SimError):
-                    self.call(lambda _client: None)
             yield
         finally:
-            with self._hold_lock:
-                self._holds -= 1
-            self.nudge()  # wake a loop waiting on calls
+            release()
 
     @contextmanager
     def sharing(self) -> Iterator[None]:
@@ -297,13 +364,19 @@ class PhysicsThread:
         yielded = wall_start
         while not self._stopping.is_set():
             self._drain()
-            if self._holds or not all(gate() for gate in self._gates):
+            if (
+                self._holds
+                or (self._lockstep and self._budget <= 0)
+                or not all(gate() for gate in self._gates)
+            ):
                 self._stand_still()
                 continue
             if self.speed is not None and self._may_rest():
                 self._rest(wall_start, sim_start)
                 continue
             self._step_once()
+            if self._lockstep:
+                self._spend_step()
             if self.speed is not None:
                 # Time spent serving calls (a camera frame takes 30-300 ms to render) does
                 # not pass in the simulated world, as a real camera renders while the world
@@ -410,6 +483,12 @@ class PhysicsThread:
         self._run_hooks(self._post_hooks)
         self._fire_timers()
 
+    def _spend_step(self) -> None:
+        with self._hold_lock:
+            self._budget -= 1
+            if self._budget <= 0:
+                self._budget_spent.set()
+
     def _run_hooks(self, hooks: list[StepHook]) -> None:
         for hook in hooks:
             try:
@@ -420,9 +499,15 @@ class PhysicsThread:
     def _fire_timers(self) -> None:
         if not self._timers:
             return
+        due = []
         with self._timer_lock:
             while self._timers and self._timers[0][0] <= self._time + 1e-9:
-                heapq.heappop(self._timers)[2].set()
+                due.append(heapq.heappop(self._timers)[2])
+        for fn in due:  # outside the lock: a handed-over result may schedule another
+            try:
+                fn()
+            except Exception:
+                _log.exception("timer %r raised", fn)
 
     def _fail_pending(self) -> None:
         while True:
@@ -433,9 +518,11 @@ class PhysicsThread:
             if item is not None and item[1].set_running_or_notify_cancel():
                 item[1].set_exception(SimError("the simulated cell was closed"))
         with self._timer_lock:
-            for _, _, event in self._timers:
-                event.set()
+            closing = [fn for _, _, fn, on_close in self._timers if on_close]
             self._timers.clear()
+        for fn in closing:  # waiters wake (their wait says the time did not come)
+            fn()
+        self._budget_spent.set()
 
     def _disconnect(self) -> None:
         if self.client >= 0:

@@ -48,6 +48,7 @@ from capabilities.sim.mirror_state import take_snapshot
 from capabilities.sim.scene import SceneState, default_scene_path, load_scene, yaw_pose
 from capabilities.sim.worker import SimWorker, install_scene_worker
 from capabilities.world_model import WorldModel
+from engine.executor import Lockstep
 from engine.types import Pose
 
 __all__ = ["PERCEPTION_S", "SimCameraDevice", "SimCellSession"]
@@ -161,10 +162,15 @@ class SimCellSession(ClosesOnExit):
             that setting up the run costs no simulated time of theirs).
         lockstep: None: off (the world goes on while perception computes). A number: the
             simulated seconds each job of the worker pool (perception) takes: simulated time
-            stands still while it computes, as it does while a camera renders, then goes on
-            for the rest of that time before the job finishes. A run as fast as possible
-            (long trials, benches) then sees the world as its plan asks however loaded the
-            machine, and a plan that polls perception without pause still lets time pass.
+            stands still from the tick that began it until it is done, as it does while a
+            camera renders, and its result comes that long after it began. A run's executor
+            then also drives the world (:meth:`run_lockstep`): it goes on one tick's period
+            after each tick. A run as fast as possible (the CLI, tests, benches) then sees
+            the world as its plan asks however loaded the machine, and a plan that polls
+            perception without pause still lets time pass.
+        still_until_run: in lockstep, the world stands still from the start until a run's
+            executor drives it, so that the run begins at simulated time 0 whatever its
+            set-up took (the CLI's runs); else it goes on by itself until then.
     """
 
     name = "sim"
@@ -180,14 +186,14 @@ class SimCellSession(ClosesOnExit):
         faults: FaultModel | None = None,
         start_actors: bool = True,
         lockstep: float | None = None,
+        still_until_run: bool = False,
     ) -> None:
-        self.sim = SimCell(config, speed)
+        self.sim = SimCell(config, speed, still=still_until_run and lockstep is not None)
         self.world_model = WorldModel()
-        latency = lockstep
+        self._lockstep = lockstep
         # Perception computes while the world stands still (lockstep) or shares the GIL
         # with it every step (else it crawls beside a cell that steps as fast as it can).
-        around = self.sim.sharing if latency is None else (lambda: self.sim.perceiving(latency))
-        self.workers = WorkerPool(2, "costar-sim-worker", around)
+        self.workers = WorkerPool(2, "costar-sim-worker", self.sim.job_pacing(lockstep))
         self.operator = OperatorConsole()
         self.worker: SimWorker | None = None  # the simulated person, if the scene has one
         self.live_view: LiveView | None = None  # live pictures (a mirror per camera)
@@ -344,6 +350,10 @@ class SimCellSession(ClosesOnExit):
 
     def clock(self) -> float:
         return self.sim.time()
+
+    def run_lockstep(self) -> Lockstep | None:
+        """The simulated cell, for a run's executor to drive, when this session is in lockstep."""
+        return self.sim if self._lockstep is not None else None
 
     # ---------------------------------------------------------------- safety
 

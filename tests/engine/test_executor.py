@@ -79,6 +79,46 @@ def test_the_executor_ticks_at_its_rate_when_nothing_wakes_it() -> None:
     assert (result.status, result.tick, node.updates) == (SUCCESS, 3, 3)
 
 
+class CountingWorld:
+    """A lockstep that counts how far the engine let its world go, and when it was released."""
+
+    def __init__(self, on_advance: Any = None) -> None:
+        self.advanced: list[float] = []
+        self.released = 0
+        self.on_advance = on_advance
+
+    def advance(self, seconds: float) -> None:
+        self.advanced.append(seconds)
+        if self.on_advance is not None:
+            self.on_advance(len(self.advanced))
+
+    def release(self) -> None:
+        self.released += 1
+
+
+def test_in_lockstep_each_tick_lets_the_world_go_one_period_and_ends_released() -> None:
+    ctx = TreeContext()
+    node = ScriptedLeaf(ctx, "a", RUNNING, RUNNING, SUCCESS)
+    world = CountingWorld()
+    # At 0.001 Hz the wall clock would bring the second tick after 1000 s: the world's does.
+    result = run_to_end(rooted(ctx, node), rate_hz=0.001, timeout=30.0, lockstep=world)
+    assert (result.status, result.tick, node.updates) == (SUCCESS, 3, 3)
+    assert world.advanced == [1000.0, 1000.0]  # after the two ticks that left it running
+    assert world.released == 1
+
+
+def test_in_lockstep_a_job_that_ends_while_the_world_goes_on_is_seen_at_the_next_tick() -> None:
+    ctx = TreeContext()
+    work = JobOperation()
+    tree = rooted(ctx, leaf(ctx, work, "move"))
+    # The job ends (as a motion does, on the physics thread) while the world goes its one
+    # period after tick 1: tick 2 sees it, and the world went on just once.
+    world = CountingWorld(on_advance=lambda n: work.job.succeed() if n == 1 else None)
+    result = run_to_end(tree, rate_hz=20.0, timeout=30.0, lockstep=world)
+    assert result.status is SUCCESS and result.tick == 2
+    assert world.advanced == [0.05] and world.released == 1
+
+
 # ---------------------------------------------------------------------- control
 
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import threading
+import time
 from pathlib import Path
 from typing import Any
 
@@ -128,7 +129,7 @@ def test_an_object_seen_elsewhere_is_not_in_the_region_and_no_handoff_there(
         assert tree.root.message.startswith("timed out")
 
 
-def test_halting_the_wait_stops_its_camera_thread(tmp_path: Path) -> None:
+def test_halting_the_wait_takes_no_more_frames(tmp_path: Path) -> None:
     with SimCellSession("cup_to_bin", 0, speed=None) as session:
         library = session.scene.library
         frames = threading.Event()
@@ -142,12 +143,18 @@ def test_halting_the_wait_stops_its_camera_thread(tmp_path: Path) -> None:
 
         job = HandoffJob(CountingCamera(), object_markers(library.get("kit_bin")),  # type: ignore[arg-type]  # a duck-typed camera
                          HANDOFF_AREA, session.world_model, session.clock,
-                         HandoffSettings())  # fmt: skip
-        assert frames.wait(DEADLINE)
+                         HandoffSettings(), session.workers)  # fmt: skip
+        deadline = time.monotonic() + DEADLINE
+        while not frames.is_set() and time.monotonic() < deadline:
+            assert job.poll() is Status.RUNNING  # the engine polls it at every tick
+            time.sleep(0.01)
+        assert frames.is_set()
         job.cancel()
-        job.join(DEADLINE)
-        assert job.poll() is Status.FAILURE and job.message == "halted"
-        assert not job.watching
+        taken = job.frames
+        for _ in range(20):
+            assert job.poll() is Status.FAILURE and job.message == "halted"
+            session.sim.wait_sim(0.2)
+        assert job.frames <= taken + 1  # at most the frame under way when it was halted
 
 
 def test_searching_only_the_regions_part_of_the_image_finds_the_same_pose() -> None:

@@ -7,11 +7,11 @@ from __future__ import annotations
 
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 import pytest
 
-from capabilities.jobs import WorkerPool
+from capabilities.jobs import JobEnd, WorkerPool
 from capabilities.robot.commands import CommandHandle
 from capabilities.sim.errors import SimError
 from capabilities.sim.physics_thread import PhysicsThread
@@ -58,8 +58,24 @@ def test_blocks_of_several_threads_overlap(physics: PhysicsThread) -> None:
     assert physics.wait_sim(0.05, timeout=10.0)
 
 
+class _Holding:
+    """A pacing that holds the world from a job's start until its end."""
+
+    def __init__(self, physics: PhysicsThread) -> None:
+        self.physics = physics
+
+    def begin(self) -> JobEnd:
+        release = self.physics.hold()
+
+        def end(deliver: Callable[[], None]) -> None:
+            release()
+            deliver()
+
+        return end
+
+
 def test_a_lockstep_pool_holds_the_clock_while_a_job_runs(physics: PhysicsThread) -> None:
-    pool = WorkerPool(1, "test-lockstep", around=physics.standing_still)
+    pool = WorkerPool(1, "test-lockstep", pacing=_Holding(physics))
     seen: list[float] = []
 
     def perceive() -> dict[str, float]:
@@ -156,3 +172,40 @@ def test_a_shared_block_lets_the_world_go_on(physics: PhysicsThread) -> None:
     """Unlike standing still, sharing the GIL does not stop simulated time."""
     with physics.sharing():
         assert physics.wait_sim(0.05, timeout=10.0)
+
+
+def test_a_world_driven_by_an_engine_steps_one_period_per_advance(physics: PhysicsThread) -> None:
+    """Lockstep: each advance is whole steps, and between two the world stands still."""
+    start = physics.steps
+    assert physics.advance(0.05, timeout=10.0)
+    assert physics.steps - start == 12  # 0.05 s of 1/240 s steps
+    time.sleep(0.2)  # an engine that takes long over its tick
+    assert physics.steps - start == 12
+    assert physics.call(lambda client: client) == physics.client  # calls are still served
+    for _ in range(3):
+        assert physics.advance(0.05, timeout=10.0)
+    assert physics.steps - start == 48
+    physics.release()
+    assert physics.wait_sim(0.05, timeout=10.0)  # free again
+    assert physics.steps - start > 48
+
+
+def test_a_lockstep_job_s_result_comes_at_its_simulated_time_however_long_it_took() -> None:
+    """The world stands still from the tick that began the job; its result is handed over
+    on the physics thread once the latency has passed, so a driven run sees it at the same
+    tick whether it took 10 ms or 300 ms of wall time.
+    """
+    with SimCellSession("empty", 0, lockstep=0.1) as session:
+        ticks_seen = []
+        for work_s in (0.01, 0.3):
+            session.sim.advance(0.05)
+            job = session.workers.submit(lambda w=work_s: time.sleep(w) or {})
+            begun = session.clock()
+            ticks = 0
+            while job.poll() is RUNNING:
+                session.sim.advance(0.05)  # what the executor does after each tick
+                ticks += 1
+            ticks_seen.append(ticks)
+            assert session.clock() == pytest.approx(begun + 0.1, abs=0.05 + 1e-9)
+        session.sim.release()
+        assert ticks_seen[0] == ticks_seen[1] == 2
