@@ -142,6 +142,9 @@ def test_a_live_feed_gets_the_frame_it_asked_for_ahead_but_never_a_stale_one(
     home = arm.joint_positions()
     # The arm turns slowly all along: a frame asked for ahead shows another view.
     moving = arm.move_joints((home[0] + 1.0, *home[1:]), speed=0.05)
+    # A frame asked for ahead goes stale after STALE_AFTER wall seconds: on a loaded machine
+    # the calls below may be that far apart, and the stale case is tried on purpose below.
+    monkeypatch.setattr(live_view, "STALE_AFTER", 60.0)
     try:
         cell.sim.wait_sim(0.1)
         device.preview(SIZE, ahead=True)  # the mirror renders the next frame meanwhile
