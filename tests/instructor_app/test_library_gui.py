@@ -352,3 +352,19 @@ def test_a_saved_selection_is_an_instance_named_by_its_subtree_and_logs_name_its
     said = [line for line in window.views.log.lines() if line.endswith("hello")]
     assert said and all("greet" in line and "say" in line for line in said), said
     assert not any(instance.id in line for line in window.views.log.lines())
+
+
+# ---------------------------------------------------------------------- pick and place (issue 26)
+
+
+def test_the_shipped_pick_and_place_are_in_the_library_and_the_palette(
+    qtbot: Any, window: MainWindow
+) -> None:
+    panel = window.views.library
+    assert {"Pick", "Place"} <= set(panel.visible_names())
+    panel.select("Pick")
+    text = panel.preview.toPlainText()
+    assert "OBJECT: ObjectModel" in text and "gripper.grasp" in text
+    qtbot.keyClicks(window.views.palette.search_field, "place")
+    hit = window.views.palette.current_hit()
+    assert hit is not None and hit.op == "pick_place.place"
