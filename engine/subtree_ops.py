@@ -43,6 +43,7 @@ __all__ = [
     "Usage",
     "detach",
     "find_usages",
+    "instance_name",
     "instance_of",
     "make_subtree",
     "names_used",
@@ -169,6 +170,21 @@ def make_subtree(
         inputs=inputs,
         outputs=declared_outputs,
     )
+
+
+def instance_name(subtree: SubtreeSpec, params: Mapping[str, Binding]) -> str:
+    """What an instance is called until someone names it: the subtree's name and the object
+    or waypoint its first input is given ("Pick cup", "Place over bin"), else the name alone.
+    """
+    first = subtree.inputs[0].name if subtree.inputs else None
+    binding = params.get(first) if first is not None else None
+    if binding is None or binding.is_ref or binding.type not in _NAMING_TYPES:
+        return subtree.name
+    thing = getattr(binding.value, "name", "")
+    return f"{subtree.name} {thing}" if thing else subtree.name
+
+
+_NAMING_TYPES = (ParamType.OBJECT, ParamType.WAYPOINT)
 
 
 def instance_of(

@@ -26,8 +26,9 @@ from PySide6.QtGui import QAction
 from PySide6.QtWidgets import QDialog, QFileDialog, QMenu, QWidget
 
 from engine.library import Library, LibraryEntry, LibraryError
-from engine.spec import NodeKind, NodeSpec, SubtreeSpec
+from engine.spec import Binding, NodeKind, NodeSpec, SubtreeSpec
 from engine.subtree_ops import Usage, find_usages, ports_of
+from engine.types import ObjectModel, ParamType
 from instructor_app.document.editing import PlanDocument
 from instructor_app.document.model import DocumentError
 from instructor_app.document.subtree_edits import SubtreeEditor
@@ -143,8 +144,20 @@ class LibraryController(QObject):
         self.views.canvas.select(node_id)
         return node_id
 
-    def _insert_under(self, subtree_id: str, parent_id: str | None) -> str:
-        return self.editor.insert_instance(self.subtree(subtree_id), parent_id)
+    def _insert_under(
+        self, subtree_id: str, parent_id: str | None, object_name: str | None = None
+    ) -> str:
+        """An instance dropped on the canvas; an object model dropped with it (dragged from
+        the Objects panel) is given to its first object input, and names it ("Pick cup").
+        """
+        subtree = self.subtree(subtree_id)
+        params: dict[str, Binding] = {}
+        if object_name:
+            port = next((p for p in subtree.inputs if p.type is ParamType.OBJECT), None)
+            if port is None:
+                raise DocumentError(f"{subtree.name} takes no object")
+            params[port.name] = Binding.fixed(ObjectModel(object_name), ParamType.OBJECT)
+        return self.editor.insert_instance(subtree, parent_id, params=params)
 
     def save_as_subtree(self, node_id: str, choices: SubtreeChoices) -> bool:
         """Save a node and those below it to the library, off the GUI thread; once saved, an

@@ -18,6 +18,7 @@ from instructor_app.errors import InstructorError
 
 __all__ = [
     "PALETTE_MIME",
+    "PICK_SUBTREE",
     "LOGIC_GROUPS",
     "NodeFactoryError",
     "PaletteItem",
@@ -28,9 +29,13 @@ __all__ = [
     "item_from_mime",
     "readable",
     "manifest_or_none",
+    "pick_payload",
 ]
 
 PALETTE_MIME = "application/x-costar-palette-item"
+# The shipped Pick subtree (resources/library/pick_place): an object model dragged onto the
+# canvas becomes an instance of it with the object as its input ("Pick cup").
+PICK_SUBTREE = "pick_place.pick"
 
 # Group titles of the logic kinds, in the order the palette shows them.
 LOGIC_GROUPS: dict[Category, str] = {
@@ -146,6 +151,13 @@ def make_node(item: PaletteItem, manifest: OperationManifest | None = None) -> N
         if port.required and item.kind in _START_VALUES
     }
     return NodeSpec(item.kind, name=item.label, params=params)
+
+
+def pick_payload(object_name: str) -> dict[str, Any]:
+    """The drag data of an object model: a Pick of that object (``"object"`` names it; the
+    library binds it to the subtree's first object input).
+    """
+    return {"kind": NodeKind.SUBTREE.value, "op": PICK_SUBTREE, "object": object_name}
 
 
 def item_from_payload(payload: Any, registry: OperationSource) -> PaletteItem:

@@ -82,8 +82,9 @@ class CanvasView(QWidget):
 
     # ------------------------------------------------------------------ public API
 
-    # (subtree id, parent id or None) -> the new instance's id; set by the library's wiring.
-    instance_inserter: Callable[[str, str | None], str] | None = None
+    # (subtree id, parent id or None, object model name or None) -> the new instance's id;
+    # set by the library's wiring.
+    instance_inserter: Callable[[str, str | None, str | None], str] | None = None
 
     def set_node_factory(self, factory: NodeFactory | None) -> None:
         """How palette drops and "Add child" make nodes: ``factory(kind, op) -> NodeSpec``."""
@@ -322,7 +323,8 @@ class CanvasView(QWidget):
             data = json.loads(bytes(mime.data(PALETTE_MIME).data()).decode("utf-8"))
             kind = NodeKind(data["kind"])
             op = data.get("op")
-        except (ValueError, KeyError, TypeError) as exc:
+            dropped_object = data.get("object")  # an object model dragged: Pick it
+        except (ValueError, KeyError, TypeError, AttributeError) as exc:
             self.message.emit(f"cannot drop this item: {exc}")
             return
         target = self.viewer.node_item_at(scene_pos)
@@ -332,7 +334,8 @@ class CanvasView(QWidget):
                     raise DocumentError("this canvas has no subtree library")
                 if target is None and self.document.plan.tree is not None:
                     raise DocumentError("drop the subtree onto the node that should hold it")
-                self.select(self.instance_inserter(op, target.id if target else None))
+                parent_id = target.id if target else None
+                self.select(self.instance_inserter(op, parent_id, dropped_object))
             elif target is not None:
                 if not can_have_child(self.document.node(target.id)):
                     raise DocumentError(

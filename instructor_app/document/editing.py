@@ -15,11 +15,13 @@ from PySide6.QtGui import QUndoCommand, QUndoStack
 
 from engine.files import PlanFileError, load_plan, loads_plan, save_plan
 from engine.spec import Binding, NodeLayout, NodeSpec, ParameterDecl, PlanSpec
+from engine.subtree_ops import instance_name
 from engine.tree import RunPolicy
 from engine.types import Waypoint
 from instructor_app.document import tree_ops
 from instructor_app.document.commands import (
     AddNodeCommand,
+    CompoundCommand,
     DeclareParameterCommand,
     DeleteNodesCommand,
     MoveNodeCommand,
@@ -143,7 +145,21 @@ class PlanDocument(PlanModel):
         return not (current_parent == parent_id and current_index == index)  # else: no step
 
     def set_param(self, node_id: str, port: str, binding: Binding | None) -> None:
-        self.push(SetParamCommand(self, node_id, port, binding))
+        """Bind a port; an instance still called what its first input made it ("Pick cup")
+        is renamed after the new value in the same undo step.
+        """
+        node = self.node(node_id)
+        subtree = self.plan.subtree(node.subtree) if node.subtree is not None else None
+        if subtree is None or node.name != instance_name(subtree, node.params):
+            self.push(SetParamCommand(self, node_id, port, binding))
+            return
+        params = {k: v for k, v in node.params.items() if k != port}
+        named = instance_name(subtree, params if binding is None else {**params, port: binding})
+        command = CompoundCommand(self, f"Set {port} of {node.label}")
+        command.add(SetParamCommand(self, node_id, port, binding))
+        if named != node.name:
+            command.add(RenameCommand(self, node_id, named))
+        self.push(command)
 
     def rename(self, node_id: str, name: str) -> None:
         if self.node(node_id).name != name:

@@ -10,12 +10,14 @@ instance to the library's newer version. Each pushes one compound command of
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 
 from engine.operations import OperationSource
-from engine.spec import SubtreeSpec
+from engine.spec import Binding, SubtreeSpec
 from engine.subtree_ops import (
     OpenPort,
     detach,
+    instance_name,
     instance_of,
     make_subtree,
     ports_of,
@@ -45,15 +47,24 @@ class SubtreeEditor:
         self.document = document
 
     def insert_instance(
-        self, subtree: SubtreeSpec, parent_id: str | None, index: int | None = None
+        self,
+        subtree: SubtreeSpec,
+        parent_id: str | None,
+        index: int | None = None,
+        params: Mapping[str, Binding] | None = None,
     ) -> str:
-        """Insert an instance of a library subtree (its inputs unbound); returns its id."""
+        """Insert an instance of a library subtree (its inputs unbound but ``params``, and
+        named after them: "Pick cup"); returns its id.
+        """
         doc = self.document
         if parent_id is not None and not can_have_child(doc.node(parent_id)):
             raise DocumentError(f"{doc.node(parent_id).label!r} cannot take another child")
         if parent_id is None and doc.plan.tree is not None:
             raise DocumentError("the plan already has a root node; add the instance under it")
         node = instance_of(subtree)
+        if params:
+            bound = {**node.params, **params}
+            node = replace(node, params=bound, name=instance_name(subtree, bound))
         if parent_id is not None and index is None:
             index = len(doc.node(parent_id).children)
         doc.push(InsertInstanceCommand(doc, subtree, node, parent_id, index or 0))

@@ -1,5 +1,6 @@
 """The Objects panel: the object models the cell knows, with a picture of each, their
-symmetry, markers and grasp poses; and Add model… from a mesh file.
+symmetry, markers and grasp poses; and Add model… from a mesh file. A model dragged onto a
+node of the canvas becomes a Pick of it there (the shipped Pick subtree, "Pick cup").
 
 Models come from the cell's library (the shipped ``resources/objects``) and from the
 user's own library folder, where added models go (a model folder written whole, see
@@ -11,13 +12,14 @@ its error instead of a picture; it never stops the others from showing.
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Callable
+import json
+from collections.abc import Callable, Iterable
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from PySide6.QtCore import QSize, QStandardPaths, Qt, Signal
+from PySide6.QtCore import QMimeData, QSize, QStandardPaths, Qt, Signal
 from PySide6.QtGui import QIcon, QImage, QPixmap
 from PySide6.QtWidgets import (
     QDialog,
@@ -32,6 +34,7 @@ from PySide6.QtWidgets import (
 
 from capabilities.object_import import MESH_SUFFIXES, NewModel, import_mesh_model
 from capabilities.object_library import ObjectLibrary, ObjectLibraryError, ObjectModelSpec
+from instructor_app.node_factory import PALETTE_MIME, pick_payload
 from instructor_app.panels.object_model_dialog import AddModelDialog
 from instructor_app.panels.object_thumbnails import ThumbnailCache
 
@@ -103,6 +106,24 @@ def describe_model(spec: ObjectModelSpec, user: bool = False) -> str:
     return "<br>".join(line for line in lines if line)
 
 
+class _ObjectList(QListWidget):
+    """The models; a model drags onto the canvas as a Pick of it (the shipped Pick subtree)."""
+
+    def mimeData(self, items: Iterable[QListWidgetItem]) -> QMimeData:
+        mime = QMimeData()
+        name = next((i.data(_ROLE_NAME) for i in items if i.flags() & _DRAGGABLE), None)
+        if name:
+            mime.setData(PALETTE_MIME, json.dumps(pick_payload(name)).encode("utf-8"))
+            mime.setText(name)
+        return mime
+
+    def mimeTypes(self) -> list[str]:
+        return [PALETTE_MIME]
+
+
+_DRAGGABLE = Qt.ItemFlag.ItemIsDragEnabled
+
+
 class ObjectLibraryPanel(QWidget):
     """The known object models with thumbnails; Add model… from a mesh.
 
@@ -136,7 +157,9 @@ class ObjectLibraryPanel(QWidget):
         self._shipped = ObjectLibrary()
         self._specs: dict[str, tuple[ObjectModelSpec, bool]] = {}
         self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="costar-thumbnails")
-        self.list = QListWidget()
+        self.list = _ObjectList()
+        self.list.setDragEnabled(True)
+        self.list.setDragDropMode(QListWidget.DragDropMode.DragOnly)
         self.list.setIconSize(QSize(self.thumbnails.size, self.thumbnails.size))
         self.list.currentItemChanged.connect(lambda *_: self._show_selected())
         self.details = QLabel()
@@ -243,9 +266,10 @@ class ObjectLibraryPanel(QWidget):
         except ObjectLibraryError as exc:
             item.setToolTip(str(exc))
             item.setText(f"{name}: broken model")
+            item.setFlags(item.flags() & ~_DRAGGABLE)
             return
         self._specs[name] = (spec, user)
-        item.setToolTip(_symmetry_text(spec))
+        item.setToolTip(f"{_symmetry_text(spec)}\nDrag onto the canvas: Pick {name}")
         self._pool.submit(self._draw, spec)
 
     def _draw(self, spec: ObjectModelSpec) -> None:

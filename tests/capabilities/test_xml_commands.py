@@ -145,14 +145,15 @@ def _shape(
 
 
 def test_a_tree_btcpp_wrote_after_loading_our_export_imports_as_the_plan() -> None:
-    """cup_to_bin_written_by_btcpp.xml: our export of cup_to_bin loaded by BehaviorTree.CPP
-    4.10 and written back with its WriteTreeToXML (its names, no _uid, its own model).
+    """cup_to_bin_written_by_btcpp.xml: our export of cup_to_bin (the Figure 3 plan of
+    operation leaves it was then, kept beside it) loaded by BehaviorTree.CPP 4.10 and written
+    back with its WriteTreeToXML (its names, no _uid, its own model).
     """
     written = (BTCPP_DATA / "cup_to_bin_written_by_btcpp.xml").read_text(encoding="utf-8")
     assert "_uid" not in written
     manifests = operation_manifests()
     plan = import_xml(written, "written.xml", manifests)
-    original = load_plan(EXAMPLES / "cup_to_bin.costar.json")
+    original = load_plan(BTCPP_DATA / "cup_to_bin.costar.json")
     assert plan.tree is not None and original.tree is not None
     assert _shape(plan.tree, manifests) == _shape(original.tree, manifests)
     assert [n.name for _, n in plan.walk()] == [n.name for _, n in original.walk()]

@@ -16,9 +16,17 @@ from pathlib import Path
 from typing import Any
 
 from PySide6.QtCore import QPointF, QSettings, Qt
-from PySide6.QtWidgets import QComboBox, QDockWidget, QToolBar, QTreeWidgetItem, QWidget
+from PySide6.QtGui import QDropEvent
+from PySide6.QtWidgets import (
+    QComboBox,
+    QDockWidget,
+    QTabBar,
+    QToolBar,
+    QTreeWidgetItem,
+    QWidget,
+)
 
-from engine.spec import RunPolicy
+from engine.spec import NodeSpec, RunPolicy
 from engine.types import ObjectModel, ParamType, Waypoint
 from instructor_app.inspectors.base import ParamEditor
 from instructor_app.inspectors.editors import (
@@ -45,6 +53,8 @@ __all__ = [
     "search_insert",
     "search_down_insert",
     "double_click_palette",
+    "show_tab",
+    "drag_object_onto",
     "select",
     "click_node",
     "choose",
@@ -119,7 +129,7 @@ class CountingBot:
 
     One action is: a click (a double click counts once: its first click), a key press, a
     typed text (the keys of one word or phrase), opening a list, choosing a file in a file
-    dialog, and going to another field before typing into it (a click into it; a triple
+    dialog, a drag (press, move, release), and going to another field before typing into it (a click into it; a triple
     click when its text is selected to be typed over). Everything else is ``qtbot``'s own.
 
     Attributes:
@@ -224,13 +234,14 @@ def search_insert(qtbot: Any, window: MainWindow, text: str, expect: str) -> str
     qtbot.keyClick(field, Qt.Key.Key_Return)
     added = _one_added(window, before, text)
     node = window.document.node(added)
-    assert expect in (node.op, node.kind.value), f"{text!r} inserted {node.op or node.kind}"
+    assert expect in _what(node), f"{text!r} inserted {node.op or node.kind}"
     return added
 
 
 def search_down_insert(qtbot: Any, window: MainWindow, text: str, expect: str) -> str:
     """Type ``text`` into the palette's search field, press Down until the current hit is
-    ``expect`` (an operation id or a kind), then Enter; the added node's id.
+    ``expect`` (an operation id, a kind or a library subtree's id), then Enter; the added
+    node's id.
     """
     before = _ids(window)
     palette = window.views.palette
@@ -243,8 +254,13 @@ def search_down_insert(qtbot: Any, window: MainWindow, text: str, expect: str) -
     qtbot.keyClick(palette.search_field, Qt.Key.Key_Return)
     added = _one_added(window, before, text)
     node = window.document.node(added)
-    assert expect in (node.op, node.kind.value), f"{text!r} inserted {node.op or node.kind}"
+    assert expect in _what(node), f"{text!r} inserted {node.op or node.kind}"
     return added
+
+
+def _what(node: NodeSpec) -> tuple[str | None, ...]:
+    """What a node is, as a palette item names it: its operation, kind or subtree id."""
+    return (node.op, node.kind.value, node.subtree.id if node.subtree else None)
 
 
 def double_click_palette(qtbot: Any, window: MainWindow, key: str) -> str:
@@ -259,6 +275,41 @@ def double_click_palette(qtbot: Any, window: MainWindow, key: str) -> str:
     qtbot.mouseClick(palette.tree.viewport(), Qt.MouseButton.LeftButton, pos=centre)
     qtbot.mouseDClick(palette.tree.viewport(), Qt.MouseButton.LeftButton, pos=centre)
     return _one_added(window, before, key)
+
+
+def show_tab(qtbot: Any, window: MainWindow, title: str) -> None:
+    """Click the dock tab called ``title`` (Palette, Objects, Library...) unless it shows."""
+    dock = next(d for d in window.findChildren(QDockWidget) if d.windowTitle() == title)
+    if not dock.visibleRegion().isEmpty():
+        return
+    for bar in window.findChildren(QTabBar):
+        index = next((i for i in range(bar.count()) if bar.tabText(i) == title), -1)
+        if index >= 0 and bar.isVisible():
+            qtbot.mouseClick(bar, Qt.MouseButton.LeftButton, pos=bar.tabRect(index).center())
+            qtbot.waitUntil(lambda: not dock.visibleRegion().isEmpty(), timeout=2000)
+            return
+    raise LookupError(f"no tab {title!r} to click")
+
+
+def drag_object_onto(qtbot: Any, window: MainWindow, name: str, node_id: str) -> str:
+    """Drag the object model ``name`` from the Objects panel onto a node of the canvas (one
+    action: press on the model, release on the node); the id of the node it added.
+    """
+    before = _ids(window)
+    objects = window.views.objects
+    row = objects.list.item(objects.names().index(name))
+    mime = objects.list.mimeData([row])  # what the list hands to a drag
+    canvas = window.views.canvas
+    canvas.center_on(node_id)
+    item = canvas.item(node_id)
+    pos = canvas.viewer.mapFromScene(item.mapToScene(item.shape_rect().center()))
+    _count(qtbot, f"drag {name} onto the canvas", canvas.viewer)
+    event = QDropEvent(
+        QPointF(pos), Qt.DropAction.CopyAction, mime, Qt.MouseButton.LeftButton,
+        Qt.KeyboardModifier.NoModifier,
+    )  # fmt: skip
+    canvas.viewer.dropEvent(event)
+    return _one_added(window, before, name)
 
 
 def select(window: MainWindow, node_id: str, qtbot: Any = None) -> None:

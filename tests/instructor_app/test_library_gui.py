@@ -2,7 +2,8 @@
 
 Save a selection as a subtree (the dialog's tables), the Library panel (folders, search,
 preview, insert, find usages), palette search-to-insert of a library subtree, an instance's
-binding form in the inspector, detach and update, each one undo step. A library save runs off
+binding form in the inspector (and its name following its object), detach and update, the
+shipped Pick taken by dragging an object model onto the canvas, each one undo step. A library save runs off
 the GUI thread: a lock held elsewhere does not stop the window.
 """
 
@@ -22,13 +23,14 @@ from engine.files import dump_plan
 from engine.library import LIBRARY_ENV, Library
 from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
 from engine.status import Status
-from engine.types import ParamType
+from engine.types import ObjectModel, ParamType
 from instructor_app.main_window import MainWindow
 from instructor_app.runtime.session import CellSession
 from instructor_app.subtree_dialog import SaveSubtreeDialog
 from tests.instructor_app.gui_driver import (
     ScriptedDialogs,
     make_window,
+    rename,
     run_to_end,
     search_insert,
     select,
@@ -352,3 +354,73 @@ def test_a_saved_selection_is_an_instance_named_by_its_subtree_and_logs_name_its
     said = [line for line in window.views.log.lines() if line.endswith("hello")]
     assert said and all("greet" in line and "say" in line for line in said), said
     assert not any(instance.id in line for line in window.views.log.lines())
+
+
+# ---------------------------------------------------------------------- pick and place (issue 26)
+
+
+def _drop_on(window: MainWindow, node_id: str, mime: Any) -> None:
+    canvas = window.views.canvas
+    item = canvas.item(node_id)
+    pos = canvas.viewer.mapFromScene(item.mapToScene(item.shape_rect().center()))
+    event = QDropEvent(
+        QPointF(pos), Qt.DropAction.CopyAction, mime, Qt.MouseButton.LeftButton,
+        Qt.KeyboardModifier.NoModifier,
+    )  # fmt: skip
+    canvas.viewer.dropEvent(event)
+
+
+def test_the_shipped_pick_and_place_are_in_the_library_and_the_palette(
+    qtbot: Any, window: MainWindow
+) -> None:
+    panel = window.views.library
+    assert {"Pick", "Place"} <= set(panel.visible_names())
+    panel.select("Pick")
+    text = panel.preview.toPlainText()
+    assert "OBJECT: ObjectModel" in text and "gripper.grasp" in text
+    qtbot.keyClicks(window.views.palette.search_field, "place")
+    hit = window.views.palette.current_hit()
+    assert hit is not None and hit.op == "pick_place.place"
+
+
+def test_an_instance_is_named_after_its_object_until_renamed_one_undo_step_each(
+    qtbot: Any, window: MainWindow, tmp_path: Path
+) -> None:
+    _open(window, tmp_path, _plan())
+    select(window, _node(window, "main").id)
+    pick = search_insert(qtbot, window, "pick", "pick_place.pick")
+    document = window.document
+    assert document.node(pick).name == "Pick"
+    before = document.serialized()
+    set_value(qtbot, window, pick, "OBJECT", ObjectModel("cup"))
+    assert document.node(pick).name == "Pick cup"
+    assert window.views.inspector.name_field.text() == "Pick cup"
+    set_value(qtbot, window, pick, "OBJECT", ObjectModel("waste_bin"))
+    assert document.node(pick).name == "Pick waste_bin"
+    document.undo_stack.undo()
+    assert document.node(pick).name == "Pick cup"
+    document.undo_stack.undo()
+    assert document.serialized() == before
+    document.undo_stack.redo()
+    rename(qtbot, window, pick, "take the cup")  # a name given by hand stays
+    set_value(qtbot, window, pick, "OBJECT", ObjectModel("waste_bin"))
+    assert document.node(pick).name == "take the cup"
+
+
+def test_an_object_dragged_from_the_objects_panel_onto_a_node_is_a_pick_of_it(
+    qtbot: Any, window: MainWindow, tmp_path: Path
+) -> None:
+    _open(window, tmp_path, _plan())
+    before = window.document.serialized()
+    objects = window.views.objects
+    row = objects.list.item(objects.names().index("cup"))
+    assert row.flags() & Qt.ItemFlag.ItemIsDragEnabled
+    _drop_on(window, _node(window, "main").id, objects.list.mimeData([row]))
+    added = window.document.plan.tree.children[-1]  # type: ignore[union-attr]
+    assert added.kind is NodeKind.SUBTREE and added.subtree is not None
+    assert added.subtree.id == "pick_place.pick" and added.name == "Pick cup"
+    assert added.params["OBJECT"] == Binding.fixed(ObjectModel("cup"), ParamType.OBJECT)
+    assert window.views.canvas.selected_ids() == [added.id]
+    assert window.views.inspector.port_row("OBJECT").editor.combo.currentText() == "cup"
+    window.document.undo_stack.undo()  # one step
+    assert window.document.serialized() == before

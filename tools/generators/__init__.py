@@ -7,6 +7,7 @@ Run them from the repository's root (each writes into the ``resources/`` folder 
     python -m tools.generators                      # all of them, in order
     python -m tools.generators.make_objects         # object models and meshes (--check)
     python -m tools.generators.make_clear_stop      # recovery/ClearStopAndBackOff
+    python -m tools.generators.make_pick_place      # pick_place/Pick and Place
     python -m tools.generators.make_examples        # figure3_debug and nodes/*
     python -m tools.generators.make_cell_examples   # cup_to_bin(_vision), tending_paper
     python -m tools.generators.make_kitting         # the kitting library and plan

@@ -12,6 +12,7 @@ from tools.generators import (
     make_examples,
     make_kitting,
     make_objects,
+    make_pick_place,
     make_tending,
 )
 
@@ -21,6 +22,7 @@ def main() -> int:
     status = make_objects.main([])
     for generator in (
         make_clear_stop,
+        make_pick_place,
         make_examples,
         make_cell_examples,
         make_kitting,

@@ -1,12 +1,14 @@
 """Write the example plans that run on the simulated cell (reproducible byte for byte).
 
-``cup_to_bin.costar.json`` is the paper's Figure 3 on the simulated cell: the arm steps out of
-the shoulder camera's view, the camera finds the cup and the waste bin through their ArUco
-markers, the plan checks the cup was found, queries both poses, grasps the cup at its pose
-with the grasp its object model carries (``gripper.grasp``: approach, descend, close, lift)
-and drops it over the bin; when the cup is not visible it waits and tries again (the root
-runs until success). Its waypoints are also written to ``cup_to_bin.waypoints.json`` beside
-it.
+``cup_to_bin.costar.json`` is the paper's Figure 3 on the simulated cell, taught as a worker
+does with the shipped Pick and Place subtrees (``make_pick_place``): "Pick cup" steps the arm
+out of the shoulder camera's view, finds the cup and the waste bin through their ArUco
+markers, checks the cup was found and grasps it at its pose with the grasp its object model
+carries (``gripper.grasp``: approach, descend, close, lift); "Place over bin" drops it over
+the bin; when the cup is not visible it waits and tries again (the root runs until
+success). Its waypoints are also written to ``cup_to_bin.waypoints.json`` beside it.
+``cup_to_bin_vision.costar.json`` keeps Figure 3's operation leaves (found, both poses,
+grasp, move, release), finding the objects by perception.
 
 ``tending_paper.costar.json`` is the paper's wire-bender tending plan (section V-B) on the
 ``tending`` scene: look up the rack by its marker, then for each part wait until the bender's
@@ -29,7 +31,7 @@ from engine.types import (
     Waypoint,
     WaypointFrame,
 )
-from tools.generators import RESOURCES
+from tools.generators import RESOURCES, make_pick_place
 from tools.generators.plan_builder import CELL_EXAMPLES, PlanBuilder, fixed, obj, stable_id
 
 HERE = RESOURCES / "examples"  # where the plans are written
@@ -146,19 +148,38 @@ def _figure3_plan(name: str, detect: tuple[str, str], root: str, title: str, doc
 
 
 def cup_to_bin() -> PlanSpec:
-    """Figure 3 through the ArUco markers on the cup and the bin."""
-    return _figure3_plan(
-        "cup_to_bin",
-        ("markers", "detect_markers"),
-        "cup to bin",
+    """Figure 3 through the ArUco markers on the cup and the bin, taught with the shipped
+    Pick and Place subtrees (each names what it takes: "Pick cup", "Place over bin").
+    """
+    m = _Cell("cup_to_bin")
+    pick, place = make_pick_place.pick(), make_pick_place.place()
+    transfer = m.node(
+        NodeKind.SEQUENCE,
+        "Sequence",
+        m.instance(pick, "Pick cup", OBJECT=obj("cup")),
+        m.instance(place, "Place over bin", PLACE=fixed(m.wps["over bin"], ParamType.WAYPOINT)),
+    )
+    wait = m.node(
+        NodeKind.FORCE_FAILURE, "Force failure", m.node(NodeKind.WAIT, "Wait", seconds=1.0)
+    )
+    return PlanSpec(
+        m.node(NodeKind.SELECTOR, "Selector", transfer, wait),
         "Cup to bin (Figure 3, simulated cell)",
-        "The paper's Figure 3 on the simulated cell: step the arm out of the shoulder camera's "
-        "view first (with the arm over the table the camera cannot see the cup, and the look "
-        "says 'the arm hides the table from the shoulder camera'), find the cup and the waste "
-        "bin through their markers, check the cup was found, query both poses, grasp the cup at its pose with the "
-        "grasp of its object model and drop it over the bin. When the cup is not visible the selector falls "
-        "back to WAIT (forced to fail) and the root, which runs until success, looks again. "
-        "Run it with: costar run example:cup_to_bin --seed N. Runs to SUCCESS.",
+        "The paper's Figure 3 on the simulated cell, taught with the shipped Pick and Place "
+        "subtrees: Pick cup steps the arm out of the shoulder camera's view (with the arm "
+        "over the table the camera cannot see the cup, and the look says 'the arm hides the "
+        "table from the shoulder camera'), finds the cup and the waste bin through their "
+        "markers, checks the cup was found and grasps it at its pose with the grasp of its "
+        "object model; Place over bin drops it at the waypoint taught relative to the bin. "
+        "When the cup is not visible the selector falls back to Wait (forced to fail) and "
+        "the root, which runs until success, looks again. Run it with: costar run "
+        "example:cup_to_bin --seed N. Runs to SUCCESS.",
+        RunPolicy.UNTIL_SUCCESS,
+        waypoints=waypoints(),
+        objects=["cup", "waste_bin"],
+        reset_cell=True,  # each run in the Instructor starts from the scene's seed
+        id=stable_id(CELL_EXAMPLES, "cup_to_bin"),
+        subtrees=[pick, place],
     )
 
 

@@ -25,6 +25,7 @@ __all__ = [
     "DATE",
     "EXAMPLES",
     "KITTING",
+    "PICK_PLACE",
     "TENDING",
     "PlanBuilder",
     "fixed",
@@ -44,6 +45,7 @@ CELL_EXAMPLES = uuid.UUID("0b7f2a4e-3c1d-4f5e-8a9b-6c7d8e9f0a1b")  # make_cell_e
 CLEAR_STOP = uuid.UUID("3f0c5b1e-8a47-4d2a-b6e1-5c9d2e7a4f10")  # make_clear_stop
 KITTING = uuid.UUID("5d1c7a0e-2b4f-4c8e-9a3d-7e6f5a4b3c2d")  # make_kitting
 TENDING = uuid.UUID("8f3e6a2c-1d4b-4e7a-9c5f-2b8d7e6a5c41")  # make_tending, tending_library
+PICK_PLACE = uuid.UUID("c41e2d7a-6b3f-4a58-9e0d-1f7c3b5a2e96")  # make_pick_place
 
 
 def stable_id(namespace: uuid.UUID, name: str) -> str:

@@ -61,14 +61,14 @@ def test_waits_while_the_cup_is_hidden_and_completes_when_it_appears() -> None:
         tree = build_tree(load_plan(PLAN), registry, clock=session.clock)
         seen = []
         tree.ctx.status_sink = lambda node, old, new: seen.append((node.name, new))
-        # Tick by hand (paced by simulated time) until the plan has fallen back to WAIT
+        # Tick by hand (paced by simulated time) until the plan has fallen back to Wait
         # twice. The bound is wall time: detection runs on a worker thread at its own pace.
         deadline = time.monotonic() + 120.0
         while tree.root.runs < 2 and time.monotonic() < deadline:
             tree.tick()
             session.sim.wait_sim(0.05)
         assert tree.root.runs >= 2 and tree.status is Status.RUNNING
-        assert ("WAIT", Status.RUNNING) in seen
+        assert ("Wait", Status.RUNNING) in seen
         session.sim.call(lambda client: session.scene.spawn(client, "cup", "cup", cup_pose))
         deadline = time.monotonic() + 120.0
         while tree.tick() is Status.RUNNING and time.monotonic() < deadline:
