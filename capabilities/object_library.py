@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from capabilities.errors import CapabilityError
-from engine.json_reader import JsonFileError, JsonReader, read_json_file
+from engine.json_reader import JsonReader, errors_as, read_json_file
 from engine.types import Pose
 from resources import resource_path
 
@@ -268,10 +268,8 @@ def parse_model(data: Any, directory: Path, file: Path | str) -> ObjectModelSpec
     Raises:
         ObjectLibraryError: a field is off; the message names ``file`` and the JSON path.
     """
-    try:
+    with errors_as(ObjectLibraryError):
         return _parse_model(JsonReader(data, file), directory)
-    except JsonFileError as exc:
-        raise ObjectLibraryError(str(exc)) from exc
 
 
 class ObjectLibrary:
@@ -303,9 +301,7 @@ class ObjectLibrary:
                 raise ObjectLibraryError(
                     f"{file}: no such model {name!r} (library {self._path} has {self.names()})"
                 )
-            try:
+            with errors_as(ObjectLibraryError):
                 data = read_json_file(file, "object model")
-            except JsonFileError as exc:
-                raise ObjectLibraryError(str(exc)) from exc
             self._models[name] = parse_model(data, directory, file)
         return self._models[name]

@@ -28,7 +28,7 @@ import numpy as np
 
 from capabilities.camera_source import CameraSource, RGBDFrame
 from capabilities.errors import CapabilityError
-from engine.json_reader import JsonFileError, JsonReader, read_json_file
+from engine.json_reader import JsonReader, errors_as, read_json_file
 from engine.plan_writer import write_atomic
 from engine.types import ParamType, Pose
 
@@ -123,7 +123,7 @@ class RecordedCamera:
     def __init__(self, folder: str | Path, name: str | None = None) -> None:
         self.folder = Path(folder)
         index = self.folder / INDEX
-        try:
+        with errors_as(RecordingError):
             r = JsonReader(read_json_file(index, "frame recording"), index)
             r.as_object(("format", "format_version", "camera", "on_wrist", "depth_unit", "frames"))
             if r.text("format") != FORMAT:
@@ -133,8 +133,6 @@ class RecordedCamera:
             self.on_wrist = r.flag("on_wrist", False)
             self._unit = r.number("depth_unit", DEPTH_UNIT, above=True, lo=0.0)
             self._frames = [self._frame_entry(f) for f in r.items("frames", "frames", False)]
-        except JsonFileError as exc:
-            raise RecordingError(str(exc)) from exc
         if not self._frames:
             raise RecordingError(f"{index}: $.frames: expected at least one frame, got none")
         self._order = itertools.cycle(range(len(self._frames)))

@@ -20,7 +20,7 @@ import numpy as np
 
 from capabilities.camera_source import CameraSource, RGBDFrame
 from capabilities.errors import CapabilityError
-from engine.json_reader import JsonFileError, JsonReader, parse_json
+from engine.json_reader import JsonReader, errors_as, parse_json
 from engine.types import ParamType, Pose
 
 __all__ = ["FRAME_PORT", "StreamCamera", "StreamCameraError", "serve_frames"]
@@ -103,7 +103,7 @@ class StreamCamera:
         sock = self._socket
         sock.sendall(self.name.encode("utf-8") + b"\n")
         where = f"{self._address[0]}:{self._address[1]}"
-        try:
+        with errors_as(StreamCameraError):
             r = JsonReader(parse_json(_read_line(sock).decode("utf-8"), where, "frame"), where)
             if not r.flag("ok"):
                 raise StreamCameraError(f"camera {self.name}: {r.text('error', '?')}")
@@ -113,8 +113,6 @@ class StreamCamera:
             k = np.array([r.at("K").at(i).as_vector(3) for i in range(3)])
             pose = r.typed("T_world_camera", ParamType.POSE)
             stamp = r.number("stamp")
-        except JsonFileError as exc:
-            raise StreamCameraError(str(exc)) from exc
         rgb = np.frombuffer(_read(sock, width * height * 3), np.uint8).reshape(height, width, 3)
         depth = np.frombuffer(_read(sock, width * height * 4), "<f4").reshape(height, width)
         return RGBDFrame(

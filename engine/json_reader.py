@@ -15,7 +15,7 @@ limit. :class:`JsonReader` then gives typed access to the parsed document; every
         marker_id = marker.integer("id", lo=0, hi=49)
 
 Capability-side readers wrap a JsonFileError into their own CapabilityError subclass
-(``raise SceneFileError(str(exc)) from exc``); the engine raises it (or a subclass such as
+(``with errors_as(SceneFileError): ...``, :func:`errors_as`); the engine raises it (or a subclass such as
 PlanFileError, chosen with ``error=``) as is. Nothing in a file is executed.
 """
 
@@ -23,7 +23,8 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from typing import Any, NoReturn
 
 from engine.json_text import (
@@ -46,9 +47,21 @@ __all__ = [
     "JsonReader",
     "at",
     "describe",
+    "errors_as",
     "parse_json",
     "read_json_file",
 ]
+
+
+@contextmanager
+def errors_as(error: Callable[[str], Exception]) -> Iterator[None]:
+    """A JsonFileError raised in the block is raised again as ``error`` (a reader's own error
+    class) with the same message, the JsonFileError its ``__cause__``.
+    """
+    try:
+        yield
+    except JsonFileError as exc:
+        raise error(str(exc)) from exc
 
 
 class JsonReader:

@@ -23,7 +23,7 @@ from engine.events import (
     RunHeld,
     StatusChanged,
 )
-from engine.json_reader import JsonFileError, parse_json
+from engine.json_reader import errors_as, parse_json
 from engine.spec import PlanSpec
 from engine.status import Status
 from engine.types import encode_value
@@ -155,10 +155,8 @@ def read_trace(path: str | os.PathLike[str]) -> Trace:
     for number, line in enumerate(lines, start=1):
         if not line.strip():
             continue
-        try:
+        with errors_as(TraceError):
             record = parse_json(line, f"{path}:{number}", "trace")
-        except JsonFileError as exc:
-            raise TraceError(str(exc)) from exc
         if not isinstance(record, dict):
             raise TraceError(f"{path}:{number}: expected a JSON object")
         records.append((number, record))

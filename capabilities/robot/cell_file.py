@@ -18,7 +18,7 @@ from capabilities.camera_source import SOURCE_KINDS
 from capabilities.robot.camera_mounts import SHOULDER_EYE, SHOULDER_TARGET, WRIST_MOUNT, look_at
 from capabilities.robot.cell_robot import RobotSettings, read_robot
 from capabilities.robot.errors import RobotCellError
-from engine.json_reader import JsonFileError, JsonReader, read_json_file
+from engine.json_reader import JsonReader, errors_as, read_json_file
 from engine.types import ParamType, Pose
 from resources import resource_path
 
@@ -147,10 +147,8 @@ class CellConfig:
             CellConfigError: the file is missing, not JSON, or a field is off; the message
                 names the file as given and the JSON path.
         """
-        try:
+        with errors_as(CellConfigError):
             return _config(JsonReader(read_json_file(path, "cell configuration"), path))
-        except JsonFileError as exc:
-            raise CellConfigError(str(exc)) from exc
 
     @classmethod
     def from_json(cls, data: Any, source: str = "<cell config>") -> CellConfig:
@@ -159,10 +157,8 @@ class CellConfig:
         Raises:
             CellConfigError: a field is off; the message names ``source`` and the JSON path.
         """
-        try:
+        with errors_as(CellConfigError):
             return _config(JsonReader(data, source))
-        except JsonFileError as exc:
-            raise CellConfigError(str(exc)) from exc
 
     def to_json(self) -> dict[str, Any]:
         """The JSON form (what ``from_json`` reads)."""

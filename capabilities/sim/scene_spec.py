@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from capabilities.sim.objects import SceneError
-from engine.json_reader import JsonFileError, JsonReader, read_json_file
+from engine.json_reader import JsonReader, errors_as, read_json_file
 
 __all__ = [
     "FORMAT_VERSION",
@@ -226,10 +226,8 @@ def parse_scene(data: Any, source: str = "<scene>") -> SceneSpec:
     Raises:
         SceneFileError: a field is off; the message names ``source`` and the JSON path.
     """
-    try:
+    with errors_as(SceneFileError):
         return _scene(JsonReader(data, source))
-    except JsonFileError as exc:
-        raise SceneFileError(str(exc)) from exc
 
 
 def read_scene(scene: Path | str | dict[str, Any] | SceneSpec) -> SceneSpec:
@@ -256,15 +254,11 @@ def parse_block(
     """
     if not isinstance(data, dict) or name not in data:
         return None
-    try:
+    with errors_as(SceneFileError):
         return build(JsonReader(data, source).child(name, fields, optional=False))
-    except JsonFileError as exc:
-        raise SceneFileError(str(exc)) from exc
 
 
 def read_scene_json(path: Path | str) -> Any:
     """The parsed JSON of a scene file; raises SceneFileError (missing, not JSON)."""
-    try:
+    with errors_as(SceneFileError):
         return read_json_file(path, "scene")
-    except JsonFileError as exc:
-        raise SceneFileError(str(exc)) from exc
