@@ -44,6 +44,7 @@ __all__ = [
     "detach",
     "find_usages",
     "instance_name",
+    "ports_bound_elsewhere",
     "instance_of",
     "make_subtree",
     "names_used",
@@ -185,6 +186,25 @@ def instance_name(subtree: SubtreeSpec, params: Mapping[str, Binding]) -> str:
 
 
 _NAMING_TYPES = (ParamType.OBJECT, ParamType.WAYPOINT)
+
+
+def ports_bound_elsewhere(plan: PlanSpec, subtree: SubtreeSpec) -> dict[str, Binding]:
+    """What the plan's instances already give a port of ``subtree``'s name and type (the
+    first in tick order): a second instance of a library's subtrees is bound as the others
+    are ("ABOVE" is "over exit" wherever the plan already says so; an output writes the
+    parameter the others write).
+    """
+    wanted = {port.name: port.type for port in (*subtree.inputs, *subtree.outputs)}
+    found: dict[str, Binding] = {}
+    for _, node in plan.walk():
+        spec = plan.subtree(node.subtree) if node.subtree is not None else None
+        if spec is None:
+            continue
+        for port in (*spec.inputs, *spec.outputs):
+            binding = node.params.get(port.name)
+            if binding is not None and wanted.get(port.name) is port.type:
+                found.setdefault(port.name, binding)
+    return found
 
 
 def instance_of(

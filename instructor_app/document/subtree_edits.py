@@ -20,6 +20,7 @@ from engine.subtree_ops import (
     instance_name,
     instance_of,
     make_subtree,
+    ports_bound_elsewhere,
     ports_of,
     update,
 )
@@ -53,8 +54,9 @@ class SubtreeEditor:
         index: int | None = None,
         params: Mapping[str, Binding] | None = None,
     ) -> str:
-        """Insert an instance of a library subtree (its inputs unbound but ``params``, and
-        named after them: "Pick cup"); returns its id.
+        """Insert an instance of a library subtree (its ports unbound but ``params`` and
+        those the plan's other instances bind under the same name and type, and named after
+        them: "Pick cup"); returns its id.
         """
         doc = self.document
         if parent_id is not None and not can_have_child(doc.node(parent_id)):
@@ -62,6 +64,7 @@ class SubtreeEditor:
         if parent_id is None and doc.plan.tree is not None:
             raise DocumentError("the plan already has a root node; add the instance under it")
         node = instance_of(subtree)
+        params = {**ports_bound_elsewhere(doc.plan, subtree), **(params or {})}
         if params:
             bound = {**node.params, **params}
             node = replace(node, params=bound, name=instance_name(subtree, bound))

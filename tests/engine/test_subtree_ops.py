@@ -12,7 +12,7 @@ from capabilities.base import CapabilityRegistry
 from engine.build import build_tree
 from engine.files import dump_plan, loads_plan, save_plan
 from engine.library import Library
-from engine.spec import Binding, NodeKind, PlanSpec
+from engine.spec import Binding, NodeKind, PlanSpec, SubtreePort, SubtreeSpec
 from engine.status import SUCCESS
 from engine.subtree_ops import (
     OpenPort,
@@ -20,6 +20,7 @@ from engine.subtree_ops import (
     find_usages,
     instance_of,
     make_subtree,
+    ports_bound_elsewhere,
     ports_of,
     update,
 )
@@ -145,3 +146,18 @@ def test_one_input_may_feed_several_parameters(registry: CapabilityRegistry) -> 
     assert [p.name for p in made.inputs] == ["OBJECT"]
     inner = made.tree.children
     assert inner[0].params["value"] == inner[1].params["expected"] == Binding.reference("OBJECT")
+
+
+def test_ports_bound_elsewhere_are_the_first_bindings_of_the_same_name_and_type() -> None:
+    spec = two_instances()
+    sub = spec.subtrees[0]
+    assert ports_bound_elsewhere(spec, sub) == {
+        "OBJECT": Binding.fixed("a", ParamType.TEXT),  # Pick A's, the first in tick order
+        "RESULT": Binding.reference("GOT_A"),
+    }
+    other = SubtreeSpec(
+        id="test.other", name="Other", tree=sub.tree,
+        inputs=[SubtreePort("OBJECT", ParamType.POSE, "another type")],
+    )  # fmt: skip
+    assert ports_bound_elsewhere(spec, other) == {}
+    assert ports_bound_elsewhere(plan(logic(NodeKind.SEQUENCE)), sub) == {}

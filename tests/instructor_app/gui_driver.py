@@ -362,6 +362,8 @@ def bind_reference(qtbot: Any, window: MainWindow, node_id: str, port: str, name
         binding = window.document.node(node_id).params.get(port)
         if row.ref_field.text() == name and binding is not None and binding.ref == name:
             return
+    elif row.ref_field.text() == name:
+        return  # an output already written there (bound as the plan's other instances)
     _replace_text(qtbot, row.ref_field, name)
     qtbot.keyClick(row.ref_field, Qt.Key.Key_Return)
 
@@ -379,12 +381,20 @@ def set_value(
     """
     select(window, node_id, qtbot)
     row: PortRow = window.views.inspector.port_row(port)
+    if _bound_to(window, node_id, port, value):
+        return  # a user leaves a binding that is already right
     choose_index(qtbot, row.mode_combo, MODE_VALUE)
     if ptype is not None and ptype is not row.value_type:
         choose(qtbot, row.type_combo, ptype.value)
     assert row.editor is not None
     if row.editor.value() != value:  # a user leaves a value that is already right
         _enter(qtbot, row.editor, value)
+
+
+def _bound_to(window: MainWindow, node_id: str, port: str, value: Any) -> bool:
+    """Whether the port already holds ``value`` (an instance's input bound as elsewhere)."""
+    binding = window.document.node(node_id).params.get(port)
+    return binding is not None and not binding.is_ref and binding.value == value
 
 
 def unset(qtbot: Any, window: MainWindow, node_id: str, port: str) -> None:

@@ -29,6 +29,7 @@ from instructor_app.runtime.session import CellSession
 from instructor_app.subtree_dialog import SaveSubtreeDialog
 from tests.instructor_app.gui_driver import (
     ScriptedDialogs,
+    bind_reference,
     make_window,
     rename,
     run_to_end,
@@ -424,3 +425,28 @@ def test_an_object_dragged_from_the_objects_panel_onto_a_node_is_a_pick_of_it(
     assert window.views.inspector.port_row("OBJECT").editor.combo.currentText() == "cup"
     window.document.undo_stack.undo()  # one step
     assert window.document.serialized() == before
+
+
+def test_an_instance_inserted_is_bound_as_the_plans_other_instances_are(
+    qtbot: Any, window: MainWindow, tmp_path: Path
+) -> None:
+    _open(window, tmp_path, _plan())
+    document = window.document
+    select(window, _node(window, "main").id)
+    first = search_insert(qtbot, window, "ReRegisterRack", "subtree")
+    bind_reference(qtbot, window, first, "RACK_POSE", "RACK_POSE")  # an output
+    pick = search_insert(qtbot, window, "pick", "pick_place.pick")
+    set_value(qtbot, window, pick, "OBJECT", ObjectModel("cup"))
+    select(window, _node(window, "main").id)
+    before = document.serialized()
+    again = search_insert(qtbot, window, "pick", "pick_place.pick")
+    cup = Binding.fixed(ObjectModel("cup"), ParamType.OBJECT)
+    assert document.node(again).params["OBJECT"] == cup  # as the other Pick: cup
+    assert document.node(again).name == "Pick cup"
+    assert window.views.inspector.port_row("OBJECT").editor.combo.currentText() == "cup"
+    document.undo_stack.undo()  # one step
+    assert document.serialized() == before
+    select(window, _node(window, "main").id)
+    find = search_insert(qtbot, window, "ReRegisterRack", "subtree")
+    assert document.node(find).params["RACK_POSE"] == Binding.reference("RACK_POSE")
+    assert window.views.inspector.port_row("RACK_POSE").ref_field.text() == "RACK_POSE"
