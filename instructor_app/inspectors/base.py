@@ -49,6 +49,7 @@ class ParamEditor(QWidget):
         super().__init__(parent)
         self.port = port
         self._value: Any = None
+        self._unset = False  # what it shows is not bound yet: choosing it binds it
         self._layout = QHBoxLayout(self)
         self._layout.setContentsMargins(0, 0, 0, 0)
         self._layout.setSpacing(2)
@@ -60,7 +61,16 @@ class ParamEditor(QWidget):
     def set_value(self, value: Any) -> None:
         """Show ``value`` without emitting ``value_committed``."""
         self._value = value
+        self._unset = False
         self._show(value)
+
+    def show_unset(self, default: Any = None) -> None:
+        """Show an unbound port: its default (when it has one), or what was shown; the user
+        choosing or entering a value, even the one shown, binds it (``value_committed``).
+        """
+        if default is not None and default != self._value:
+            self.set_value(default)
+        self._unset = True
 
     def set_context(self, context: EditorContext) -> None:
         """New choices (objects, waypoints); editors without choices ignore it."""
@@ -70,9 +80,10 @@ class ParamEditor(QWidget):
 
     def _commit(self, value: Any) -> None:
         """Called by subclasses when the user changed the value."""
-        if value is None or value == self._value:
+        if value is None or (value == self._value and not self._unset):
             return
         self._value = value
+        self._unset = False
         self.value_committed.emit(value)
 
 

@@ -46,8 +46,9 @@ def _name_field(model: QStringListModel) -> QLineEdit:
 class PortRow(QWidget):
     """One port of an operation node.
 
-    Inputs: a mode switch (unset / value / parameter), for values the editor of the chosen
-    type, for parameters a name with completion that lists the offered names first (the
+    Inputs: a mode switch (unset / value / parameter), for values (and while unset: a value
+    chosen or typed there binds it, no need to switch to "value" first) the editor of the
+    chosen type, for parameters a name with completion that lists the offered names first (the
     outputs of this type written before the node, nearest first: ``set_offers``); choosing
     "parameter" with no name yet binds the first offer. Outputs: the name the result is
     stored under.
@@ -101,11 +102,13 @@ class PortRow(QWidget):
         top.addWidget(self.mode_combo)
         top.addWidget(self.type_combo)
         layout.addLayout(top)
-        self.stack.addWidget(QLabel())  # MODE_UNSET: nothing to edit
+        self.stack.addWidget(QLabel())  # MODE_UNSET: shows the editor (see _show_mode)
         self.stack.addWidget(QWidget())  # MODE_VALUE: replaced by the editor
         self.stack.addWidget(self.ref_field)
         layout.addWidget(self.stack)
         self._set_editor(self.types[0])
+        assert self.editor is not None
+        self.editor.show_unset(self._default_shown())
         self._show_mode(MODE_UNSET)
 
     # ------------------------------------------------------------------ state
@@ -144,6 +147,8 @@ class PortRow(QWidget):
         self._context = context
         if self.editor is not None:
             self.editor.set_context(context)
+            if self.mode == MODE_UNSET:
+                self.editor.show_unset(self._default_shown())
 
     def load(self, binding: Binding | None) -> None:
         """Show a binding (None: unbound) without emitting."""
@@ -151,6 +156,8 @@ class PortRow(QWidget):
             self._set_ref_text(binding.ref if binding is not None and binding.ref else "")
             return
         if binding is None:
+            if self.editor is not None:
+                self.editor.show_unset(self._default_shown())
             self._show_mode(MODE_UNSET)
         elif binding.is_ref:
             self._set_ref_text(binding.ref or "")
@@ -167,13 +174,17 @@ class PortRow(QWidget):
             self.editor.set_value(binding.value)
             self._show_mode(MODE_VALUE)
 
+    def _default_shown(self) -> Any:
+        """The port's default, for the editor of its first type (the default's own)."""
+        return self.port.default if self.value_type is self.types[0] else None
+
     def _set_ref_text(self, text: str) -> None:
         if self.ref_field.text() != text:
             self.ref_field.setText(text)
 
     def _show_mode(self, mode: int) -> None:
         self.mode_combo.setCurrentIndex(mode)
-        self.stack.setCurrentIndex(mode)
+        self.stack.setCurrentIndex(MODE_VALUE if mode == MODE_UNSET else mode)
         self.type_combo.setVisible(mode == MODE_VALUE and len(self.types) > 1)
 
     def _set_editor(self, ptype: ParamType) -> None:

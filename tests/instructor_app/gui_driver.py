@@ -383,11 +383,15 @@ def set_value(
     row: PortRow = window.views.inspector.port_row(port)
     if _bound_to(window, node_id, port, value):
         return  # a user leaves a binding that is already right
-    choose_index(qtbot, row.mode_combo, MODE_VALUE)
-    if ptype is not None and ptype is not row.value_type:
+    wrong_type = ptype is not None and ptype is not row.value_type
+    unset = row.mode == MODE_UNSET and not wrong_type  # its editor shows: enter it there
+    if row.mode != MODE_VALUE and not unset:
+        choose_index(qtbot, row.mode_combo, MODE_VALUE)
+    if wrong_type:
+        assert ptype is not None
         choose(qtbot, row.type_combo, ptype.value)
     assert row.editor is not None
-    if row.editor.value() != value:  # a user leaves a value that is already right
+    if unset or row.editor.value() != value:  # a user leaves a value that is already right
         _enter(qtbot, row.editor, value)
 
 

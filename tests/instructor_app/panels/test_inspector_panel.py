@@ -13,7 +13,7 @@ from capabilities.base import CapabilityRegistry
 from engine.spec import Binding, NodeKind, NodeSpec, ParameterDecl
 from engine.types import ParamType, Pose, Waypoint
 from instructor_app.document import PlanDocument
-from instructor_app.inspectors.editors import NumberEditor
+from instructor_app.inspectors.editors import ChoiceEditor, NumberEditor
 from instructor_app.inspectors.rows import MODE_REFERENCE, MODE_UNSET, MODE_VALUE
 from instructor_app.panels.inspector import InspectorPanel
 
@@ -239,3 +239,28 @@ def test_the_parameter_area_grows_with_the_panel(qtbot: QtBot, panel: InspectorP
     above = panel.parameter_area.geometry().top()
     assert panel.parameter_area.geometry().bottom() >= panel.height() - 10
     assert above < 200
+
+
+def test_an_unset_port_shows_its_editor_and_a_value_entered_there_binds_it(
+    qtbot: QtBot, panel: InspectorPanel, document: PlanDocument
+) -> None:
+    before = document.serialized()
+    panel.show_node("move")
+    row = panel.port_row("ticks")
+    assert row.mode == MODE_UNSET and row.stack.currentWidget() is row.editor  # no "value" first
+    assert isinstance(row.editor, NumberEditor) and row.editor.value() == 3  # its default
+    spin = row.editor.spin
+    spin.lineEdit().selectAll()
+    qtbot.keyClicks(spin, "123")
+    qtbot.keyClick(spin, Qt.Key.Key_Return)
+    assert document.node("move").params["ticks"] == Binding.fixed(123.0, ParamType.NUMBER)
+    assert document.undo_stack.count() == 1 and row.mode == MODE_VALUE
+    root = document.add_node(NodeSpec(NodeKind.PARALLEL, id="par"), "root")
+    panel.show_node(root)
+    policy = panel.port_row("success")
+    assert policy.mode == MODE_UNSET and policy.stack.currentWidget() is policy.editor
+    assert isinstance(policy.editor, ChoiceEditor) and policy.editor.value() == "all"
+    _choose(policy.editor.combo, policy.editor.combo.currentIndex())  # the one shown: bound
+    assert document.node("par").params["success"] == Binding.fixed("all", policy.value_type)
+    assert policy.mode == MODE_VALUE
+    _undo_all_restores(document, before)
