@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from capabilities.object_library import ObjectLibrary
-from capabilities.perception.recognizer import Recognizer
+from capabilities.perception.recognizer import Recognition, Recognizer
 from tests.capabilities.perception.shots import SCENES, Shot, take_shots
 
 
@@ -17,3 +17,11 @@ def shots() -> list[Shot]:
 @pytest.fixture(scope="session")
 def recognizer() -> Recognizer:
     return Recognizer(ObjectLibrary())
+
+
+@pytest.fixture(scope="session")
+def recognitions(shots: list[Shot], recognizer: Recognizer) -> list[list[Recognition]]:
+    """What the recognizer finds in each shot, in order. Recognition is deterministic (its
+    RANSAC is seeded), so the tests that score the same frames share one pass over them.
+    """
+    return [recognizer.recognize(shot.frame) for shot in shots]

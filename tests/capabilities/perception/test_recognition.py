@@ -11,15 +11,16 @@ import pytest
 from capabilities.perception.errors import PerceptionError
 from capabilities.perception.evaluation import score_recognitions, visible_fraction
 from capabilities.perception.geometry import pose_to_matrix, yaw_of
-from capabilities.perception.recognizer import Recognizer
+from capabilities.perception.recognizer import Recognition, Recognizer
 from capabilities.perception.scene_cloud import segment_scene
 from tests.capabilities.perception.shots import Shot
 
 
-def _scores(shots: list[Shot], recognizer: Recognizer) -> list:
+def _scores(
+    shots: list[Shot], recognitions: list[list[Recognition]], recognizer: Recognizer
+) -> list:
     scores = []
-    for shot in shots:
-        found = recognizer.recognize(shot.frame)
+    for shot, found in zip(shots, recognitions, strict=True):
         visible = {
             name: (model, pose)
             for name, (model, pose) in shot.truth.items()
@@ -29,8 +30,10 @@ def _scores(shots: list[Shot], recognizer: Recognizer) -> list:
     return scores
 
 
-def test_recall_and_pose_errors_meet_the_targets(shots: list[Shot], recognizer: Recognizer) -> None:
-    scores = _scores(shots, recognizer)
+def test_recall_and_pose_errors_meet_the_targets(
+    shots: list[Shot], recognitions: list[list[Recognition]], recognizer: Recognizer
+) -> None:
+    scores = _scores(shots, recognitions, recognizer)
     found = [s for s in scores if s.found]
     assert len(scores) >= 30
     assert len(found) / len(scores) >= 0.95, [s for s in scores if not s.found]
@@ -38,17 +41,19 @@ def test_recall_and_pose_errors_meet_the_targets(shots: list[Shot], recognizer: 
     assert statistics.median(s.rotation_error for s in found) < math.radians(5)
 
 
-def test_plates_are_classified_by_their_holes(shots: list[Shot], recognizer: Recognizer) -> None:
-    scores = [s for s in _scores(shots, recognizer) if s.model.startswith("plate_")]
+def test_plates_are_classified_by_their_holes(
+    shots: list[Shot], recognitions: list[list[Recognition]], recognizer: Recognizer
+) -> None:
+    scores = [s for s in _scores(shots, recognitions, recognizer) if s.model.startswith("plate_")]
     assert len(scores) >= 15
     right = sum(s.nearest_class == s.model for s in scores)
     assert right / len(scores) >= 0.95, [(s.model, s.nearest_class) for s in scores]
 
 
-def test_symmetric_objects_get_the_canonical_yaw(shots: list[Shot], recognizer: Recognizer) -> None:
+def test_symmetric_objects_get_the_canonical_yaw(recognitions: list[list[Recognition]]) -> None:
     yaws: dict[str, list[float]] = {}
-    for shot in shots[:4]:
-        for r in recognizer.recognize(shot.frame):
+    for found in recognitions[:4]:
+        for r in found:
             yaws.setdefault(r.object_class, []).append(yaw_of(pose_to_matrix(r.pose)[:3, :3]))
     assert all(abs(y) < 1e-6 for y in yaws["cup"])  # continuous symmetry: yaw 0
     assert all(-math.pi / 2 - 1e-6 <= y <= math.pi / 2 + 1e-6 for y in yaws["waste_bin"])
