@@ -4,10 +4,10 @@ Each plan (the paper's ``tending_paper.costar.json`` and ours, ``tending.costar.
 ``trials`` trials of ``parts`` parts on the ``tending`` scene (trial i on seed ``seed + i``;
 the same seeds, hence the same parts and faults, for both plans) through
 ``capabilities/sim/tending_trial.py``; the counters of the trials are added up as Table I
-does. The simulated cell runs in lockstep: its time stands still while perception computes
-(each job then takes ``PERCEPTION_S`` simulated seconds), and it never runs more than ``LEAD`` simulated seconds ahead of the engine's last tick (a
-50 Hz controller's view of the world); otherwise as fast as it can, or at ``speed`` times
-real time.
+does. The simulated cell runs in lockstep: it goes on only with the engine's 50 Hz ticks,
+its time stands still while perception computes (each job then takes ``PERCEPTION_S``
+simulated seconds), and the run starts at simulated time 0; otherwise as fast as it can, or
+at ``speed`` times real time. A trial is the same every time it runs with the same seed.
 """
 
 from __future__ import annotations
@@ -22,11 +22,17 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from capabilities.sim.session import PERCEPTION_S, SimCellSession
 from capabilities.sim.tending_score import TrialCounters
-from capabilities.sim.tending_trial import OperatorModel, TendingTrial
+from capabilities.sim.tending_trial import OperatorModel, TendingTrial, trial_session
 
-__all__ = ["PAPER", "PLANS", "TendingJob", "c_output_to_stderr", "measure_tending", "table_one"]
+__all__ = [
+    "PAPER",
+    "PLANS",
+    "TendingJob",
+    "c_output_to_stderr",
+    "measure_tending",
+    "table_one",
+]
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "resources" / "examples"
 PLANS = {"paper": EXAMPLES / "tending_paper.costar.json", "ours": EXAMPLES / "tending.costar.json"}
@@ -34,8 +40,7 @@ PLANS = {"paper": EXAMPLES / "tending_paper.costar.json", "ours": EXAMPLES / "te
 PAPER = {"produced": 100, "caught": 82, "bad_weld": 2, "bad_grasp": 5, "lost_to_stops": 13}
 PAPER_PROJECTED = 93  # % the authors projected with better error handling
 RESET_S = 30.0  # simulated seconds the operator takes to reset the cell (see the README)
-SPEED: float | None = None  # as fast as lockstep and LEAD allow
-LEAD = 0.1  # simulated s the world may run ahead of the engine's last tick
+SPEED: float | None = None  # as fast as lockstep allows
 
 
 @contextmanager
@@ -71,11 +76,9 @@ def run_trial(job: TendingJob) -> dict[str, Any]:
     """
     started = time.perf_counter()
     try:
-        with SimCellSession(
-            "tending", job.seed, speed=job.speed, start_actors=False, lockstep=PERCEPTION_S
-        ) as session:
+        with trial_session("tending", job.seed, job.speed) as session:
             operator = OperatorModel(reset_s=job.reset_s)
-            trial = TendingTrial(session, PLANS[job.plan], operator, lead=LEAD)
+            trial = TendingTrial(session, PLANS[job.plan], operator)
             counters = trial.run(parts=job.parts, wall_timeout=300.0 * job.parts)
             out: dict[str, Any] = counters.as_dict() | {"stops": trial.stops}
             out["lost_parts"] = trial.lost()  # what became of each, and what failed then

@@ -40,16 +40,13 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from bench._tending import (  # noqa: E402
-    LEAD,
-    PERCEPTION_S,
     PLANS,
     RESET_S,
-    SPEED,
     c_output_to_stderr,
 )
 from capabilities.sim.scene import default_scene_path  # noqa: E402
 from capabilities.sim.session import SimCellSession  # noqa: E402
-from capabilities.sim.tending_trial import OperatorModel, TendingTrial  # noqa: E402
+from capabilities.sim.tending_trial import OperatorModel, TendingTrial, trial_session  # noqa: E402
 
 WARM_FRACTION = 0.05  # of the simulated time: RSS after it is the baseline of growth
 PAGE = os.sysconf("SC_PAGE_SIZE")
@@ -152,10 +149,8 @@ def soak(plan: str, hours: float, seed: int, stall_s: float, sample_s: float) ->
     started = time.perf_counter()
     with tempfile.TemporaryDirectory() as folder:
         scene = soak_scene(Path(folder), hours)
-        with SimCellSession(
-            scene, seed, speed=SPEED, start_actors=False, lockstep=PERCEPTION_S
-        ) as s:
-            trial = TendingTrial(s, PLANS[plan], OperatorModel(reset_s=RESET_S), lead=LEAD)
+        with trial_session(scene, seed) as s:
+            trial = TendingTrial(s, PLANS[plan], OperatorModel(reset_s=RESET_S))
             ticks = TickClock(trial.executor.tree, trial.executor.period)
             watch, done = Watch(s, ticks, stall_s), threading.Event()
             watcher = threading.Thread(target=watch.run, args=(done, sample_s), daemon=True)

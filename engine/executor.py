@@ -128,6 +128,9 @@ class Executor:
             thrown into the plan's Catch nodes that take it, else the run is held.
         lockstep: the world to advance one period after each tick (see the module doc);
             None: ticks come by the wall clock.
+        inline: listeners called on the engine thread as each event happens, before the
+            other listeners hear it: for what must act at the tick itself (a simulated
+            cell's actors, in lockstep), quickly and without waiting on the engine.
     """
 
     def __init__(
@@ -138,6 +141,7 @@ class Executor:
         plan_name: str = "",
         hold: HoldCheck | None = None,
         lockstep: Lockstep | None = None,
+        inline: list[Listener] | None = None,
     ) -> None:
         if rate_hz <= 0:
             raise ValueError(f"rate must be above 0 Hz, not {rate_hz}")
@@ -158,6 +162,7 @@ class Executor:
         self._failures: list[str] = []  # leaf failure messages since the cell was last clear
         self._result: RunFinished | None = None
         self._done = threading.Event()
+        self._inline: list[Listener] = list(inline or [])
         self._dispatcher = _Dispatcher(self._listeners)
         self._thread = threading.Thread(target=self._run, name="costar-engine", daemon=True)
 
@@ -236,7 +241,7 @@ class Executor:
 
     def _attach(self) -> None:
         ctx = self.tree.ctx
-        put = self._dispatcher.put
+        put = self._emit
         clock = time.monotonic
 
         def on_status(node: Node, old: Status, new: Status) -> None:
@@ -277,7 +282,7 @@ class Executor:
                 self._cond.wait(remaining)
 
     def _run(self) -> None:
-        self._dispatcher.put(RunStarted(time.monotonic(), self.plan_name))
+        self._emit(RunStarted(time.monotonic(), self.plan_name))
         status: Status = RUNNING
         reason, message = "finished", ""
         next_tick = time.monotonic()
@@ -310,9 +315,7 @@ class Executor:
         try:
             lockstep.release()
         except Exception as exc:  # a closed cell: nothing to release
-            self._dispatcher.put(
-                LogMessage(0, "root", f"error ending the lockstep: {exc}", time.monotonic())
-            )
+            self._emit(LogMessage(0, "root", f"error ending the lockstep: {exc}", time.monotonic()))
 
     @property
     def held(self) -> str:
@@ -341,7 +344,7 @@ class Executor:
             for leaf in self.tree.running_leaves():
                 leaf.reset()
         self._held = reason
-        self._dispatcher.put(RunHeld(self.tree.ctx.tick_count, reason, time.monotonic()))
+        self._emit(RunHeld(self.tree.ctx.tick_count, reason, time.monotonic()))
         return bool(reason)
 
     def _thrown_now(self, hold: Hold | None) -> bool:
@@ -356,7 +359,7 @@ class Executor:
             return False
         throw(leaves, hold)
         for leaf in leaves:
-            self._dispatcher.put(
+            self._emit(
                 LogMessage(
                     self.tree.ctx.tick_count,
                     leaf.id,
@@ -367,13 +370,22 @@ class Executor:
         self._thrown = hold
         return True
 
+    def _emit(self, event: Event) -> None:
+        """Hand an event to the inline listeners now, then to the dispatcher (engine thread)."""
+        for listener in self._inline:
+            try:
+                listener(event)
+            except Exception as exc:  # a broken listener must not end the run
+                self._dispatcher.put(
+                    LogMessage(0, "root", f"a listener failed: {exc}", time.monotonic())
+                )
+        self._dispatcher.put(event)
+
     def _halt_all(self) -> None:
         try:
             self.tree.reset()
         except Exception as exc:
-            self._dispatcher.put(
-                LogMessage(0, "root", f"error while halting: {exc}", time.monotonic())
-            )
+            self._emit(LogMessage(0, "root", f"error while halting: {exc}", time.monotonic()))
 
     def _finish(self, status: Status, reason: str, message: str) -> None:
         # A stopped run reports the status of its last tick (RUNNING when it was cut short).
@@ -381,7 +393,7 @@ class Executor:
             self.tree.ctx.tick_count, status, reason, message, time.monotonic()
         )
         self._state = ExecutorState.FINISHED
-        self._dispatcher.put(self._result)
+        self._emit(self._result)
         self._dispatcher.close()
         self._done.set()
 

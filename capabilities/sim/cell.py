@@ -192,13 +192,12 @@ class SimCell(ClosesOnExit):
         """End the lockstep of :meth:`advance`: the world runs free again."""
         self._physics.release()
 
-    def add_gate(self, may_step: Callable[[], bool]) -> None:
-        """Step only while ``may_step()`` says True (see ``PhysicsThread.add_gate``)."""
-        self._physics.add_gate(may_step)
-
-    def nudge(self) -> None:
-        """Look at the gates again now (see ``PhysicsThread.nudge``)."""
-        self._physics.nudge()
+    def at(self, when: float, fn: Callable[[], None]) -> None:
+        """Run ``fn()`` on the physics thread once simulated time reaches ``when`` (at the
+        next step when it already has; dropped when the cell closes first): what an actor
+        does at a set simulated time, the same in every run however loaded the machine.
+        """
+        self._physics.at(when, fn)
 
     def wait_sim(self, seconds: float) -> None:
         """Block until simulated time has advanced by ``seconds`` (tests, CLI)."""

@@ -12,12 +12,17 @@ its first N), and scores it as Table I does (``tending_score``). As on site:
   and reset ... the bender kept producing parts") the operator clears away what lies loose in
   the cell (parts and pieces at the exit or dropped: lost), unlocks a protective stop and
   presses Continue.
-- With ``lead`` the world never runs more than ``lead`` simulated seconds ahead of the
-  engine's last tick (a gate of the physics thread): with a lockstep session (time stands
-  still while perception computes) a run as fast as possible then reacts as a 50 Hz
-  controller would, however loaded the machine.
+- The session runs in lockstep (``SimCellSession(lockstep=..., still_until_run=True)``):
+  the world goes on only with the engine's ticks, perception holds it, and the run begins at
+  simulated time 0. What the trial does happens at set simulated times on the engine or the
+  physics thread, never when a thread of its own wakes up: the bender starts at the tick its
+  first watch began (an inline listener), the operator acts on the physics thread
+  ``reset_s`` after the tick that called, and the trial looks at the cell there every
+  ``POLL`` s. The same plan, scene, seed and faults give the same trial, however loaded the
+  machine.
 - The trial ends once the bender released its last part and everything settled (every
-  part in a tote or taken away), or ``tail`` simulated seconds after that last release.
+  part in a tote or taken away), or ``tail`` simulated seconds after that last release; it
+  is scored ``SETTLE`` s later.
 
 Ground truth (the bender's events, object poses) is read only to score and to play the
 operator, never by the plan.
@@ -26,15 +31,18 @@ operator, never by the plan.
 from __future__ import annotations
 
 import threading
-import time
+from concurrent.futures import Future
+from concurrent.futures import TimeoutError as FutureTimeout
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from capabilities.base import CapabilityRegistry
 from capabilities.bullet import pybullet as p
 from capabilities.faults import hold_check
+from capabilities.sim.bender_spec import FaultModel
 from capabilities.sim.errors import SimError
-from capabilities.sim.session import SimCellSession
+from capabilities.sim.session import PERCEPTION_S, SimCellSession
 from capabilities.sim.tending_score import TrialCounters, loose_things, lost_parts, score_trial
 from engine.build import build_tree
 from engine.events import Event, RunHeld, StatusChanged
@@ -44,7 +52,7 @@ from engine.hold import Hold
 from engine.status import Status
 from engine.validation import has_errors, validate_plan
 
-__all__ = ["OperatorModel", "TendingTrial", "TrialError"]
+__all__ = ["OperatorModel", "TendingTrial", "TrialError", "trial_session"]
 
 OPERATOR_OPS = frozenset({"collaboration.wait_for_button"})
 WATCH_PREFIX = "occupancy."  # the first of these to run starts the bender
@@ -70,15 +78,32 @@ class OperatorModel:
     present: bool = True
 
 
+def trial_session(
+    scene: str | Path, seed: int, speed: float | None = None, faults: FaultModel | None = None
+) -> SimCellSession:
+    """A session for a :class:`TendingTrial`: in lockstep from simulated time 0, the bender
+    waiting for the plan's first watch; as fast as it can (``speed`` None) or paced.
+    """
+    return SimCellSession(
+        scene,
+        seed,
+        speed=speed,
+        faults=faults,
+        start_actors=False,
+        lockstep=PERCEPTION_S,
+        still_until_run=True,
+    )
+
+
 class TendingTrial:
     """One trial of ``plan`` on ``session`` (whose scene has a bender not started yet).
 
     Args:
-        session: a session made with ``start_actors=False``.
+        session: a session in lockstep from simulated time 0 with the bender not started:
+            :func:`trial_session`.
         plan: the plan file.
         operator: who answers the plan's calls.
         rate_hz: the executor's tick rate.
-        lead: simulated seconds the world may run ahead of the engine (None: no bound).
 
     Attributes:
         calls: simulated times at which the plan (or a held run) called the operator.
@@ -93,20 +118,24 @@ class TendingTrial:
         plan: Path,
         operator: OperatorModel | None = None,
         rate_hz: float = 50.0,
-        lead: float | None = None,
     ) -> None:
         if session.bender is None:
             raise TrialError(f"the scene {session.scene.name!r} has no wire bender")
+        lockstep = session.run_lockstep()
+        if lockstep is None:
+            raise TrialError("a trial needs a session in lockstep (SimCellSession(lockstep=...))")
         self.session = session
         self.operator = operator or OperatorModel()
         self.calls: list[float] = []
         self.stops: list[str] = []
         self.failures: list[tuple[float, str]] = []
         self._lock = threading.Lock()
-        self._pending: list[tuple[float, bool]] = []  # when the operator resets; press?
+        self._pending = 0  # operator calls not answered yet
         self._removed: set[int] = set()
         self._last_failure = ""
-        self._engine_at: float | None = None  # simulated time of the engine's last tick
+        self._over = threading.Event()  # the trial is over: the engine stops at its next tick
+        self._scored: Future[tuple[TrialCounters, list[dict[str, Any]]]] = Future()
+        self._lost: list[dict[str, Any]] | None = None  # lost parts when scored
         registry = CapabilityRegistry(cell=session)
         spec = load_plan(plan, registry.aliases())
         problems = validate_plan(spec, registry)
@@ -121,25 +150,19 @@ class TendingTrial:
                 self._nodes.setdefault(node.id, (f"{sub.name}/{node.label}", node.op or ""))
         tree = build_tree(spec, registry, clock=session.clock)
         self._cell_hold = hold_check(session)
-        self.executor = Executor(tree, rate_hz, [self._heard], hold=self._before_tick)
-        if lead is not None:
-            bound = lead
-            session.sim.add_gate(lambda: self._lag() <= bound)
+        self.executor = Executor(
+            tree, rate_hz, hold=self._before_tick, lockstep=lockstep, inline=[self._heard]
+        )
 
     # ------------------------------------------------------------------ the engine
 
     def _before_tick(self) -> Hold | None:
-        """The executor's hold check, asked before every tick: the engine is here now."""
-        self._engine_at = self.session.clock()
-        self.session.sim.nudge()
+        """The executor's hold check, asked before every tick (engine thread, the world
+        standing still): the trial ends here once it is over, at the same tick every run.
+        """
+        if self._over.is_set():
+            self.executor.stop("trial over")
         return self._cell_hold() if self._cell_hold is not None else None
-
-    def _lag(self) -> float:
-        """How far the world is ahead of the engine (0 before it starts, once it ended)."""
-        at = self._engine_at
-        if at is None or self.executor.result is not None:
-            return 0.0
-        return self.session.clock() - at
 
     def ended(self) -> str:
         """How the plan's run ended ("" while it runs or when the trial stopped it)."""
@@ -155,6 +178,9 @@ class TendingTrial:
         return self._nodes.get(node_id.rsplit("/", 1)[-1], ("", ""))
 
     def _heard(self, event: Event) -> None:
+        """An inline listener: on the engine thread, at the tick of the event (the world
+        stands still meanwhile, so "now" is the tick's simulated time).
+        """
         if isinstance(event, RunHeld) and event.reason:
             self._call(f"held: {event.reason}", press=False)
         if not isinstance(event, StatusChanged):
@@ -178,23 +204,24 @@ class TendingTrial:
         with self._lock:
             self.calls.append(now)
             self.stops.append(why)
-            if self.operator.present:
-                self._pending.append((now + self.operator.reset_s, press))
+            if not self.operator.present:
+                return
+            self._pending += 1
+        self.session.sim.at(now + self.operator.reset_s, lambda: self._reset(press))
 
     # ------------------------------------------------------------------ the operator
 
-    def _operate(self) -> None:
-        """Reset the cell and press Continue for each call whose reset time has come."""
-        now = self.session.clock()
+    def _reset(self, press: bool) -> None:
+        """On the physics thread, ``reset_s`` after a call: clear the cell, unlock a
+        protective stop and press Continue if the plan waits for it.
+        """
+        self._clear_cell()
+        if self.session.hold_reason():
+            self.session.clear()  # on the pendant: unlocks once the delay allows
+        if press:
+            self.session.operator.press("continue")
         with self._lock:
-            due = [press for t, press in self._pending if t <= now]
-            self._pending = [(t, press) for t, press in self._pending if t > now]
-        for press in due:
-            self._clear_cell()
-            if self.session.hold_reason():
-                self.session.clear()  # on the pendant: unlocks once the delay allows
-            if press:
-                self.session.operator.press("continue")
+            self._pending -= 1
 
     def _clear_cell(self) -> None:
         """Take away every loose part and piece (as the operator does: they are lost)."""
@@ -212,7 +239,7 @@ class TendingTrial:
         session.sim.call(clear)
 
     def _settled(self) -> bool:
-        """Nothing loose, nothing held, no call of the operator open."""
+        """Nothing loose, nothing held, no call of the operator open (physics thread)."""
         session, bender = self.session, self.session.bender
         assert bender is not None
         with self._lock:
@@ -251,35 +278,48 @@ class TendingTrial:
             if bender.start_time is not None:
                 raise TrialError("the bender already started: its parts are set")
             bender.plan = bender.plan[:parts]
-        deadline = None if wall_timeout is None else time.monotonic() + wall_timeout
-        self._engine_at = self.session.clock()  # the gate holds until the engine ticks
+        sim = self.session.sim
+        sim.at(sim.time() + POLL, lambda: self._look(tail, until))
         self.executor.start()
         try:
-            self._run_until_done(tail, deadline, until)
+            counters, self._lost = self._scored.result(wall_timeout)
+        except FutureTimeout:
+            at = self.session.clock()
+            raise TrialError(f"the trial ran out of wall time at {at:.0f} s") from None
         finally:
             self.executor.stop("trial over")
             self.executor.wait(10.0)
-            self._engine_at = None  # no engine any more: the world goes on
-        self.session.sim.wait_sim(SETTLE)
-        return self.score()
+        return counters
 
-    def _run_until_done(self, tail: float, deadline: float | None, until: float | None) -> None:
-        session, bender = self.session, self.session.bender
+    def _look(self, tail: float, until: float | None) -> None:
+        """On the physics thread every ``POLL`` s: is the trial over? Then it is scored
+        ``SETTLE`` s later, there too.
+        """
+        if not self._is_over(tail, until):
+            self.session.sim.at(self.session.clock() + POLL, lambda: self._look(tail, until))
+            return
+        self._over.set()
+        self.session.sim.at(self.session.clock() + SETTLE, self._score_now)
+
+    def _is_over(self, tail: float, until: float | None) -> bool:
+        bender = self.session.bender
         assert bender is not None
-        while self.executor.result is None:
-            if deadline is not None and time.monotonic() > deadline:
-                raise TrialError(f"the trial ran out of wall time at {session.clock():.0f} s")
-            session.sim.wait_sim(POLL)
-            self._operate()
-            start = bender.start_time
-            if until is not None and start is not None and session.clock() - start >= until:
-                return
-            released = bender.produced()
-            if not bender.plan or len(released) < len(bender.plan):
-                continue
-            since = session.clock() - released[-1].time
-            if since >= tail or (since > SETTLE and self._settled()):
-                return
+        if self.executor.result is not None:  # the plan ended: nothing more will happen
+            return True
+        now, start = self.session.clock(), bender.start_time
+        if until is not None and start is not None and now - start >= until:
+            return True
+        released = bender.produced()
+        if not bender.plan or len(released) < len(bender.plan):
+            return False
+        since = now - released[-1].time
+        return since >= tail or (since > SETTLE and self._settled())
+
+    def _score_now(self) -> None:
+        try:
+            self._scored.set_result((self.score(), self._lost_now()))
+        except Exception as exc:  # a score that cannot be made ends the trial with it
+            self._scored.set_exception(exc)
 
     def score(self) -> TrialCounters:
         """Table I's counters now (ground truth)."""
@@ -295,15 +335,23 @@ class TendingTrial:
 
         return session.sim.call(count)
 
-    def lost(self) -> list[dict[str, object]]:
-        """Each lost part's fault and whereabouts, with the failures around it (ground truth,
-        for the bench's report): the failures from 5 s before its release to 40 s after.
-        """
+    def _lost_now(self) -> list[dict[str, Any]]:
         session, bender = self.session, self.session.bender
         assert bender is not None
-        report = session.sim.call(
+        return session.sim.call(
             lambda client: lost_parts(client, bender, session.scene, self._removed)
         )
+
+    def lost(self) -> list[dict[str, Any]]:
+        """Each lost part's fault and whereabouts when the trial was scored (now, before),
+        with the failures around it (ground truth, for the bench's report): the failures
+        from 5 s before its release to 40 s after.
+        """
+        bender = self.session.bender
+        assert bender is not None
+        report = [
+            dict(part) for part in (self._lost if self._lost is not None else self._lost_now())
+        ]
         start = bender.start_time or 0.0
         for part in report:
             at = float(part["released"])

@@ -3,7 +3,7 @@ the ``tending`` scene: each fault is recovered by its library subtree with no op
 slipped grasp by Regrasp, a broken weld by DiscardToScrap, a moved rack by ReRegisterRack,
 a collision while placing by ClearStopAndBackOff and ReRegisterRack). Each is also a short
 trial of ours (one or two parts). The cell runs in
-lockstep (its time stands while perception computes), as the benches run it. Ground truth
+lockstep from simulated time 0 (``trial_session``), as the benches run it. Ground truth
 is read here only, to set the faults up and to score.
 """
 
@@ -20,14 +20,13 @@ from capabilities.sim.bender_spec import FaultModel, plan_parts
 from capabilities.sim.objects import set_object_frame_pose
 from capabilities.sim.session import SimCellSession
 from capabilities.sim.tending_score import TrialCounters, container_of
-from capabilities.sim.tending_trial import OperatorModel, TendingTrial
+from capabilities.sim.tending_trial import OperatorModel, TendingTrial, trial_session
 from engine.events import Event, StatusChanged
 from engine.status import Status
 from engine.types import Pose
 from tests.capabilities.sim.test_bender import tending_scene
 
 PLAN = Path(__file__).resolve().parents[3] / "resources" / "examples" / "tending.costar.json"
-LEAD = 0.1  # s the world may run ahead of the engine (as bench/_tending.py)
 NOBODY = OperatorModel(present=False)  # ours never calls the operator
 
 
@@ -51,7 +50,7 @@ def _seed_with(
 
 
 def _session(scene: Path, seed: int, rates: FaultModel) -> SimCellSession:
-    return SimCellSession(scene, seed, speed=None, faults=rates, start_actors=False, lockstep=True)
+    return trial_session(scene, seed, faults=rates)
 
 
 class _Watched(TendingTrial):
@@ -59,7 +58,7 @@ class _Watched(TendingTrial):
 
     def __init__(self, session: SimCellSession) -> None:
         self.ran: set[str] = set()
-        super().__init__(session, PLAN, NOBODY, lead=LEAD)
+        super().__init__(session, PLAN, NOBODY)
 
     def _heard(self, event: Event) -> None:
         super()._heard(event)

@@ -14,14 +14,11 @@ from capabilities.sim.bender import read_bender
 from capabilities.sim.bender_spec import FaultModel, plan_parts
 from capabilities.sim.session import SimCellSession
 from capabilities.sim.tending_score import TrialCounters, container_of
-from capabilities.sim.tending_trial import OperatorModel, TendingTrial
+from capabilities.sim.tending_trial import OperatorModel, TendingTrial, trial_session
+from engine.events import StatusChanged
 from tests.capabilities.sim.test_bender import tending_scene
 
 PLAN = Path(__file__).resolve().parents[3] / "resources" / "examples" / "tending_paper.costar.json"
-# Paced: perception takes wall time, and as fast as possible a part could come and go while
-# a camera's image is searched. Twice real time leaves room for a loaded CI machine (at four
-# times, two parallel test workers made the robot miss part 2 once).
-SPEED = 2.0
 
 
 def _where(session: SimCellSession, part: str) -> str:
@@ -47,9 +44,7 @@ def test_a_bad_weld_stops_the_robot_until_the_operator_resets_it(tmp_path: Path)
     scene = tending_scene(tmp_path, parts=2, interval=18.0)
     faults = FaultModel(bad_weld=0.5, bad_grasp=0.0, interval_spread=0.0)
     seed = _seed_with([True, False], faults, scene)
-    # The shoulder camera at its full 640 x 480: at 320 x 240 the rack's marker is too small
-    # to be found from some of the rack's poses.
-    with SimCellSession(scene, seed, speed=SPEED, faults=faults, start_actors=False) as session:
+    with trial_session(scene, seed, faults=faults) as session:
         trial = TendingTrial(session, PLAN, OperatorModel(reset_s=2.0))
         counters = trial.run(tail=30.0, wall_timeout=300.0)
         bender = session.bender
@@ -69,7 +64,9 @@ def test_a_bad_weld_stops_the_robot_until_the_operator_resets_it(tmp_path: Path)
 
 
 def test_a_plan_that_ends_early_ends_the_trial_even_in_lockstep(tmp_path: Path) -> None:
-    """The engine stops ticking when its plan ends: the world must not wait for it (lead)."""
+    """The engine stops ticking when its plan ends: the world, no longer driven by it, runs
+    on by itself and the trial ends.
+    """
     paper = json.loads(PLAN.read_text(encoding="utf-8"))
     watch = next(n for n in _nodes(paper["tree"]) if n.get("name") == "wait for the welding arm")
     fail = {"id": "f" * 32, "kind": "operation", "name": "give up", "op": "debug.fail"}
@@ -78,11 +75,39 @@ def test_a_plan_that_ends_early_ends_the_trial_even_in_lockstep(tmp_path: Path) 
     plan = tmp_path / "ends_early.costar.json"
     plan.write_text(json.dumps(paper), encoding="utf-8")
     scene = tending_scene(tmp_path, parts=2)
-    with SimCellSession(scene, 3, start_actors=False, lockstep=0.1) as session:
-        trial = TendingTrial(session, plan, OperatorModel(), lead=0.1)
+    with trial_session(scene, 3) as session:
+        trial = TendingTrial(session, plan, OperatorModel())
         counters = trial.run(wall_timeout=120.0)
         assert trial.ended().startswith("FAILURE")
         assert counters.produced == 1  # the trial ended with the plan, at the first part
+
+
+def _trial_record(scene: Path, seed: int, faults: FaultModel) -> tuple[list[Any], list[float]]:
+    """Every status change (tick, node, status) of a one-part trial, and the operator's calls."""
+    with trial_session(scene, seed, faults=faults) as session:
+        trial = TendingTrial(session, PLAN, OperatorModel(reset_s=2.0))
+        changes: list[Any] = []
+        trial.executor.add_listener(
+            lambda e: (
+                changes.append((e.tick, e.node_id, e.new)) if isinstance(e, StatusChanged) else None
+            )
+        )
+        trial.run(tail=20.0, wall_timeout=300.0)
+        return changes, trial.calls
+
+
+def test_a_trial_run_again_with_its_seed_is_the_same_trial(tmp_path: Path) -> None:
+    """In lockstep from simulated time 0, with the bender started and the operator acting at
+    set simulated times: the same seed gives the same node changes at the same ticks, and
+    the operator is called at the same moment (a bad weld stops the paper's plan).
+    """
+    scene = tending_scene(tmp_path, parts=1)
+    faults = FaultModel(bad_weld=1.0, bad_grasp=0.0)
+    first, calls = _trial_record(scene, 5, faults)
+    again, calls_again = _trial_record(scene, 5, faults)
+    assert len(first) > 20 and len(calls) == 1
+    assert again == first
+    assert calls_again == calls
 
 
 def _nodes(node: dict[str, Any]) -> list[dict[str, Any]]:
