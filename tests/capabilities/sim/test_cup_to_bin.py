@@ -15,7 +15,7 @@ import pytest
 
 from capabilities.base import CapabilityRegistry
 from capabilities.cli import main as costar
-from capabilities.sim.session import SimCellSession
+from capabilities.sim.session import PERCEPTION_S, SimCellSession
 from engine.build import build_tree
 from engine.executor import run_to_end
 from engine.files import load_plan
@@ -42,12 +42,13 @@ def _run(session: SimCellSession, timeout: float = 60.0) -> Status:
     plan = load_plan(PLAN, registry.aliases())
     assert not has_errors(validate_plan(plan, registry))
     tree = build_tree(plan, registry, clock=session.clock)
-    return run_to_end(tree, rate_hz=50.0, timeout=timeout).status
+    return run_to_end(tree, 50.0, timeout, lockstep=session.run_lockstep()).status
 
 
 @pytest.mark.parametrize("seed", range(20))
 def test_cup_ends_in_the_bin(seed: int) -> None:
-    with SimCellSession("cup_to_bin", seed=seed) as session:
+    # In lockstep from simulated time 0, as `costar run` runs it: the same run every time.
+    with SimCellSession("cup_to_bin", seed, lockstep=PERCEPTION_S, still_until_run=True) as session:
         assert _run(session) is Status.SUCCESS
         session.sim.wait_sim(1.0)  # let the cup settle
         assert cup_in_bin(session.truth_pose("cup"), session.truth_pose("waste_bin"))

@@ -34,14 +34,15 @@ def _run(session: SimCellSession, timeout: float = 60.0) -> tuple[Status, str]:
     plan = load_plan(PLAN, registry.aliases())
     assert not has_errors(validate_plan(plan, registry))
     tree = build_tree(plan, registry, clock=session.clock)
-    result = run_to_end(tree, rate_hz=50.0, timeout=timeout)
+    result = run_to_end(tree, 50.0, timeout, lockstep=session.run_lockstep())
     messages = " | ".join(f"{n.name}: {n.message}" for n in tree.iterate() if n.message)
     return result.status, messages
 
 
 @pytest.mark.parametrize("seed", range(20))
 def test_cup_ends_in_the_bin(seed: int) -> None:
-    with SimCellSession("cup_to_bin", seed=seed, lockstep=PERCEPTION_S) as session:
+    # In lockstep from simulated time 0, as `costar run` runs it: the same run every time.
+    with SimCellSession("cup_to_bin", seed, lockstep=PERCEPTION_S, still_until_run=True) as session:
         status, messages = _run(session)
         assert status is Status.SUCCESS, messages
         session.sim.wait_sim(1.0)  # let the cup settle
