@@ -61,6 +61,8 @@ _BINDING: dict[Tok, int] = {
 }
 _PREFIXES = {Tok.MINUS: "-", Tok.TILDE: "~", Tok.NOT: "!"}
 _INT64 = 2**63
+# How deeply a script may nest (parentheses, operators): the evaluator recurses as deep.
+MAX_DEPTH = 200
 
 
 class _Parser:
@@ -68,6 +70,8 @@ class _Parser:
         self.tokens = tokens
         self.at = 0
         self.where = where
+        self.nesting = 0
+        self.depths: dict[int, int] = {}  # id(expr) -> how deep its tree is
 
     def peek(self) -> Token:
         return self.tokens[self.at]
@@ -79,7 +83,8 @@ class _Parser:
         return token
 
     def error(self, token: Token, why: str) -> ScriptSyntaxError:
-        return ScriptSyntaxError(why, *self.where(token.pos))
+        """The error at ``token``; at a malformed token, what that token lacks."""
+        return ScriptSyntaxError(token.why or why, *self.where(token.pos))
 
     def expect(self, kind: Tok, what: str) -> Token:
         token = self.peek()
@@ -95,7 +100,27 @@ class _Parser:
                 self.advance()
         return found
 
+    def made(self, expr: Expr, *parts: Expr) -> Expr:
+        """``expr``, whose parts are ``parts``, once its depth is checked."""
+        depth = 1 + max((self.depths.get(id(p), 1) for p in parts), default=0)
+        if depth > MAX_DEPTH:
+            raise ScriptSyntaxError(
+                f"the script nests too deeply (more than {MAX_DEPTH} levels)", *self.where(expr.pos)
+            )
+        self.depths[id(expr)] = depth
+        return expr
+
     def expression(self, min_binding: int) -> Expr:
+        self.nesting += 1
+        if self.nesting > MAX_DEPTH:
+            why = f"the script nests too deeply (more than {MAX_DEPTH} levels)"
+            raise self.error(self.peek(), why)
+        try:
+            return self._expression(min_binding)
+        finally:
+            self.nesting -= 1
+
+    def _expression(self, min_binding: int) -> Expr:
         left = self.prefix()
         while True:
             kind = self.peek().kind
@@ -110,13 +135,15 @@ class _Parser:
                 left = self.comparison(left)
                 continue
             token = self.advance()
-            left = Binary(token.pos, token.text, left, self.expression(binding + 1))
+            right = self.expression(binding + 1)
+            left = self.made(Binary(token.pos, token.text, left, right), left, right)
 
     def prefix(self) -> Expr:
         token = self.advance()
         kind = token.kind
         if kind in _PREFIXES:
-            return Unary(token.pos, _PREFIXES[kind], self.expression(_PREFIX))
+            operand = self.expression(_PREFIX)
+            return self.made(Unary(token.pos, _PREFIXES[kind], operand), operand)
         if kind is Tok.LPAREN:
             inside = self.expression(0)
             self.expect(Tok.RPAREN, "')'")
@@ -133,8 +160,6 @@ class _Parser:
             if token.text == "@":
                 raise self.error(token, "expected a name after '@'")
             return Name(token.pos, token.text)
-        if kind is Tok.ERROR:
-            raise self.error(token, token.why)
         raise self.error(token, f"expected a value, got {_shown(token)}")
 
     def integer(self, token: Token) -> int:
@@ -148,13 +173,15 @@ class _Parser:
         token = self.advance()
         if not isinstance(target, Name):
             raise self.error(token, f"expected an entry's name left of {token.text!r}")
-        return Assign(token.pos, token.text, target.name, self.expression(0))
+        value = self.expression(0)
+        return self.made(Assign(token.pos, token.text, target.name, value), value)
 
     def ternary(self, condition: Expr) -> Expr:
         token = self.advance()
         then = self.expression(0)
         self.expect(Tok.COLON, "':' of '?:'")
-        return Ternary(token.pos, condition, then, self.expression(_TERNARY))
+        otherwise = self.expression(_TERNARY)
+        return self.made(Ternary(token.pos, condition, then, otherwise), condition, then, otherwise)
 
     def comparison(self, first: Expr) -> Expr:
         ops: list[str] = []
@@ -163,7 +190,7 @@ class _Parser:
         while self.peek().kind in _COMPARISONS:
             ops.append(self.advance().text)
             operands.append(self.expression(_COMPARISON + 1))
-        return Compare(pos, tuple(ops), tuple(operands))
+        return self.made(Compare(pos, tuple(ops), tuple(operands)), *operands)
 
 
 def _shown(token: Token) -> str:
