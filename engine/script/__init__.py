@@ -19,8 +19,8 @@ How values are typed: :mod:`engine.script.values`; the operators:
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from dataclasses import dataclass
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, fields
 from typing import Any
 
 from engine.blackboard import Blackboard
@@ -32,12 +32,13 @@ from engine.script.errors import (
     ScriptTypeError,
     line_column,
 )
-from engine.script.expressions import Expr
+from engine.script.expressions import Assign, Expr, Name
 from engine.script.parser import parse_statements
 from engine.script.values import ScriptEnv, ValueProblem, as_bool
 
 __all__ = [
     "Script",
+    "ScriptNames",
     "ScriptEnv",
     "ScriptError",
     "ScriptNameError",
@@ -46,6 +47,7 @@ __all__ = [
     "ScriptTypeError",
     "parse_script",
     "run_script",
+    "script_names",
 ]
 
 
@@ -88,6 +90,56 @@ class Script:
         except ValueProblem as exc:
             line, column = self._where(self.statements[-1].pos)
             raise ScriptTypeError(f"the script's value: {exc}", line, column) from None
+
+
+@dataclass(frozen=True)
+class ScriptNames:
+    """The entries a script reads and writes, for validation (``@`` names left out).
+
+    Attributes:
+        reads: names read before the script itself has written them, in order.
+        writes: every name it may write (in any branch).
+        sure: the names it has written whenever it ran to its end (its statements' own
+            assignments, not those inside a branch or an operand).
+    """
+
+    reads: tuple[str, ...]
+    writes: tuple[str, ...]
+    sure: tuple[str, ...]
+
+
+def _parts(expr: Expr) -> Iterator[Expr]:
+    """``expr`` and every part inside it, in evaluation order (an assignment's value first)."""
+    for f in fields(expr):
+        value = getattr(expr, f.name)
+        for item in value if isinstance(value, tuple) else (value,):
+            if isinstance(item, Expr):
+                yield from _parts(item)
+    yield expr
+
+
+def script_names(script: Script) -> ScriptNames:
+    """The names ``script`` reads and writes (see :class:`ScriptNames`)."""
+    reads: dict[str, None] = {}
+    writes: dict[str, None] = {}
+    sure: dict[str, None] = {}
+    for statement in script.statements:
+        for part in _parts(statement):
+            if isinstance(part, Name) and part.name not in writes:
+                reads[part.name] = None
+            elif isinstance(part, Assign):
+                if part.op != ":=" and part.name not in writes:  # = needs the entry too
+                    reads[part.name] = None
+                writes[part.name] = None
+        chain: Expr = statement
+        while isinstance(chain, Assign):
+            sure[chain.name] = None
+            chain = chain.value
+
+    def plain(names: dict[str, None]) -> tuple[str, ...]:
+        return tuple(n for n in names if not n.startswith("@"))
+
+    return ScriptNames(plain(reads), plain(writes), plain(sure))
 
 
 def parse_script(text: str) -> Script:
