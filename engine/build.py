@@ -35,7 +35,7 @@ from engine.error_types import parse_error_types
 from engine.errors import EngineError
 from engine.instances import ROOT_SCOPE, InputCopy, Scope, SubtreeInstance
 from engine.kinds import settings_of
-from engine.leaves import OperationLeaf, Wait
+from engine.leaves import OperationLeaf, ScriptLeaf, Wait
 from engine.node import Node
 from engine.operations import Direction, OperationNotFound, OperationSource
 from engine.spec import NodeKind, NodeSpec, PlanSpec
@@ -74,7 +74,7 @@ def _policy(value: str | float) -> str | int:
     return value if isinstance(value, str) else int(value)
 
 
-def _logic_node(spec: NodeSpec, ctx: TreeContext, node_id: str) -> Node:
+def _logic_node(spec: NodeSpec, ctx: TreeContext, node_id: str, scope: Scope) -> Node:
     simple = _SIMPLE.get(spec.kind)
     if simple is not None:
         return simple(ctx, node_id, spec.label)
@@ -100,6 +100,10 @@ def _logic_node(spec: NodeSpec, ctx: TreeContext, node_id: str) -> Node:
         NodeKind.WAIT: lambda: Wait(ctx, node_id, label, float(cfg["seconds"])),
         NodeKind.CATCH: lambda: Catch(
             ctx, node_id, label, parse_error_types(str(cfg["errors"])), str(cfg["error"])
+        ),
+        NodeKind.SCRIPT: lambda: ScriptLeaf(ctx, node_id, label, cfg["code"], key=scope.key),
+        NodeKind.SCRIPT_CONDITION: lambda: ScriptLeaf(
+            ctx, node_id, label, cfg["code"], condition=True, key=scope.key
         ),
     }
     return factories[spec.kind]()
@@ -202,12 +206,12 @@ def _build_node(spec: NodeSpec, build: _Build, path: str, scope: Scope) -> Node:
         if spec.kind is NodeKind.OPERATION:
             node = _operation_leaf(spec, build, path, scope)
         else:
-            node = _logic_node(spec, build.ctx, scope.node_id(spec.id))
+            node = _logic_node(spec, build.ctx, scope.node_id(spec.id), scope)
         children = [
             _build_node(child, build, f"{path}/{child.label}[{index}]", scope)
             for index, child in enumerate(spec.children)
         ]
-        if isinstance(node, (OperationLeaf, Wait)):
+        if isinstance(node, (OperationLeaf, Wait, ScriptLeaf)):
             if children:
                 raise BuildError(path, f"{with_article(spec.kind.value)} node cannot have children")
         else:

@@ -16,6 +16,7 @@ from typing import Any
 
 from engine.error_types import parse_error_types
 from engine.operations import PortSpec
+from engine.script import ScriptSyntaxError, parse_script
 from engine.spec import Binding, NodeKind
 from engine.types import ParamType
 
@@ -79,7 +80,14 @@ KIND_PORTS: dict[NodeKind, tuple[PortSpec, ...]] = {
     NodeKind.RETRY: (_count("count", "how many attempts"),),
     NodeKind.TIMEOUT: (_seconds("seconds", "time limit"),),
     NodeKind.WAIT: (_seconds("seconds", "how long to wait"),),
+    NodeKind.SCRIPT: (
+        PortSpec("code", (_T,), doc="the script: statements of BehaviorTree.CPP's language"),
+    ),
+    NodeKind.SCRIPT_CONDITION: (
+        PortSpec("code", (_T,), doc="the script; its last value, true or false, is the answer"),
+    ),
 }
+_SCRIPT_KINDS = (NodeKind.SCRIPT, NodeKind.SCRIPT_CONDITION)
 
 # What a fixed value of each port must be beyond its type: (minimum, whole number).
 _LIMITS: dict[tuple[NodeKind, str], tuple[float, bool]] = {
@@ -114,6 +122,9 @@ KIND_DOC: dict[NodeKind, str] = {
     NodeKind.FORCE_SUCCESS: "Succeeds once its child has finished.",
     NodeKind.FORCE_FAILURE: "Fails once its child has finished.",
     NodeKind.WAIT: "Waits a number of seconds.",
+    NodeKind.SCRIPT: "Runs a script that sets named parameters (BehaviorTree.CPP's Script).",
+    NodeKind.SCRIPT_CONDITION: "Succeeds when a script's value is true, fails when it is false "
+    "(BehaviorTree.CPP's ScriptCondition).",
     NodeKind.OPERATION: "Runs a capability operation.",
 }
 
@@ -142,6 +153,8 @@ def check_setting(kind: NodeKind, name: str, value: Any) -> str | None:
     if isinstance(value, str):
         if kind is NodeKind.CATCH and name == "errors":
             return _error_list_problem(value)
+        if kind in _SCRIPT_KINDS and name == "code":
+            return _script_problem(value)
         return None  # a word: checked against the port's choices
     minimum, whole = _LIMITS.get((kind, name), (0.0, False))
     strict = kind is NodeKind.TIMEOUT  # a time limit of 0 would fail at once
@@ -163,6 +176,15 @@ def _error_list_problem(text: str) -> str | None:
         parse_error_types(text)
     except ValueError as exc:
         return f"a comma-separated list of error types, or any ({exc})"
+    return None
+
+
+def _script_problem(text: str) -> str | None:
+    """None when ``text`` parses as a script, else what was expected where."""
+    try:
+        parse_script(text)
+    except ScriptSyntaxError as exc:
+        return f"a script in BehaviorTree.CPP's language ({exc})"
     return None
 
 

@@ -1,4 +1,4 @@
-"""Leaves: operation leaves (Action, Query, Condition) and Wait.
+"""Leaves: operation leaves (Action, Query, Condition), Wait, and the script leaves.
 
 An operation leaf never blocks a tick: on its first tick it resolves its inputs and calls
 the operation's ``start``; if that returns a Job, later ticks poll it, and a reset cancels
@@ -7,7 +7,7 @@ it. Anything the operation raises becomes FAILURE of this node with the message.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from engine.blackboard import MISSING
@@ -24,9 +24,10 @@ from engine.operations import (
     read_reference,
     typed_input,
 )
+from engine.script import ScriptEnv, ScriptRunError, parse_script
 from engine.status import RUNNING, SUCCESS, Status
 
-__all__ = ["OperationLeaf", "Wait"]
+__all__ = ["OperationLeaf", "ScriptLeaf", "Wait"]
 
 
 def _error_text(exc: BaseException) -> str:
@@ -193,3 +194,50 @@ class Wait(Node):
 
     def on_reset(self) -> None:
         self._deadline = None
+
+
+class ScriptLeaf(Node):
+    """BehaviorTree.CPP's Script (SUCCESS once the script ran) or ScriptCondition (SUCCESS
+    when the script's value is true, FAILURE when false); both in one tick.
+
+    A script that fails while it runs (a missing entry, a value of the wrong type) fails the
+    node with ``invalid_input`` and the line and column in the message; BehaviorTree.CPP
+    throws there instead.
+
+    Args:
+        ctx: the tree's context.
+        node_id: the runtime id (the writer of its blackboard writes).
+        name: label.
+        code: the script (parsed here: a syntax error raises ScriptSyntaxError).
+        condition: True for a ScriptCondition.
+        key: a name in the script -> its blackboard key (the scope it runs in).
+        enums: names that read as integers.
+    """
+
+    kind = "script"
+
+    def __init__(
+        self,
+        ctx: TreeContext,
+        node_id: str,
+        name: str,
+        code: str,
+        *,
+        condition: bool = False,
+        key: Callable[[str], str] | None = None,
+        enums: Mapping[str, int] | None = None,
+    ) -> None:
+        self.kind = "script_condition" if condition else "script"
+        super().__init__(ctx, node_id, name)
+        self.is_condition = condition
+        self.script = parse_script(code)
+        self._env = ScriptEnv(ctx.blackboard, enums, key=key, writer=node_id)
+
+    def update(self) -> Status:
+        try:
+            if self.is_condition:
+                return SUCCESS if self.script.check(self._env) else self.fail("false")
+            self.script.run(self._env)
+        except ScriptRunError as exc:
+            return self.fail(f"script {exc}", ErrorType.INVALID_INPUT)
+        return SUCCESS

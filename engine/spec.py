@@ -67,6 +67,10 @@ class NodeKind(str, enum.Enum):
     FORCE_SUCCESS = "force_success"
     FORCE_FAILURE = "force_failure"
     WAIT = "wait"
+    # BehaviorTree.CPP's Script and ScriptCondition: a script of its language (engine.script)
+    # run on the blackboard; the condition succeeds when the script's value is true.
+    SCRIPT = "script"
+    SCRIPT_CONDITION = "script_condition"
     OPERATION = "operation"
     # An instance of a library subtree: one leaf in the plan's tree, expanded when built.
     SUBTREE = "subtree"
@@ -88,6 +92,8 @@ KIND_CATEGORY: dict[NodeKind, Category] = {
     NodeKind.FORCE_SUCCESS: Category.DECORATOR,
     NodeKind.FORCE_FAILURE: Category.DECORATOR,
     NodeKind.WAIT: Category.LEAF,
+    NodeKind.SCRIPT: Category.LEAF,
+    NodeKind.SCRIPT_CONDITION: Category.LEAF,
     NodeKind.OPERATION: Category.LEAF,
     NodeKind.SUBTREE: Category.LEAF,
 }

@@ -25,6 +25,7 @@ from engine.operations import (
     OperationNotFound,
     OperationSource,
 )
+from engine.script import ScriptError, ScriptNames, parse_script, script_names
 from engine.spec import (
     KIND_CATEGORY,
     Category,
@@ -122,6 +123,8 @@ def validate_plan(
             _check_operation(check, node)
         elif node.kind is NodeKind.SUBTREE:
             check_instance(check, node, library, stack, validate_plan)
+        elif node.kind in _SCRIPTS:
+            _script_writes(check, node)
     check_crossings(check)
     _check_writer_types(check)
     _check_rules(check)
@@ -129,6 +132,41 @@ def validate_plan(
         initial = {p.name for p in plan.parameters if p.value is not None} | set(given or {})
         _check_reads(check, plan.tree, frozenset(initial))
     return [problem for _, _, problem in sorted(check.found, key=lambda f: (f[0], f[1]))]
+
+
+_SCRIPTS = (NodeKind.SCRIPT, NodeKind.SCRIPT_CONDITION)
+
+
+def _names_of_script(node: NodeSpec) -> ScriptNames | None:
+    """What a script node reads and writes; None without a script that parses."""
+    binding = node.params.get("code")
+    if binding is None or binding.is_ref or not isinstance(binding.value, str):
+        return None
+    try:
+        return script_names(parse_script(binding.value))
+    except ScriptError:
+        return None  # reported with the node's settings
+
+
+def _script_writes(check: Check, node: NodeSpec) -> None:
+    """A script's assignments write their names (of any type: a script converts)."""
+    names = _names_of_script(node)
+    for name in names.writes if names is not None else ():
+        check.writers.setdefault(name, []).append(
+            Writer(f"the script of {node.label}", (ParamType.ANY,), node)
+        )
+
+
+def _script_reads(check: Check, node: NodeSpec, available: frozenset[str]) -> frozenset[str]:
+    """A script reads names (checked as an operation's references); after SUCCESS it has
+    written its statements' own assignments.
+    """
+    names = _names_of_script(node)
+    if names is None:
+        return frozenset()
+    for name in names.reads:
+        _check_reference(check, node, "code", name, (ParamType.ANY,), available)
+    return frozenset(names.sure)
 
 
 def _check_parameters(check: Check) -> None:
@@ -303,6 +341,8 @@ def _check_reads(check: Check, node: NodeSpec, available: frozenset[str]) -> fro
     """Check the references this subtree reads; return what it guarantees after SUCCESS."""
     if node.kind is NodeKind.OPERATION:
         return _operation_reads(check, node, available)
+    if node.kind in _SCRIPTS:
+        return _script_reads(check, node, available)
     if node.kind is NodeKind.SUBTREE:
         for name in check.crossing_reads.get(id(node), ()):
             _check_reference(check, node, name, name, (ParamType.ANY,), available)

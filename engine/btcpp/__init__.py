@@ -40,7 +40,8 @@ A plan is written as::
   scripts (``_skipIf``...), ``_autoremap="true"``, unknown ports and values not in their
   port's form are problems, all of them reported with their lines (:class:`XmlFileError`).
 - Logic nodes as BehaviorTree.CPP's built-ins, Iterator and Enforce as declared
-  decorators (:mod:`engine.btcpp.logic`).
+  decorators (:mod:`engine.btcpp.logic`); ``Script`` and ``ScriptCondition`` with their
+  ``code`` as it is, run by :mod:`engine.script`.
 - A reference is ``{NAME}``; a fixed value is text in one exact form per type
   (:mod:`engine.btcpp.values`).
 - What BehaviorTree.CPP has no place for is in ``_``-attributes, which it ignores: our node

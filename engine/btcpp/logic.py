@@ -93,6 +93,7 @@ class LogicModel:
 _SUCCESS = _words({"all": "-1", "any": "1"})
 _FAILURE = _words({"any": "1"})
 _MSEC = SettingMap("msec", _msec_text, _msec_read)
+_CODE = SettingMap("code", _word_text, _word_read)  # a script, as it is
 
 LOGIC: dict[NodeKind, LogicModel] = {
     m.kind: m
@@ -148,6 +149,10 @@ LOGIC: dict[NodeKind, LogicModel] = {
         LogicModel(NodeKind.FORCE_SUCCESS, "ForceSuccess", "Decorator"),
         LogicModel(NodeKind.FORCE_FAILURE, "ForceFailure", "Decorator"),
         LogicModel(NodeKind.WAIT, "Sleep", "Action", settings={"seconds": _MSEC}),
+        LogicModel(NodeKind.SCRIPT, "Script", "Action", settings={"code": _CODE}),
+        LogicModel(
+            NodeKind.SCRIPT_CONDITION, "ScriptCondition", "Condition", settings={"code": _CODE}
+        ),
     )
 }
 LOGIC_BY_MODEL: dict[str, LogicModel] = {m.model: m for m in LOGIC.values()}

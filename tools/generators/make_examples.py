@@ -388,8 +388,28 @@ def _decorators() -> dict[str, PlanSpec]:
 
 
 def _leaves() -> dict[str, PlanSpec]:
-    """Wait, an action, a query and a condition."""
+    """Wait, an action, a query, a condition and the script leaves."""
     return {
+        "script": _one(
+            "script",
+            "Script and ScriptCondition",
+            "Scripts (BehaviorTree.CPP's language) count three parts into PARTS, check the "
+            "count and write a REPORT that an action logs. Runs to SUCCESS.",
+            lambda m: m.node(
+                N.SEQUENCE,
+                "count parts",
+                m.node(N.SCRIPT, "start", code="PARTS := 0; BIN := 'left'"),
+                m.node(
+                    N.REPEAT,
+                    "three parts",
+                    m.node(N.SCRIPT, "one more", code="PARTS += 1"),
+                    count=3,
+                ),
+                m.node(N.SCRIPT_CONDITION, "all counted", code="PARTS == 3 && BIN == 'left'"),
+                m.node(N.SCRIPT, "report", code="REPORT := 'counted ' .. PARTS .. ' parts'"),
+                m.debug("log", "log it", message=Binding.reference("REPORT")),
+            ),
+        ),
         "wait": _one(
             "wait",
             "Wait",
