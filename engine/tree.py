@@ -2,7 +2,9 @@
 
 The root holds the run policy: ``once`` returns its child's result; ``until_success``
 resets the child after a FAILURE and runs it again (the paper's "evaluated until it returns
-SUCCESS"); ``forever`` resets the child after every result.
+SUCCESS"); ``forever`` resets the child after every result. A child that is SKIPPED (its
+pre-conditions, or all its children, skipped it) ends a ``once`` or ``until_success`` run
+with SKIPPED, as BehaviorTree.CPP's tree returns it; ``forever`` starts it again.
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ from collections.abc import Iterator
 from engine.blackboard import Blackboard
 from engine.context import TreeContext
 from engine.node import Node
-from engine.status import FAILURE, IDLE, RUNNING, SUCCESS, Status
+from engine.status import FAILURE, IDLE, RUNNING, SKIPPED, SUCCESS, Status
 
 __all__ = ["RunPolicy", "Root", "BehaviorTree"]
 
@@ -45,10 +47,12 @@ class Root(Node):
             return RUNNING
         self.runs += 1
         if self.policy is RunPolicy.ONCE or (
-            self.policy is RunPolicy.UNTIL_SUCCESS and status is SUCCESS
+            self.policy is RunPolicy.UNTIL_SUCCESS and (status is SUCCESS or status is SKIPPED)
         ):
             if status is FAILURE:
                 self.message = child.message or f"{child.name} failed"
+            elif status is SKIPPED:
+                self.message = child.message or f"{child.name} was skipped"
             return status
         # Run again from a clean subtree on the next tick.
         self.ctx.log(self.id, f"run {self.runs} ended with {status.value}; starting again")

@@ -421,7 +421,7 @@ class RunController(QObject):
         if self._running:
             self._running = []
             self.running_nodes_changed.emit([])
-        level = "info" if event.status is Status.SUCCESS else "warning"
+        level = "info" if event.status in (Status.SUCCESS, Status.SKIPPED) else "warning"
         self.log_message.emit(self._summary(event, failed, message), level)
         self._set_state(ExecutorState.FINISHED)
         self.run_finished.emit(RunOutcome(event, failed, message, dict(self._statuses)))
