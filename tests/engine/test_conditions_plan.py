@@ -267,3 +267,17 @@ def test_btcpp_conditions_run_as_btcpp_runs_them(registry: CapabilityRegistry) -
     )
     tree = build_tree(skipping, registry)
     assert tree.tick_until_done() is SUCCESS and tree.blackboard.get("after") == 1
+
+
+def test_the_schema_takes_conditions_and_refuses_unknown_ones() -> None:
+    import jsonschema
+
+    from resources import resource_path
+
+    schema = json.loads(Path(resource_path("schemas/plan.schema.json")).read_text("utf-8"))
+    validator = jsonschema.Draft202012Validator(schema)
+    p = plan(logic(NodeKind.SEQUENCE, conditioned(op("debug.succeed"), while_="go", post="n")))
+    doc = json.loads(dump_plan(p))
+    assert list(validator.iter_errors(doc)) == []
+    doc["tree"]["children"][0]["conditions"]["skipIf"] = "x"
+    assert list(validator.iter_errors(doc))
