@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from PySide6.QtCore import QObject, QTimer, Signal
 
-from capabilities.cell_features import ReportsStatus
+from capabilities.cell_features import ReportsStatus, lockstep_of
 from capabilities.faults import hold_check
 from engine.blackboard import Blackboard, BlackboardError
 from engine.build import BuildError, build_tree
@@ -254,8 +254,15 @@ class RunController(QObject):
         self._reset_run(plan)
         self._statuses.update({k: v for k, v in done.items() if k in self._order})
         hold = hold_check(self.session.cell)  # a robot's stops (held, or thrown to a Catch)
+        # On the simulated cell the engine drives the world, paced to real time: the run
+        # is the one `costar run` gives for the same plan, scene and seed.
         self._executor = Executor(
-            tree, self.rate_hz, [self._pump.put], plan_name=plan.name, hold=hold
+            tree,
+            self.rate_hz,
+            [self._pump.put],
+            plan_name=plan.name,
+            hold=hold,
+            lockstep=lockstep_of(self.session.cell),
         )
         self._executor.start(paused=paused)
         self._timer.start()
