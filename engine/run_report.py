@@ -77,6 +77,22 @@ class RootCause:
         text = "; ".join(parts)
         return f"{stopped_words(self.stopped_after)}: {text}" if self.stopped_after else text
 
+    def tip(self) -> str:
+        """What the failed node's tooltip adds to its name: ``grasp_failed: nothing between
+        the fingers (4 times); passed up by Retry 'pick'; caught by Selector 'pick or wait'``.
+        """
+        kind = "" if self.error == ErrorType.FAILED.value else self.error
+        parts = [": ".join(part for part in (kind, self.message) if part) or "failed"]
+        if self.times > 1:
+            parts[0] += f" ({self.times} times)"
+        if self.passed_up_by:
+            parts.append(f"passed up by {', '.join(self.passed_up_by)}")
+        if self.caught_by:
+            parts.append(f"caught by {self.caught_by}")
+        if self.stopped_after:
+            parts.append(f"the run {stopped_words(self.stopped_after)}")
+        return "; ".join(parts)
+
     def as_record(self) -> dict[str, Any]:
         """The fields as a JSON object (a trace keeps them)."""
         return {

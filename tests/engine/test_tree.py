@@ -104,7 +104,7 @@ def test_the_first_failed_option_of_a_fallback_is_what_counts(
     """Figure 3 without a cup: the transfer fails at "CUP found" every time, then the forced
     failure of the wait; the root gives up naming the missing cup, not the wait.
     """
-    tree, changes = figure3(registry, clock, failures=100)
+    tree, _ = figure3(registry, clock, failures=100)
     assert run_by_hand(tree, clock) is FAILURE
     assert tree.root.runs == 5
     assert tree.root.message == (
