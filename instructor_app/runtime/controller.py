@@ -442,11 +442,12 @@ class RunController(QObject):
             if event.status is Status.FAILURE:
                 failed, message = self._deepest_failure()
             self._set_failure(failed, message or (event.message if failed else ""))
-        tips = {
-            c.node_id: c.tip()
-            for c in (*others, *([cause] if cause else []))
-            if c.node_id in self._order
-        }
+        tips: dict[str, str] = {}
+        for root in (*others, *([cause] if cause else [])):  # the run's cause last: it wins
+            if root.node_id in self._order:
+                tips[root.node_id] = root.tip()
+            elif root.node_id.split("/")[0] in self._order:  # inside an instance: its
+                tips[root.node_id.split("/")[0]] = f"{root.node}: {root.tip()}"  # tip names it
         if tips:
             self.failures_described.emit(tips)
         if event.reason != "finished":
