@@ -10,7 +10,7 @@ from capabilities.base import CapabilityRegistry
 from engine.build import ROOT_ID, build_tree
 from engine.events import StatusChanged
 from engine.run_report import FailureLog, RootCause
-from engine.spec import NodeKind, NodeSpec, PlanSpec
+from engine.spec import NodeKind, NodeSpec, PlanSpec, SubtreeSpec
 from engine.status import FAILURE, Status
 from engine.tree import RunPolicy
 
@@ -145,3 +145,21 @@ def test_until_success_gives_up_and_the_cause_says_so_with_every_attempt_counted
         "stopped after 3 identical failures in a row: grasp CUP failed 12 times (grasp_failed)"
     )
     assert RootCause.from_record(cause.as_record()) == cause
+
+
+def test_a_failure_inside_an_instance_is_named_with_the_instance(
+    registry: CapabilityRegistry,
+) -> None:
+    grasp = op("debug.fail", "grasp CUP", message="nothing between the fingers")
+    inner = logic(NodeKind.SEQUENCE, grasp, name="Pick")
+    sub = SubtreeSpec(id="test.pick", name="Pick", tree=inner, version=1)
+    pick = NodeSpec(NodeKind.SUBTREE, name="Pick cup", subtree=sub.ref)
+    top = logic(NodeKind.SEQUENCE, pick, name="transfer")
+    status, _, log = run_logged(plan(top, subtrees=[sub]), registry)
+    assert status is Status.FAILURE
+    cause = log.failed_run()
+    assert cause is not None and cause.node_id == f"{pick.id}/{grasp.id}"
+    assert cause.describe() == (
+        "Pick cup > grasp CUP failed: nothing between the fingers; passed up by "
+        "Pick cup > Sequence 'Pick', Pick cup, Sequence 'transfer'"
+    )
