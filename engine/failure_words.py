@@ -22,7 +22,8 @@ def node_title(kind: str, name: str, *, leaf: bool) -> str:
     if leaf:
         return name or kind
     title = kind.replace("_", " ").capitalize()
-    return title if not name or name == kind else f"{title} '{name}'"
+    plain = not name or name.lower() in (kind, title.lower())  # "Selector" named "Selector"
+    return title if plain else f"{title} '{name}'"
 
 
 def failed_words(title: str, error: str, message: str, times: int = 1) -> str:

@@ -9,6 +9,7 @@ from bt_fakes import logic, op, plan
 from capabilities.base import CapabilityRegistry
 from engine.build import ROOT_ID, build_tree
 from engine.events import StatusChanged
+from engine.failure_words import failed_words, node_title
 from engine.run_report import FailureLog, RootCause
 from engine.spec import NodeKind, NodeSpec, PlanSpec, SubtreeSpec
 from engine.status import FAILURE, Status
@@ -163,3 +164,14 @@ def test_a_failure_inside_an_instance_is_named_with_the_instance(
         "Pick cup > grasp CUP failed: nothing between the fingers; passed up by "
         "Pick cup > Sequence 'Pick', Pick cup, Sequence 'transfer'"
     )
+
+
+def test_how_nodes_and_failures_are_put_in_words() -> None:
+    assert node_title("selector", "Selector", leaf=False) == "Selector"
+    assert node_title("force_failure", "force_failure", leaf=False) == "Force failure"
+    assert node_title("retry", "pick 4 times", leaf=False) == "Retry 'pick 4 times'"
+    assert node_title("action", "grasp CUP", leaf=True) == "grasp CUP"
+    assert failed_words("grasp CUP", "failed", "nothing between the fingers", 3) == (
+        "grasp CUP failed 3 times: nothing between the fingers"
+    )
+    assert failed_words("look", "not_found", "") == "look failed (not_found)"
