@@ -283,11 +283,13 @@ def _report(
 
 
 def _report_caught(failures: FailureLog, out: TextIO) -> None:
-    """The failures the plan carried on past (a fallback, a retry), one line each."""
-    caught = failures.caught()
-    if caught:
+    """The failures other than the run's cause (those the plan carried on past with a
+    fallback or a retry, a fallback that failed too), one line each.
+    """
+    others = failures.on_the_way()
+    if others:
         print("  on the way:", file=out)
-        for failure in caught:
+        for failure in others:
             print(f"  - {failure.describe()}", file=out)
 
 
