@@ -25,7 +25,7 @@ from engine.events import (
     RunHeld,
     StatusChanged,
 )
-from engine.json_reader import errors_as, parse_json
+from engine.json_reader import JsonFileError, errors_as, parse_json
 from engine.run_report import FailureLog, RootCause
 from engine.spec import PlanSpec
 from engine.status import Status
@@ -166,13 +166,20 @@ def read_trace(path: str | os.PathLike[str]) -> Trace:
     """Load a trace; raises TraceError naming the file and line of anything wrong."""
     path = Path(path)
     try:
-        lines = path.read_bytes().decode("utf-8").splitlines()
+        text = path.read_bytes().decode("utf-8")
+        lines = text.splitlines()
     except OSError as exc:
         raise TraceError(f"{path}: cannot read: {exc.strerror or exc}") from exc
     except UnicodeDecodeError as exc:
         raise TraceError(
             f"{path}: not a trace file: a byte that is not UTF-8 at offset {exc.start}"
         ) from exc
+    if lines and not text.endswith("\n"):
+        # The run was killed while its last event was written: the record ends before it.
+        try:
+            parse_json(lines[-1], str(path), "trace")
+        except JsonFileError:
+            lines.pop()
     records: list[tuple[int, dict[str, Any]]] = []  # (line number in the file, record)
     for number, line in enumerate(lines, start=1):
         if not line.strip():

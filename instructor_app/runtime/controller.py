@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import copy
 from dataclasses import dataclass
+from pathlib import Path
 
 from PySide6.QtCore import QObject, QTimer, Signal
 
@@ -21,9 +22,11 @@ from engine.build import BuildError, build_tree
 from engine.events import RunFinished
 from engine.executor import Executor, ExecutorState
 from engine.failure_words import failed_words
+from engine.run_records import RunRecordError, new_record_path, prune_records, runs_folder
 from engine.run_report import FailureLog, RootCause
 from engine.spec import PlanSpec
 from engine.status import RUNNING, Status
+from engine.trace import TraceRecorder
 from engine.tree import BehaviorTree
 from engine.validation import ERROR, Problem, has_errors, validate_plan
 from instructor_app.document.editing import PlanDocument
@@ -141,6 +144,7 @@ class RunController(QObject):
         self._failure: tuple[str, str] = ("", "")
         self._stopping = False  # a stop was asked: the halt's IDLE resets are not shown
         self._held = ""  # why the cell holds the run ("" when it does not)
+        self.last_record: Path | None = None  # the record of the last run started
         self._idled: set[str] = set()  # nodes that went RUNNING -> IDLE at the last drain
 
     # ------------------------------------------------------------------ state
@@ -270,12 +274,13 @@ class RunController(QObject):
         self._statuses.update({k: v for k, v in done.items() if k in self._order})
         hold = hold_check(self.session.cell)  # a robot's stops (held, or thrown to a Catch)
         self._failures = FailureLog(plan)  # on the dispatcher thread, read when the run ends
+        recorder = self._recorder(plan)  # first: what the views show is already recorded
         # On the simulated cell the engine drives the world, paced to real time: the run
         # is the one `costar run` gives for the same plan, scene and seed.
         self._executor = Executor(
             tree,
             self.rate_hz,
-            [self._pump.put, self._failures],
+            [*recorder, self._pump.put, self._failures],
             plan_name=plan.name,
             hold=hold,
             lockstep=lockstep_of(self.session.cell),
@@ -295,6 +300,22 @@ class RunController(QObject):
         else:
             self.log_message.emit(f"Run of {plan.name or 'the plan'} started", "info")
         return True
+
+    def _recorder(self, plan: PlanSpec) -> list[TraceRecorder]:
+        """This run's record in the runs folder ($COSTAR_RUNS, else the user's; the oldest
+        removed past its size limit), as `costar run` keeps one; none when it cannot be
+        written (said in the Log: the run goes on).
+        """
+        folder = runs_folder()
+        try:
+            path = new_record_path(folder, plan.name)
+            recorder = TraceRecorder(path, plan)
+        except (RunRecordError, OSError) as exc:
+            self.log_message.emit(f"This run keeps no record: {exc}", "warning")
+            return []
+        prune_records(folder, keep=path)
+        self.last_record = path
+        return [recorder]
 
     def _resume_at(self, tree: BehaviorTree, node_id: str) -> dict[str, Status] | None:
         """Mark the nodes before ``node_id`` done and carry the last run's values over."""
