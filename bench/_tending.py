@@ -103,14 +103,37 @@ def _total(trials: list[dict[str, Any]]) -> dict[str, Any]:
     return total.as_dict() | {"trials": trials, "errors": errors}
 
 
+def _spread(trials: list[dict[str, Any]], per_pair: int) -> dict[str, Any]:
+    """Table I of each pair of trials (consecutive seeds) and each row's mean, minimum and
+    maximum over the pairs: one pair of 50-part trials says little about random faults.
+    """
+    pairs = [trials[i : i + per_pair] for i in range(0, len(trials), per_pair)]
+    tables = [_total(pair) for pair in pairs]
+    rows = {
+        row: [float(t[row]) for t in tables if not t["errors"]] for row in (*ROWS, "sim_seconds")
+    }
+    spread = {
+        row: {"mean": round(sum(v) / len(v), 1), "min": min(v), "max": max(v)}
+        for row, v in rows.items()
+        if v
+    }
+    pair_rows = [{k: t[k] for k in (*ROWS, "sim_seconds", "errors")} for t in tables]
+    return {"pairs": pair_rows, "spread": spread}
+
+
 def measure_tending(
     seed: int, parts: int, trials: int = 2, jobs: int = 1, reset_s: float = RESET_S,
-    speed: float | None = SPEED, only: list[str] | None = None,
+    speed: float | None = SPEED, only: list[str] | None = None, pairs: int = 0,
 ) -> dict[str, Any]:  # fmt: skip
     """{"paper": {...}, "ours": {...}}: each plan's counters over ``trials`` trials
     (ours: {"skipped": why} while resources/examples/tending.costar.json does not exist;
-    a plan left out of ``only``: {"skipped": "not asked for"}).
+    a plan left out of ``only``: {"skipped": "not asked for"}). With ``pairs``, that many
+    pairs of trials (seeds seed, seed + 1; seed + 2, seed + 3; ...) instead, each plan's
+    figures with ``"pairs"`` (each pair's Table I) and ``"spread"`` (each row's mean,
+    minimum and maximum over the pairs).
     """
+    if pairs:
+        trials = 2 * pairs
     asked = [name for name in PLANS if only is None or name in only]
     plans = [name for name in asked if PLANS[name].is_file()]
     work = [TendingJob(p, seed + i, parts, reset_s, speed) for p in plans for i in range(trials)]
@@ -125,7 +148,8 @@ def measure_tending(
             why = "not asked for" if name not in asked else f"{path.name} does not exist yet"
             figures[name] = {"skipped": why}
             continue
-        figures[name] = _total([r for j, r in zip(work, results, strict=True) if j.plan == name])
+        mine = [r for j, r in zip(work, results, strict=True) if j.plan == name]
+        figures[name] = _total(mine) | (_spread(mine, 2) if pairs else {})
     return figures
 
 
@@ -140,15 +164,28 @@ def _percent(entry: dict[str, Any]) -> str:
     return f"{100 * (entry.get('caught', 0) + entry.get('scrapped', 0)) / produced:.0f} %"
 
 
+def _cell(entry: dict[str, Any], row: str) -> str:
+    """A row's figure; over several pairs, its mean per pair and (min-max)."""
+    spread = entry.get("spread", {}).get(row)
+    if spread is None:
+        return str(entry.get(row, "-"))
+    return f"{spread['mean']:g} ({spread['min']:g}-{spread['max']:g})"
+
+
 def table_one(figures: dict[str, Any]) -> str:
-    """Table I side by side: the paper at Marlin Steel, the paper's plan and ours here."""
+    """Table I side by side: the paper at Marlin Steel, the paper's plan and ours here (with
+    pairs: each figure per pair of trials as mean (min-max) over the pairs).
+    """
     columns = [("paper (Marlin)", PAPER), ("paper's plan, sim", figures.get("paper", {})),
                ("ours, sim", figures.get("ours", {}))]  # fmt: skip
-    lines = [f"{'Table I':24}" + "".join(f"{name:>20}" for name, _ in columns)]
+    width = 24 if any("spread" in entry for _, entry in columns) else 20
+    pairs = max((len(entry.get("pairs", [])) for _, entry in columns), default=0)
+    title = f"Table I, {pairs} pairs" if pairs else "Table I"
+    lines = [f"{title:24}" + "".join(f"{name:>{width}}" for name, _ in columns)]
     for row in ROWS:
-        cells = [str(entry.get(row, "-")) for _, entry in columns]
-        lines.append(f"{row:24}" + "".join(f"{c:>20}" for c in cells))
+        cells = [_cell(entry, row) for _, entry in columns]
+        lines.append(f"{row:24}" + "".join(f"{c:>{width}}" for c in cells))
     handled = [f"{_percent(PAPER)} ({PAPER_PROJECTED} % proj.)"]
     handled += [_percent(entry) for _, entry in columns[1:]]
-    lines.append(f"{'handled':24}" + "".join(f"{c:>20}" for c in handled))
+    lines.append(f"{'handled':24}" + "".join(f"{c:>{width}}" for c in handled))
     return "\n".join(lines)

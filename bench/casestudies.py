@@ -53,7 +53,7 @@ from bench._tending import (  # noqa: E402
     table_one,
 )
 from capabilities.base import CapabilityRegistry  # noqa: E402
-from capabilities.sim.session import SimCellSession  # noqa: E402
+from capabilities.sim.session import PERCEPTION_S, SimCellSession  # noqa: E402
 from engine.build import build_tree  # noqa: E402
 from engine.executor import run_to_end  # noqa: E402
 from engine.files import load_plan  # noqa: E402
@@ -122,14 +122,16 @@ TENDING = "tending"
 
 def run_case(case: CaseStudy, seed: int) -> str:
     """'' when the run of one seed succeeded, else why not."""
-    with SimCellSession(case.scene, seed) as session:
+    # In lockstep from simulated time 0, as `costar run` runs it: a seed's run is the same on
+    # any machine and beside any load.
+    with SimCellSession(case.scene, seed, lockstep=PERCEPTION_S, still_until_run=True) as session:
         registry = CapabilityRegistry(cell=session)
         plan = load_plan(case.plan, aliases=registry.aliases())
         problems = validate_plan(plan, registry)
         if has_errors(problems):
             return "invalid: " + "; ".join(str(p) for p in problems if p.severity == "error")
         tree = build_tree(plan, registry, clock=session.clock)
-        result = run_to_end(tree, 20.0, timeout=RUN_TIMEOUT)
+        result = run_to_end(tree, 20.0, RUN_TIMEOUT, lockstep=session.run_lockstep())
         if result.status is not Status.SUCCESS:
             return f"{result.status.value}: {result.message or result.reason}"
         return case.score(session)
@@ -174,6 +176,13 @@ def _arguments(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument("--parts", type=int, default=50, help="tending: parts per trial")
     parser.add_argument("--trials", type=int, default=2, help="tending: trials per plan")
     parser.add_argument(
+        "--pairs",
+        type=int,
+        default=0,
+        help="tending: this many pairs of trials per plan (instead of --trials), each "
+        "figure printed as its mean (min-max) over the pairs",
+    )
+    parser.add_argument(
         "--reset-s",
         type=float,
         default=RESET_S,
@@ -210,7 +219,14 @@ def _measure_all(args: argparse.Namespace) -> dict[str, Any]:
         if name == TENDING:
             speed = args.speed or None
             figures[name] = measure_tending(
-                args.seed, args.parts, args.trials, args.jobs, args.reset_s, speed, args.plan
+                args.seed,
+                args.parts,
+                args.trials,
+                args.jobs,
+                args.reset_s,
+                speed,
+                args.plan,
+                args.pairs,
             )
         else:
             figures[name] = measure(name, args.runs, args.first_seed, args.jobs)

@@ -110,14 +110,13 @@ def open_cell(
     )
 
 
-def _lockstep(speed: float | None) -> float | None:
-    """The simulated cell's lockstep: a run as fast as possible (the CLI, tests) charges each
-    perception job a fixed simulated time, so what its plan sees does not depend on how busy
-    the machine is (else the world steps on while perception computes: a loaded machine
-    made kitting miss plates); a paced cell (the GUI) lets the world go on, as a real one.
+def _lockstep(speed: float | None) -> float:
+    """The simulated cell's lockstep, paced (the GUI) or not (the CLI, tests): each
+    perception job costs a fixed simulated time while the world stands still, and a run's
+    engine drives the world, so what a plan sees does not depend on how busy the machine is
+    (a loaded machine made kitting miss plates when the world stepped on meanwhile).
     """
-    if speed is not None:
-        return None
+    del speed  # the same for every pace: the engine's ticks are paced instead
     from capabilities.sim.session import PERCEPTION_S
 
     return PERCEPTION_S

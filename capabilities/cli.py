@@ -35,6 +35,15 @@ from engine.files import PlanFileError, load_plan, plan_scene
 from engine.instances import runtime_paths
 from engine.library import Library, library_folder
 from engine.operations import OperationManifest
+from engine.run_records import (
+    RUNS_ENV,
+    RunRecordError,
+    find_record,
+    list_records,
+    new_record_path,
+    prune_records,
+    runs_folder,
+)
 from engine.run_report import FailureLog
 from engine.spec import PlanSpec
 from engine.status import Status
@@ -203,8 +212,9 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             return EXIT_INVALID
         failures = FailureLog(plan)
         listeners: list[Callable[[Event], None]] = []
-        if args.trace:  # first: what a line on screen says is already in the trace
-            listeners.append(TraceRecorder(args.trace, plan))
+        record = _record_path(args, plan.name, err)
+        if record is not None:  # first: what a line on screen says is already in the record
+            listeners.append(TraceRecorder(record, plan))
         holds = HoldWatch(out, args.hold_timeout, cell)
         listeners += [failures, holds]
         if args.verbose:
@@ -227,11 +237,32 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             restore()
             if answerer is not None:
                 answerer.detach()
+        if record is not None:
+            print(f"run record: {record}", file=out)
         code = _report(
             result, plan, tree.blackboard.snapshot(), out, args.verbose, failures.cause()
         )
         _report_caught(failures, out)
         return code
+
+
+def _record_path(args: argparse.Namespace, plan_name: str, err: TextIO) -> Path | None:
+    """Where this run's record goes: ``--trace FILE``, else a new record in the runs folder
+    (the oldest records there removed past its size limit); None with ``--no-record`` or
+    when the folder cannot be used (said on ``err``: the run goes on without a record).
+    """
+    if args.trace:
+        return Path(args.trace)
+    if args.no_record:
+        return None
+    folder = runs_folder(args.runs)
+    try:
+        path = new_record_path(folder, plan_name)
+    except RunRecordError as exc:
+        print(f"warning: no run record: {exc}", file=err)
+        return None
+    prune_records(folder, keep=path)
+    return path
 
 
 def _wait(executor: Executor, timeout: float | None, holds: HoldWatch, out: TextIO) -> RunFinished:
@@ -284,11 +315,13 @@ def _report(
 
 
 def _report_caught(failures: FailureLog, out: TextIO) -> None:
-    """The failures the plan carried on past (a fallback, a retry), one line each."""
-    caught = failures.caught()
-    if caught:
+    """The failures other than the run's cause (those the plan carried on past with a
+    fallback or a retry, a fallback that failed too), one line each.
+    """
+    others = failures.on_the_way()
+    if others:
         print("  on the way:", file=out)
-        for failure in caught:
+        for failure in others:
             print(f"  - {failure.describe()}", file=out)
 
 
@@ -349,10 +382,19 @@ def _cmd_ops(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     return EXIT_SUCCESS
 
 
+def _cmd_runs_list(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    folder = runs_folder(args.runs)
+    records = list_records(folder)
+    print(f"{len(records)} run records in {folder} (newest first)", file=out)
+    for summary in records[: args.most]:
+        print(summary.line(), file=out)
+    return EXIT_SUCCESS
+
+
 def _cmd_trace_show(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     try:
-        trace = read_trace(args.file)
-    except TraceError as exc:
+        trace = read_trace(find_record(runs_folder(getattr(args, "runs", None)), args.file))
+    except (TraceError, RunRecordError) as exc:
         print(f"error: {exc}", file=err)
         return EXIT_INVALID
     print(f"trace of {trace.header.get('plan') or 'a plan'}: {len(trace.events)} events", file=out)
@@ -386,7 +428,14 @@ def _parser() -> argparse.ArgumentParser:
     run = sub.add_parser("run", help="run a plan until it finishes")
     run.add_argument("plan", help=PLAN_HELP)
     run.add_argument("--rate", type=float, default=20.0, help="ticks per second (default 20)")
-    run.add_argument("--trace", help="write a trace (JSON lines) to this file")
+    run.add_argument(
+        "--trace", help="write the run's record (a trace, JSON lines) to this file instead"
+    )
+    run.add_argument(
+        "--runs",
+        help=f"the runs folder for the run's record (default: ${RUNS_ENV}, else the user's)",
+    )
+    run.add_argument("--no-record", action="store_true", help="keep no record of this run")
     run.add_argument("--timeout", type=float, help="stop after this many seconds (exit 3)")
     run.add_argument(
         "--hold-timeout",
@@ -425,7 +474,17 @@ def _parser() -> argparse.ArgumentParser:
         help="a loopback UR controller backed by the simulated cell (--help for its options)",
     )
 
-    trace = sub.add_parser("trace", help="traces of runs")
+    runs = sub.add_parser("runs", help="the records of runs (every `costar run` keeps one)")
+    runs_sub = runs.add_subparsers(dest="runs_command", required=True)
+    listing = runs_sub.add_parser("list", help="the run records, newest first")
+    listing.add_argument("--runs", help=f"the runs folder (default: ${RUNS_ENV}, else the user's)")
+    listing.add_argument("--most", type=int, default=50, help="list at most this many (50)")
+    listing.set_defaults(func=_cmd_runs_list)
+    shown = runs_sub.add_parser("show", help="print a run record as a readable timeline")
+    shown.add_argument("file", help="a record's path or name (its start is enough), or last")
+    shown.add_argument("--runs", help=f"the runs folder (default: ${RUNS_ENV}, else the user's)")
+    shown.set_defaults(func=_cmd_trace_show)
+    trace = sub.add_parser("trace", help="traces of runs (as `costar runs show`)")
     trace_sub = trace.add_subparsers(dest="trace_command", required=True)
     show = trace_sub.add_parser("show", help="print a trace as a readable timeline")
     show.add_argument("file")

@@ -269,6 +269,6 @@ def build_tree(
                 raise BuildError(f"parameters/{decl.name}", str(exc)) from exc
     ctx = TreeContext(board, clock) if clock is not None else TreeContext(board)
     top = _build_node(plan.tree, _Build(plan, ctx, source), plan.tree.label, ROOT_SCOPE)
-    root = Root(ctx, ROOT_ID, plan.name or "root", plan.run_policy)
+    root = Root(ctx, ROOT_ID, plan.name or "root", plan.run_policy, plan.give_up_after)
     root.set_children([top])
     return BehaviorTree(root, ctx)

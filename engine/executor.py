@@ -14,11 +14,11 @@ held (the running leaves are halted, nothing is ticked, a RunHeld event says why
 cell is clear again the run goes on, and the composites tick the halted leaves afresh
 (PolyScope). A stop of no known type (``failed``: power off, a stopped script) is always held.
 
-In lockstep (a :class:`Lockstep`: a simulated cell run as fast as it can) the world goes on
-only with the engine's clock: after each tick the executor lets it run one period and waits
-until it has, and the next tick comes then, not earlier (a job that finishes does not bring
-it forward). The same plan, scene and seed then give the same ticks, however busy the
-machine is.
+In lockstep (a :class:`Lockstep`: a simulated cell, run as fast as it can or paced to real
+time) the world goes on only with the engine's clock: after each tick the executor lets it
+run one period and waits until it has, and the next tick comes then, not earlier (a job that
+finishes does not bring it forward). The same plan, scene and seed then give the same ticks,
+however busy the machine is. While the run is paused the world runs free.
 """
 
 from __future__ import annotations
@@ -271,6 +271,10 @@ class Executor:
                     if self._steps:
                         self._steps -= 1
                         return None
+                    if self._lockstep is not None:
+                        # Paused, the world runs free (the robot is held, not frozen in
+                        # mid-air); the next tick's advance drives it again.
+                        self._release(self._lockstep)
                     self._cond.wait()
                     continue
                 if self._woken:

@@ -25,7 +25,15 @@ from engine.spec import NodeKind, NodeSpec, PlanSpec, SubtreeRef, SubtreeSpec
 from engine.status import RUNNING, SUCCESS, Status
 from engine.types import ParamType
 
-__all__ = ["Scope", "SubtreeInstance", "instance_manifest", "runtime_paths", "ROOT_SCOPE"]
+__all__ = [
+    "Scope",
+    "SubtreeInstance",
+    "instance_manifest",
+    "RuntimeNode",
+    "runtime_nodes",
+    "runtime_paths",
+    "ROOT_SCOPE",
+]
 
 
 def instance_manifest(subtree: SubtreeSpec) -> OperationManifest:
@@ -49,19 +57,40 @@ def instance_manifest(subtree: SubtreeSpec) -> OperationManifest:
     )
 
 
-def runtime_paths(plan: PlanSpec) -> dict[str, str]:
-    """Runtime node id -> path, the insides of instances included (``Kitting/Handoff[0]/...``).
+@dataclass(frozen=True)
+class RuntimeNode:
+    """A node of the tree a plan builds, found from the plan: the insides of instances too.
 
-    Status events name runtime ids; this tells a reader where each one is.
+    Attributes:
+        spec: the node's spec (inside an instance, the subtree definition's node).
+        path: where it is, ``Kitting/Handoff[0]/...``.
+        parent: the runtime id of its parent ("" for the plan's top node).
+        label: what the Instructor calls it; inside an instance the instance's label first,
+            ``Pick cup > grasp CUP``.
     """
-    paths: dict[str, str] = {}
-    stack: list[tuple[NodeSpec, str, str, tuple[SubtreeRef, ...]]] = []
+
+    spec: NodeSpec
+    path: str
+    parent: str
+    label: str
+
+
+def runtime_nodes(plan: PlanSpec) -> dict[str, RuntimeNode]:
+    """Runtime node id -> :class:`RuntimeNode`, the insides of instances included (their
+    ids are ``"<instance id>/<inner id>"``, as :meth:`Scope.node_id` makes them).
+    """
+    nodes: dict[str, RuntimeNode] = {}
+    # (top node, id prefix, its path, its parent's runtime id, label prefix, subtrees open)
+    stack: list[tuple[NodeSpec, str, str, str, str, tuple[SubtreeRef, ...]]] = []
     if plan.tree is not None:
-        stack.append((plan.tree, "", "", ()))
+        stack.append((plan.tree, "", "", "", "", ()))
     while stack:
-        top, prefix, base, seen = stack.pop()
+        top, prefix, base, parent, labels, seen = stack.pop()
+        parents = {id(top): parent}
         for path, node in top.walk(base):
-            paths[f"{prefix}{node.id}"] = path
+            runtime_id = f"{prefix}{node.id}"
+            nodes[runtime_id] = RuntimeNode(node, path, parents[id(node)], f"{labels}{node.label}")
+            parents.update((id(child), runtime_id) for child in node.children)
             inner = (
                 plan.subtree(node.subtree)
                 if node.kind is NodeKind.SUBTREE and node.subtree
@@ -71,12 +100,22 @@ def runtime_paths(plan: PlanSpec) -> dict[str, str]:
                 stack.append(
                     (
                         inner.tree,
-                        f"{prefix}{node.id}/",
+                        f"{runtime_id}/",
                         f"{path}/{inner.tree.label}",
+                        runtime_id,
+                        f"{labels}{node.label} > ",
                         (*seen, inner.ref),
                     )
                 )
-    return paths
+    return nodes
+
+
+def runtime_paths(plan: PlanSpec) -> dict[str, str]:
+    """Runtime node id -> path, the insides of instances included (``Kitting/Handoff[0]/...``).
+
+    Status events name runtime ids; this tells a reader where each one is.
+    """
+    return {runtime_id: node.path for runtime_id, node in runtime_nodes(plan).items()}
 
 
 @dataclass(frozen=True)

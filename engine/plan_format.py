@@ -45,7 +45,15 @@ KIND_ALIASES: Mapping[str, str] = types.MappingProxyType(
 )
 
 TOP_FIELDS: tuple[str, ...] = ("format", "format_version", "id", "name", "description")
-TOP_FIELDS += ("run_policy", "reset_cell", "scene", "parameters", "tree", "waypoints")
+TOP_FIELDS += (
+    "run_policy",
+    "give_up_after",
+    "reset_cell",
+    "scene",
+    "parameters",
+    "tree",
+    "waypoints",
+)
 TOP_FIELDS += ("objects", "layout")
 TOP_FIELDS += ("subtrees",)
 NODE_FIELDS = ("id", "kind", "name", "op", "params", "children", "subtree", "conditions")

@@ -39,6 +39,7 @@ from engine.spec import (
     SubtreeSpec,
     new_id,
 )
+from engine.tree import DEFAULT_GIVE_UP_AFTER
 from engine.types import ParamType, Waypoint, with_article
 
 __all__ = ["load_plan", "loads_plan", "read_subtree"]
@@ -109,6 +110,7 @@ class _Reader:
                     doc.get("run_policy", "once"), "$.run_policy", [p.value for p in RunPolicy]
                 )
             ),
+            give_up_after=self.at(doc, "$").integer("give_up_after", DEFAULT_GIVE_UP_AFTER, lo=0),
             reset_cell=self.flag(doc.get("reset_cell", False), "$.reset_cell"),
             scene=self.text(doc.get("scene", ""), "$.scene"),
         )

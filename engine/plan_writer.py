@@ -29,6 +29,7 @@ from engine.spec import (
     SubtreePort,
     SubtreeSpec,
 )
+from engine.tree import DEFAULT_GIVE_UP_AFTER
 from engine.types import ParamType, encode_value
 
 __all__ = [
@@ -167,6 +168,11 @@ def dump_plan(plan: PlanSpec) -> str:
         "name": plan.name,
         "description": plan.description,
         "run_policy": RunPolicy(plan.run_policy).value,
+        **(
+            {"give_up_after": plan.give_up_after}
+            if plan.give_up_after != DEFAULT_GIVE_UP_AFTER
+            else {}
+        ),
         **({"reset_cell": True} if plan.reset_cell else {}),
         **({"scene": plan.scene} if plan.scene else {}),
         "parameters": [_encode_parameter(decl) for decl in plan.parameters],

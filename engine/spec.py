@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from engine.conditions import Condition
-from engine.tree import RunPolicy
+from engine.tree import DEFAULT_GIVE_UP_AFTER, RunPolicy
 from engine.types import ParamType, Waypoint
 
 __all__ = [
@@ -281,6 +281,9 @@ class PlanSpec:
     name: str = ""
     description: str = ""
     run_policy: RunPolicy = RunPolicy.ONCE
+    # With until_success: give up after this many identical failures in a row (the same
+    # first failing node, error type and message); 0: never. Files without it read as 5.
+    give_up_after: int = DEFAULT_GIVE_UP_AFTER
     # Put the cell back to its scene's seed (robot home, objects in place) before each run.
     reset_cell: bool = False
     # The simulated cell's scene the plan was taught on ("kitting_handoff"); the simulated

@@ -1,7 +1,9 @@
 """Traces: every event of a run as JSON lines (``*.trace.jsonl``), for replay and analysis.
 
 The first line is a header with the plan's nodes (id, label, kind, path), so a trace can be
-read without the plan; each further line is one event.
+read without the plan; each further line is one event. When the run had failures, a
+``failures`` record before the last one names their root causes (``engine.run_report``):
+the one that failed the run (``cause``) and those on the way.
 """
 
 from __future__ import annotations
@@ -23,7 +25,8 @@ from engine.events import (
     RunHeld,
     StatusChanged,
 )
-from engine.json_reader import errors_as, parse_json
+from engine.json_reader import JsonFileError, errors_as, parse_json
+from engine.run_report import FailureLog, RootCause
 from engine.spec import PlanSpec
 from engine.status import Status
 from engine.types import encode_value
@@ -81,6 +84,7 @@ class TraceRecorder:
         self.path = Path(path)
         self._lock = threading.Lock()
         self._file: TextIO | None = self.path.open("w", encoding="utf-8")
+        self._failures = FailureLog(plan) if plan is not None else None
         header: dict[str, Any] = {"format": TRACE_FORMAT, "format_version": TRACE_VERSION}
         if plan is not None:
             header["plan"] = plan.name
@@ -107,9 +111,27 @@ class TraceRecorder:
                 self._file.flush()
 
     def __call__(self, event: Event) -> None:
-        self._write(_event_record(event))
+        failures = self._failures
         if isinstance(event, RunFinished):
+            if failures is not None:
+                self._write_failures(failures, event)
+            self._write(_event_record(event))
             self.close()
+            return
+        if failures is not None:
+            failures(event)
+        self._write(_event_record(event))
+
+    def _write_failures(self, failures: FailureLog, event: RunFinished) -> None:
+        cause = failures.failed_run() if event.reason == "finished" else None
+        others = [c for c in failures.root_causes() if c != cause]
+        if cause is None and not others:
+            return
+        record: dict[str, Any] = {"event": "failures", "tick": event.tick}
+        if cause is not None:
+            record["cause"] = cause.as_record()
+        record["on_the_way"] = [other.as_record() for other in others]
+        self._write(record | {"time": event.time})
 
     def close(self) -> None:
         with self._lock:
@@ -144,13 +166,20 @@ def read_trace(path: str | os.PathLike[str]) -> Trace:
     """Load a trace; raises TraceError naming the file and line of anything wrong."""
     path = Path(path)
     try:
-        lines = path.read_bytes().decode("utf-8").splitlines()
+        text = path.read_bytes().decode("utf-8")
+        lines = text.splitlines()
     except OSError as exc:
         raise TraceError(f"{path}: cannot read: {exc.strerror or exc}") from exc
     except UnicodeDecodeError as exc:
         raise TraceError(
             f"{path}: not a trace file: a byte that is not UTF-8 at offset {exc.start}"
         ) from exc
+    if lines and not text.endswith("\n"):
+        # The run was killed while its last event was written: the record ends before it.
+        try:
+            parse_json(lines[-1], str(path), "trace")
+        except JsonFileError:
+            lines.pop()
     records: list[tuple[int, dict[str, Any]]] = []  # (line number in the file, record)
     for number, line in enumerate(lines, start=1):
         if not line.strip():
@@ -199,5 +228,12 @@ def format_timeline(trace: Trace) -> Iterable[str]:
         elif kind == "held":
             what = f"held: {event['reason']}" if event.get("reason") else "resumed"
             yield f"{head} tick {event['tick']:>5}  run {what}"
+        elif kind == "failures":
+            tick = f"{head} tick {event['tick']:>5}  "
+            if isinstance(event.get("cause"), dict):
+                yield f"{tick}the run failed: {RootCause.from_record(event['cause']).describe()}"
+            for other in event.get("on_the_way", []):
+                if isinstance(other, dict):
+                    yield f"{tick}on the way: {RootCause.from_record(other).describe()}"
         elif kind == "started":
             yield f"{head} run of {event.get('plan') or 'plan'} started"

@@ -2,9 +2,12 @@
 
 The root holds the run policy: ``once`` returns its child's result; ``until_success``
 resets the child after a FAILURE and runs it again (the paper's "evaluated until it returns
-SUCCESS"); ``forever`` resets the child after every result. A child that is SKIPPED (its
-pre-conditions, or all its children, skipped it) ends a ``once`` or ``until_success`` run
-with SKIPPED, as BehaviorTree.CPP's tree returns it; ``forever`` starts it again.
+SUCCESS"), but gives up after ``give_up_after`` identical failures in a row (the same first
+failing node with the same error type and message: trying again changes nothing); ``forever``
+resets the child after every result (a plan meant to run until stopped, with no limit). A
+child that is SKIPPED (its pre-conditions, or all its children, skipped it) ends a ``once``
+or ``until_success`` run with SKIPPED, as BehaviorTree.CPP's tree returns it; ``forever``
+starts it again.
 """
 
 from __future__ import annotations
@@ -14,10 +17,15 @@ from collections.abc import Iterator
 
 from engine.blackboard import Blackboard
 from engine.context import TreeContext
+from engine.failure_words import failed_words, node_title, stopped_words
 from engine.node import Node
 from engine.status import FAILURE, IDLE, RUNNING, SKIPPED, SUCCESS, Status
 
-__all__ = ["RunPolicy", "Root", "BehaviorTree"]
+__all__ = ["RunPolicy", "Root", "BehaviorTree", "DEFAULT_GIVE_UP_AFTER", "first_failed"]
+
+# How many identical failures in a row a root that runs until success takes before it gives
+# up, unless the plan says otherwise (0: no limit).
+DEFAULT_GIVE_UP_AFTER = 5
 
 
 class RunPolicy(str, enum.Enum):
@@ -28,17 +36,49 @@ class RunPolicy(str, enum.Enum):
     FOREVER = "forever"
 
 
+def first_failed(node: Node) -> Node:
+    """The node a FAILURE started at: down through the first failed child in tick order
+    (the first option a Selector tried, the body of a Catch whose handler failed too, a
+    Retry's last attempt) to a node none of whose children failed (a leaf, a Timeout that
+    ran out, a Force failure).
+    """
+    while True:
+        failed = next((child for child in node.children if child.status is FAILURE), None)
+        if failed is None:
+            return node
+        node = failed
+
+
+def _failure_key(node: Node) -> tuple[str, str, str]:
+    return node.id, node.error.value if node.error is not None else "", node.message
+
+
 class Root(Node):
-    """The tree's root: ticks its one child and applies the run policy."""
+    """The tree's root: ticks its one child and applies the run policy.
+
+    Args:
+        give_up_after: with ``until_success``, fail after this many identical failures of
+            the child in a row (0: never give up).
+    """
 
     kind = "root"
 
     def __init__(
-        self, ctx: TreeContext, node_id: str, name: str = "", policy: RunPolicy = RunPolicy.ONCE
+        self,
+        ctx: TreeContext,
+        node_id: str,
+        name: str = "",
+        policy: RunPolicy = RunPolicy.ONCE,
+        give_up_after: int = DEFAULT_GIVE_UP_AFTER,
     ) -> None:
         super().__init__(ctx, node_id, name or "root")
+        if give_up_after < 0:
+            raise ValueError(f"give up after must be 0 (no limit) or more, not {give_up_after}")
         self.policy = RunPolicy(policy)
+        self.give_up_after = give_up_after
         self.runs = 0  # finished runs of the child
+        self._last_failure: tuple[str, str, str] | None = None
+        self.in_a_row = 0  # identical failures of the child in a row
 
     def update(self) -> Status:
         child = self.children[0]
@@ -54,13 +94,31 @@ class Root(Node):
             elif status is SKIPPED:
                 self.message = child.message or f"{child.name} was skipped"
             return status
+        if self.policy is RunPolicy.UNTIL_SUCCESS and self._gives_up(first_failed(child)):
+            return FAILURE
         # Run again from a clean subtree on the next tick.
         self.ctx.log(self.id, f"run {self.runs} ended with {status.value}; starting again")
         child.reset()
         return RUNNING
 
+    def _gives_up(self, origin: Node) -> bool:
+        """Count the failure that started at ``origin``; True (with the root's message and
+        error type set) when it is the ``give_up_after``-th identical one in a row.
+        """
+        key = _failure_key(origin)
+        self.in_a_row = self.in_a_row + 1 if key == self._last_failure else 1
+        self._last_failure = key
+        if not self.give_up_after or self.in_a_row < self.give_up_after:
+            return False
+        title = node_title(origin.kind, origin.name, leaf=not origin.children)
+        why = failed_words(title, key[1], origin.message)
+        self.fail(f"{stopped_words(self.in_a_row)}: {why}", origin.error)
+        return True
+
     def on_reset(self) -> None:
         self.runs = 0
+        self._last_failure = None
+        self.in_a_row = 0
 
 
 # How the earlier children of a parent count when a run starts at a later one.

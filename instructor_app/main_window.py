@@ -94,7 +94,7 @@ class MainWindow(QMainWindow):
         self.run_actions = RunActions(self.controller, self)
         self.running_panel = RunningNodesPanel(self._node_path, self)
         self.operator_panel = OperatorPanel(self)
-        self.failure_button = FailureButton(self._node_label, self)
+        self.failure_button = FailureButton(self)
         self.selection: list[str] = []
         self.cell_views = CellViews(self.document, session, self._selected_node, parent=self)
         self.library = LibraryController(

@@ -80,5 +80,8 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
 def _own_subtree_library(
     tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """Tests never read or write the user's subtree library: COSTAR_LIBRARY is a fresh folder."""
+    """Tests never read or write the user's subtree library or run records: COSTAR_LIBRARY
+    and COSTAR_RUNS are fresh folders.
+    """
     monkeypatch.setenv("COSTAR_LIBRARY", str(tmp_path_factory.mktemp("library")))
+    monkeypatch.setenv("COSTAR_RUNS", str(tmp_path_factory.mktemp("runs")))

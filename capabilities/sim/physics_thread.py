@@ -371,7 +371,8 @@ class PhysicsThread:
             ):
                 self._stand_still()
                 continue
-            if self.speed is not None and self._may_rest():
+            # Driven by an engine (lockstep), every step is one it asked for: no rest.
+            if self.speed is not None and not self._lockstep and self._may_rest():
                 self._rest(wall_start, sim_start)
                 continue
             self._step_once()

@@ -24,6 +24,7 @@ from engine.spec import (
     SubtreePort,
     SubtreeSpec,
 )
+from engine.tree import DEFAULT_GIVE_UP_AFTER
 from engine.types import ParamType, Waypoint
 
 __all__ = ["Model", "ReaderBase", "read_models"]
@@ -90,6 +91,11 @@ class ReaderBase:
             self.problem(
                 data.line, f"run_policy one of {', '.join(policies)}", repr(attrs["run_policy"])
             )
+        give_up = attrs.get("give_up_after", str(DEFAULT_GIVE_UP_AFTER))
+        if give_up.isdigit():
+            plan.give_up_after = int(give_up)
+        else:
+            self.problem(data.line, "give_up_after a whole number of 0 or more", repr(give_up))
         plan.reset_cell = attrs.get("reset_cell") == "true"
         plan.scene = attrs.get("scene", "")
         for item in data.children:

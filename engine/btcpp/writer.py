@@ -17,6 +17,7 @@ from engine.conditions import Condition
 from engine.kinds import KIND_PORTS
 from engine.operations import Direction, OperationKind, OperationManifest
 from engine.spec import Binding, NodeKind, NodeLayout, NodeSpec, PlanSpec, SubtreeSpec
+from engine.tree import DEFAULT_GIVE_UP_AFTER
 from engine.types import ParamType, check_value, type_of_value
 
 __all__ = ["FORMAT_VERSION", "UNUSED_OUTPUT", "export_xml"]
@@ -129,6 +130,8 @@ class _Writer:
                 "scene": plan.scene,
             },
         )
+        if plan.give_up_after != DEFAULT_GIVE_UP_AFTER:
+            data.set("give_up_after", str(plan.give_up_after))
         for decl in plan.parameters:
             attrs = {"name": decl.name, "type": ParamType(decl.type).value}
             if decl.value is not None:

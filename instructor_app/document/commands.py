@@ -41,6 +41,7 @@ __all__ = [
     "ReplaceNodeCommand",
     "RenamePlanCommand",
     "SetRunPolicyCommand",
+    "SetGiveUpAfterCommand",
     "SetResetCellCommand",
     "DeclareParameterCommand",
     "StoreWaypointsCommand",
@@ -316,13 +317,15 @@ class ReplaceNodeCommand(_Command):
 class PlanFieldCommand(_Command):
     """Set the plan-wide field ``FIELD`` to a value; subclasses are named for the user's edit.
 
-    The undo text is "Change the plan's <field>".
+    The undo text is "Change the plan's <field>" (``WHAT``, else the field's name).
     """
 
     FIELD: ClassVar[str]
+    WHAT: ClassVar[str] = ""
 
     def __init__(self, document: PlanModel, value: Any) -> None:
-        super().__init__(document, f"Change the plan's {self.FIELD.replace('_', ' ')}")
+        what = self.WHAT or self.FIELD.replace("_", " ")
+        super().__init__(document, f"Change the plan's {what}")
         self.new = copy.deepcopy(value)
         self.old = copy.deepcopy(getattr(document.plan, self.FIELD))
 
@@ -346,6 +349,18 @@ class SetRunPolicyCommand(PlanFieldCommand):
 
     def __init__(self, document: PlanModel, policy: RunPolicy) -> None:
         super().__init__(document, policy)
+
+
+class SetGiveUpAfterCommand(PlanFieldCommand):
+    """Choose after how many identical failures in a row a plan that runs until success
+    gives up (0: never).
+    """
+
+    FIELD = "give_up_after"
+    WHAT = "limit of identical failures"
+
+    def __init__(self, document: PlanModel, limit: int) -> None:
+        super().__init__(document, limit)
 
 
 class SetResetCellCommand(PlanFieldCommand):

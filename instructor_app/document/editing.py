@@ -33,6 +33,7 @@ from instructor_app.document.commands import (
     ReparentCommand,
     ReplaceWaypointCommand,
     SetConditionCommand,
+    SetGiveUpAfterCommand,
     SetLayoutCommand,
     SetParamCommand,
     SetResetCellCommand,
@@ -193,6 +194,12 @@ class PlanDocument(PlanModel):
     def set_run_policy(self, policy: RunPolicy) -> None:
         """Run the plan once, until success or forever."""
         self.push(SetRunPolicyCommand(self, policy))
+
+    def set_give_up_after(self, limit: int) -> None:
+        """Give up running until success after this many identical failures in a row (0:
+        never).
+        """
+        self.push(SetGiveUpAfterCommand(self, limit))
 
     def set_reset_cell(self, reset: bool) -> None:
         """Put the cell back to its scene's start before each run, or not."""

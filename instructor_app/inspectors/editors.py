@@ -151,8 +151,18 @@ class WaypointEditor(ParamEditor):
     def __init__(self, port: PortSpec | None = None, parent: QWidget | None = None) -> None:
         super().__init__(port, parent)
         self.combo = QComboBox()
+        self.combo.setPlaceholderText("choose a waypoint")
         self.combo.activated.connect(lambda i: self._commit(self.combo.itemData(i)))
         self._layout.addWidget(self.combo)
+
+    def show_unset(self, default: Any = None) -> None:
+        """An unbound waypoint port shows a blank asking for a choice, not the plan's first
+        waypoint (which would read as chosen); choosing any, the first too, binds it.
+        """
+        super().show_unset(default)
+        if default is None:
+            with QSignalBlocker(self.combo):
+                self.combo.setCurrentIndex(-1)
 
     def set_context(self, context: EditorContext) -> None:
         with QSignalBlocker(self.combo):
@@ -160,8 +170,12 @@ class WaypointEditor(ParamEditor):
             for waypoint in context.waypoints:
                 self.combo.addItem(f"{waypoint.name} ({waypoint.frame.value})", waypoint)
         if self._value is None and context.waypoints:
-            self._value = context.waypoints[0]
-        self._show(self._value)
+            self._value = context.waypoints[0]  # what "value" binds when chosen as the mode
+        if self._unset:
+            with QSignalBlocker(self.combo):
+                self.combo.setCurrentIndex(-1)
+        else:
+            self._show(self._value)
 
     def _show(self, value: Any) -> None:
         if not isinstance(value, Waypoint):

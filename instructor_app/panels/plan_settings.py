@@ -1,13 +1,15 @@
 """The plan's own settings: its name and its run policy (the paper's root "evaluated until it
-returns SUCCESS" is the policy "until success").
+returns SUCCESS" is the policy "until success"), and after how many identical failures in a
+row such a plan gives up.
 
-Each finished edit is one document command (``rename_plan``, ``set_run_policy``, ``set_reset_cell``); the panel follows the
-document (undo, open, new) without echoing edits back.
+Each finished edit is one document command (``rename_plan``, ``set_run_policy``,
+``set_give_up_after``, ``set_reset_cell``); the panel follows the document (undo, open, new)
+without echoing edits back.
 """
 
 from __future__ import annotations
 
-from PySide6.QtWidgets import QCheckBox, QComboBox, QFormLayout, QLineEdit, QWidget
+from PySide6.QtWidgets import QCheckBox, QComboBox, QFormLayout, QLineEdit, QSpinBox, QWidget
 
 from engine.spec import RunPolicy
 from instructor_app.document import PlanDocument
@@ -22,7 +24,7 @@ POLICY_TEXT: dict[RunPolicy, str] = {
 
 
 class PlanSettingsPanel(QWidget):
-    """Edits the plan's name and run policy.
+    """Edits the plan's name, run policy, limit of identical failures and cell reset.
 
     Args:
         document: the plan being edited.
@@ -43,6 +45,17 @@ class PlanSettingsPanel(QWidget):
             "forever: start again after every run"
         )
         self.policy_combo.activated.connect(self._policy_chosen)
+        self.give_up_spin = QSpinBox()
+        self.give_up_spin.setRange(0, 1_000_000)
+        self.give_up_spin.setSpecialValueText("never")  # 0
+        self.give_up_spin.setSuffix(" identical failures in a row")
+        self.give_up_spin.setKeyboardTracking(False)  # one edit when typing is done
+        self.give_up_spin.setToolTip(
+            "A plan that runs until success stops after this many failures in a row that "
+            "started at the same node with the same error and message (never: it keeps "
+            "trying)"
+        )
+        self.give_up_spin.valueChanged.connect(self._give_up_changed)
         self.reset_box = QCheckBox("Reset the cell before each run")
         self.reset_box.setToolTip("Robot and objects go back to the scene's start before a run")
         self.reset_box.clicked.connect(lambda: self._reset_clicked(self.reset_box.isChecked()))
@@ -50,6 +63,7 @@ class PlanSettingsPanel(QWidget):
         form.setContentsMargins(4, 4, 4, 4)
         form.addRow("Name", self.name_field)
         form.addRow("Run", self.policy_combo)
+        form.addRow("Give up after", self.give_up_spin)
         form.addRow("", self.reset_box)
         document.plan_changed.connect(self._refresh)
         document.plan_reset.connect(self._refresh)
@@ -65,6 +79,10 @@ class PlanSettingsPanel(QWidget):
         if policy is not RunPolicy(self.document.plan.run_policy):
             self.document.set_run_policy(policy)
 
+    def _give_up_changed(self, limit: int) -> None:
+        if limit != self.document.plan.give_up_after:
+            self.document.set_give_up_after(limit)
+
     def _reset_clicked(self, checked: bool) -> None:
         if checked != self.document.plan.reset_cell:
             self.document.set_reset_cell(checked)
@@ -76,5 +94,8 @@ class PlanSettingsPanel(QWidget):
         index = self.policy_combo.findData(RunPolicy(plan.run_policy).value)
         if index != self.policy_combo.currentIndex():
             self.policy_combo.setCurrentIndex(index)
+        if self.give_up_spin.value() != plan.give_up_after:
+            self.give_up_spin.setValue(plan.give_up_after)  # the same value: no new edit
+        self.give_up_spin.setEnabled(RunPolicy(plan.run_policy) is RunPolicy.UNTIL_SUCCESS)
         if self.reset_box.isChecked() != plan.reset_cell:
             self.reset_box.setChecked(plan.reset_cell)

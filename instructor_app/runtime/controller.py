@@ -11,18 +11,22 @@ from __future__ import annotations
 
 import copy
 from dataclasses import dataclass
+from pathlib import Path
 
 from PySide6.QtCore import QObject, QTimer, Signal
 
-from capabilities.cell_features import ReportsStatus
+from capabilities.cell_features import ReportsStatus, lockstep_of
 from capabilities.faults import hold_check
 from engine.blackboard import Blackboard, BlackboardError
 from engine.build import BuildError, build_tree
-from engine.error_types import ErrorType
 from engine.events import RunFinished
 from engine.executor import Executor, ExecutorState
+from engine.failure_words import failed_words
+from engine.run_records import RunRecordError, new_record_path, prune_records, runs_folder
+from engine.run_report import FailureLog, RootCause
 from engine.spec import PlanSpec
 from engine.status import RUNNING, Status
+from engine.trace import TraceRecorder
 from engine.tree import BehaviorTree
 from engine.validation import ERROR, Problem, has_errors, validate_plan
 from instructor_app.document.editing import PlanDocument
@@ -38,15 +42,22 @@ class RunOutcome:
 
     Attributes:
         event: the executor's RunFinished event (status, reason, ticks, message).
-        failed_node: the deepest node that was FAILURE at the end ("" if none).
-        failure_message: that node's message.
+        failed_node: the node of the plan the run's failure started at ("" if none; the
+            instance when it started inside one).
+        failure_message: why it failed there ("grasp_failed: nothing between the fingers").
         statuses: the last status seen of every node of the plan that ran.
+        cause: the root cause of the run's failure (None when it did not fail): the node it
+            started at, its error type and message, how often, the nodes that passed it up.
+        on_the_way: the other root causes: failures the run carried on past (with the node
+            that caught each) and fallbacks that failed too.
     """
 
     event: RunFinished
     failed_node: str
     failure_message: str
     statuses: dict[str, Status]
+    cause: RootCause | None = None
+    on_the_way: tuple[RootCause, ...] = ()
 
     @property
     def status(self) -> Status:
@@ -72,8 +83,13 @@ class RunController(QObject):
         running_nodes_changed(list): ids of the nodes now RUNNING, in plan order.
         run_finished(object): a :class:`RunOutcome`.
         run_refused(list): the validation problems (or a build error) that kept it from starting.
-        failure_changed(str, str): the deepest failing node and its message ("" "": none).
-        failures_described(object): node id -> "error type: message" of the nodes that failed.
+        failure_changed(str, str): the failing node and what to say of it: while the run goes,
+            the deepest failing node, "look for cup failed (not_found): no cup"; when it
+            failed, the node its failure started at and the root cause, "grasp CUP failed 4
+            times (grasp_failed): nothing between the fingers; passed up by ..." ("" "": none).
+        failures_described(object): node id -> "error type: message" of the nodes that failed;
+            when the run ends, the node each root cause started at -> "error type: message (4
+            times); passed up by ...; caught by ...".
         hold_changed(str, str): the cell held the run (why, and what to show: "held: protective
             stop, clear it on the pendant or press Unlock protective stop") or let it go on
             ("" ""). The nodes that were running stay shown RUNNING while it is held.
@@ -116,16 +132,19 @@ class RunController(QObject):
         self._timer.setInterval(max(1, round(1000 / drain_hz)))
         self._timer.timeout.connect(self._drain)
         self._executor: Executor | None = None
+        self._failures: FailureLog | None = None
         self._state: ExecutorState = ExecutorState.READY
         self._plan: PlanSpec | None = None
         self._order: dict[str, tuple[int, int]] = {}  # node id -> (depth, plan order)
         self._statuses: dict[str, Status] = {}
         self._messages: dict[str, str] = {}
+        self._said: dict[str, str] = {}  # node id -> "look for cup failed (not_found): no cup"
         self._last_board: Blackboard | None = None  # the last run's values, for a resume
         self._running: list[str] = []
         self._failure: tuple[str, str] = ("", "")
         self._stopping = False  # a stop was asked: the halt's IDLE resets are not shown
         self._held = ""  # why the cell holds the run ("" when it does not)
+        self.last_record: Path | None = None  # the record of the last run started
         self._idled: set[str] = set()  # nodes that went RUNNING -> IDLE at the last drain
 
     # ------------------------------------------------------------------ state
@@ -254,8 +273,17 @@ class RunController(QObject):
         self._reset_run(plan)
         self._statuses.update({k: v for k, v in done.items() if k in self._order})
         hold = hold_check(self.session.cell)  # a robot's stops (held, or thrown to a Catch)
+        self._failures = FailureLog(plan)  # on the dispatcher thread, read when the run ends
+        recorder = self._recorder(plan)  # first: what the views show is already recorded
+        # On the simulated cell the engine drives the world, paced to real time: the run
+        # is the one `costar run` gives for the same plan, scene and seed.
         self._executor = Executor(
-            tree, self.rate_hz, [self._pump.put], plan_name=plan.name, hold=hold
+            tree,
+            self.rate_hz,
+            [*recorder, self._pump.put, self._failures],
+            plan_name=plan.name,
+            hold=hold,
+            lockstep=lockstep_of(self.session.cell),
         )
         self._executor.start(paused=paused)
         self._timer.start()
@@ -272,6 +300,22 @@ class RunController(QObject):
         else:
             self.log_message.emit(f"Run of {plan.name or 'the plan'} started", "info")
         return True
+
+    def _recorder(self, plan: PlanSpec) -> list[TraceRecorder]:
+        """This run's record in the runs folder ($COSTAR_RUNS, else the user's; the oldest
+        removed past its size limit), as `costar run` keeps one; none when it cannot be
+        written (said in the Log: the run goes on).
+        """
+        folder = runs_folder()
+        try:
+            path = new_record_path(folder, plan.name)
+            recorder = TraceRecorder(path, plan)
+        except (RunRecordError, OSError) as exc:
+            self.log_message.emit(f"This run keeps no record: {exc}", "warning")
+            return []
+        prune_records(folder, keep=path)
+        self.last_record = path
+        return [recorder]
 
     def _resume_at(self, tree: BehaviorTree, node_id: str) -> dict[str, Status] | None:
         """Mark the nodes before ``node_id`` done and carry the last run's values over."""
@@ -294,6 +338,7 @@ class RunController(QObject):
         self._order = _depth_order(plan)
         self._pump.drain()  # leftovers of an earlier run must not colour this one
         self._statuses, self._messages, self._running = {}, {}, []
+        self._said = {}
         self._stopping = False
         self._held, self._idled = "", set()
         self._set_failure("", "")
@@ -370,10 +415,10 @@ class RunController(QObject):
         for node_id, message, error in batch.failures:
             if node_id in self._order:
                 described[node_id] = failure_text(error, message)
+                text = failed_words(self._label(node_id), error, message)
                 if batch.statuses.get(node_id) is Status.FAILURE:  # the failure panel shows it
                     self._messages[node_id] = described[node_id]
-                kind = f" ({error})" if error and error != ErrorType.FAILED.value else ""
-                text = f"{self._label(node_id)} failed{kind}" + (f": {message}" if message else "")
+                    self._said[node_id] = text
                 self.log_message.emit(text, "error")
         if described:
             self.failures_described.emit(described)
@@ -399,10 +444,13 @@ class RunController(QObject):
         if node_id:
             self._set_failure(node_id, message)
 
-    def _set_failure(self, node_id: str, message: str) -> None:
-        if (node_id, message) != self._failure:
-            self._failure = (node_id, message)
-            self.failure_changed.emit(node_id, message)
+    def _set_failure(self, node_id: str, message: str, text: str = "") -> None:
+        """The failure shown; ``text`` what to say ("" : as the log said it)."""
+        if not text and node_id:
+            text = self._said.get(node_id) or failed_words(self._label(node_id), "", message)
+        if (node_id, text) != self._failure:
+            self._failure = (node_id, text)
+            self.failure_changed.emit(node_id, text)
 
     def _finish(self, event: RunFinished) -> None:
         self._timer.stop()
@@ -410,10 +458,26 @@ class RunController(QObject):
         if self._held:
             self._held = ""
             self.hold_changed.emit("", "")
+        failures, self._failures = self._failures, None
+        cause = failures.failed_run() if failures is not None else None
+        others = tuple(failures.on_the_way()) if failures is not None else ()
         failed, message = ("", "")
-        if event.status is Status.FAILURE:
-            failed, message = self._deepest_failure()
-        self._set_failure(failed, message or (event.message if failed else ""))
+        if event.status is Status.FAILURE and event.reason == "finished" and cause is not None:
+            failed = cause.node_id.split("/")[0]  # inside an instance: the instance is shown
+            message = failure_text(cause.error, cause.message)
+            self._set_failure(failed, message, cause.describe())
+        else:
+            if event.status is Status.FAILURE:
+                failed, message = self._deepest_failure()
+            self._set_failure(failed, message or (event.message if failed else ""))
+        tips: dict[str, str] = {}
+        for root in (*others, *([cause] if cause else [])):  # the run's cause last: it wins
+            if root.node_id in self._order:
+                tips[root.node_id] = root.tip()
+            elif root.node_id.split("/")[0] in self._order:  # inside an instance: its
+                tips[root.node_id.split("/")[0]] = f"{root.node}: {root.tip()}"  # tip names it
+        if tips:
+            self.failures_described.emit(tips)
         if event.reason != "finished":
             halted = [k for k, v in self._statuses.items() if v is Status.RUNNING]
             if halted:
@@ -421,21 +485,24 @@ class RunController(QObject):
         if self._running:
             self._running = []
             self.running_nodes_changed.emit([])
+        for other in others:
+            self.log_message.emit(f"On the way: {other.describe()}", "info")
         level = "info" if event.status in (Status.SUCCESS, Status.SKIPPED) else "warning"
-        self.log_message.emit(self._summary(event, failed, message), level)
+        self.log_message.emit(self._summary(event, self._failure[1] if failed else ""), level)
         self._set_state(ExecutorState.FINISHED)
-        self.run_finished.emit(RunOutcome(event, failed, message, dict(self._statuses)))
+        outcome = RunOutcome(event, failed, message, dict(self._statuses), cause, others)
+        self.run_finished.emit(outcome)
 
-    def _summary(self, event: RunFinished, failed: str = "", message: str = "") -> str:
-        """The run's last log line; a failed run names the leaf that made it fail and why
-        (not the composites above it, "Selector failed").
+    def _summary(self, event: RunFinished, why: str = "") -> str:
+        """The run's last log line; a failed run says why: its root cause, the node the
+        failure started at (not the composites above it, "Selector failed").
         """
         name = (self._plan.name if self._plan else "") or "the plan"
         if event.reason != "finished":
             return f"Run of {name} {event.reason} after {event.tick} ticks"
         text = f"Run of {name} ended: {event.status.value} after {event.tick} ticks"
-        if event.status is Status.FAILURE and failed:
-            text += f": {self._label(failed)} failed" + (f": {message}" if message else "")
+        if event.status is Status.FAILURE and why:
+            text += f": {why}"
         return text
 
     def _label(self, node_id: str) -> str:

@@ -116,7 +116,9 @@ class RunningNodesPanel(QListWidget):
 
 
 class FailureButton(QPushButton):
-    """The status bar's "failed: NODE: message"; clicking selects the node.
+    """The status bar's "grasp CUP failed 4 times (grasp_failed): nothing between the
+    fingers"; the tooltip says all of it (the nodes that passed it up); clicking selects the
+    node.
 
     Signals:
         node_selected(str): the failing node, when clicked.
@@ -124,9 +126,8 @@ class FailureButton(QPushButton):
 
     node_selected = Signal(str)
 
-    def __init__(self, label: LabelFn, parent: QWidget | None = None) -> None:
+    def __init__(self, parent: QWidget | None = None) -> None:
         super().__init__(parent)
-        self._label = label
         self.node_id = ""
         self.setFlat(True)
         self.setObjectName("FailureButton")
@@ -135,15 +136,15 @@ class FailureButton(QPushButton):
         self.clicked.connect(lambda: self.node_selected.emit(self.node_id))
         self.show_failure("", "")
 
-    def show_failure(self, node_id: str, message: str) -> None:
+    def show_failure(self, node_id: str, text: str) -> None:
+        """Show ``text``, what failed and why (its first part, up to "; ", on the button)."""
         self.node_id = node_id
         if not node_id:
             self.setText("")
             self.setToolTip("")
             self.hide()
             return
-        text = f"Failed: {self._label(node_id)}" + (f": {message}" if message else "")
-        self.setText(text)
+        self.setText(text.split("; ")[0])
         self.setToolTip(f"{text}\nClick to select the node.")
         self.show()
 
@@ -215,5 +216,7 @@ class RunPresenter(QObject):
         event = outcome.event
         if event.reason != "finished":
             self._show(f"Run {event.reason} after {event.tick} ticks")
+        elif outcome.cause is not None:  # why: the root cause, with its count
+            self._show(f"Run ended: FAILURE after {event.tick} ticks: {outcome.cause.describe()}")
         else:
             self._show(f"Run ended: {event.status.value} after {event.tick} ticks")

@@ -53,3 +53,23 @@ def test_a_tiny_run_prints_one_json_object_of_every_case(
     assert figures["tending"]["ours"] == {"skipped": "not asked for"}
     assert set(figures["cup_to_bin"]) == {"runs", "succeeded", "failures", "wall_s_per_run"}
     assert figures["cup_to_bin"]["runs"] == 1
+
+
+def test_pairs_of_trials_give_each_figure_with_its_spread(casestudies: ModuleType) -> None:
+    """Two pairs of trials (fake counters): each pair's Table I, each row's mean, minimum and
+    maximum over the pairs, and the table prints them as mean (min-max).
+    """
+    tending = importlib.import_module("bench._tending")
+
+    def trial(caught: int, lost: int) -> dict[str, object]:
+        return {"produced": caught + lost, "caught": caught, "lost": lost, "sim_seconds": 900.0}
+
+    trials = [trial(40, 10), trial(42, 8), trial(45, 5), trial(47, 3)]
+    figures = tending._total(trials) | tending._spread(trials, 2)
+    assert [p["caught"] for p in figures["pairs"]] == [82, 92]
+    assert figures["spread"]["caught"] == {"mean": 87.0, "min": 82.0, "max": 92.0}
+    assert figures["spread"]["produced"] == {"mean": 100.0, "min": 100.0, "max": 100.0}
+    text = tending.table_one({"paper": figures, "ours": {"skipped": "not run"}})
+    assert text.splitlines()[0].startswith("Table I, 2 pairs")
+    caught = next(line for line in text.splitlines() if line.startswith("caught"))
+    assert caught.split()[1:] == ["82", "87", "(82-92)", "-"]

@@ -79,9 +79,13 @@ def test_run_success_exits_0_and_verbose_prints_status_changes() -> None:
     assert "CUP_POSE" in out
     summary = out[out.index("SUCCESS after") :].splitlines()
     # The cup is not found twice: those failures, and what carried on past them, are named.
-    assert summary[1:3] == [
+    assert summary[1:4] == [
         "  on the way:",
-        "  - CUP found failed 2 times (false), caught by the plan's root (runs until success)",
+        "  - CUP found failed 2 times: false; passed up by Sequence 'transfer'; caught by "
+        "Selector 'transfer or wait'",
+        "  - Force failure 'then try again' failed 2 times: forced failure; passed up by "
+        "Selector 'transfer or wait', Sequence 'cup to bin'; caught by the plan's root (runs "
+        "until success)",
     ]
 
 

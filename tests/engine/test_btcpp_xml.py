@@ -21,6 +21,7 @@ from engine.spec import (
     NodeSpec,
     ParameterDecl,
     PlanSpec,
+    RunPolicy,
     SubtreePort,
     SubtreeSpec,
 )
@@ -145,6 +146,8 @@ def test_plan_data_parameters_waypoints_objects_and_off_tree_layout_come_back() 
         tree=leaf,
         name="data: all of it / <here>",
         description='quotes " and\nnewlines\r\nand tabs\t',
+        run_policy=RunPolicy.UNTIL_SUCCESS,
+        give_up_after=0,
         reset_cell=True,
         parameters=[
             ParameterDecl("HOME", ParamType.JOINTS, JointConfig((0.1, -1.2, 3.0)), "home"),
@@ -337,7 +340,8 @@ def test_every_field_of_the_spec_is_carried() -> None:
     or the XML round trip silently drops it: this test names the fields it knows.
     """
     carried = {
-        PlanSpec: {"tree", "name", "description", "run_policy", "reset_cell", "scene"}
+        PlanSpec: {"tree", "name", "description", "run_policy", "give_up_after", "reset_cell"}
+        | {"scene"}
         | {"parameters", "waypoints", "objects", "layout", "id", "subtrees"},
         NodeSpec: {"kind", "name", "id", "op", "params", "children", "subtree", "conditions"},
         SubtreeSpec: {"id", "name", "tree", "version", "date", "description", "inputs"}

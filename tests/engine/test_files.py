@@ -189,6 +189,16 @@ def test_empty_plan_and_defaults() -> None:
     assert doc["tree"] is None and doc["layout"] == {"nodes": {}}
     minimal = loads_plan('{"format": "costar-plan", "format_version": 1}')
     assert minimal.tree is None and minimal.run_policy is RunPolicy.ONCE and minimal.id
+    assert minimal.give_up_after == 5  # files written before the limit get the default
+    assert "give_up_after" not in doc  # the default is not written: old files round-trip
+
+
+def test_the_limit_of_identical_failures_round_trips() -> None:
+    for limit in (0, 1, 12):
+        plan = PlanSpec(id="p1", run_policy=RunPolicy.UNTIL_SUCCESS, give_up_after=limit)
+        text = dump_plan(plan)
+        assert json.loads(text)["give_up_after"] == limit
+        assert loads_plan(text).give_up_after == limit
 
 
 def test_half_built_plans_load() -> None:
@@ -251,6 +261,8 @@ BAD: list[tuple[str, Any, str, str]] = [
     ("unknown top field", plan_doc(trea=None), "$.trea", "one of the fields format"),
     ("name a number", plan_doc(name=3), "$.name", "a text"),
     ("bad run policy", plan_doc(run_policy="twice"), "$.run_policy", "once, until_success, forever"),
+    ("negative limit", plan_doc(give_up_after=-1), "$.give_up_after", "0 or more"),
+    ("limit as text", plan_doc(give_up_after="5"), "$.give_up_after", "whole number"),
     ("tree a list", plan_doc([]), "$.tree", "an object with id, kind"),
     ("unknown node field", plan_doc(node_doc("a", "wait", kidn=1)), "$.tree.kidn", "one of the fields id"),
     ("missing kind", plan_doc({"id": "a"}), "$.tree.kind", "required"),

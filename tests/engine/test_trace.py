@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -63,6 +64,34 @@ def test_a_recorded_run_reads_back(tmp_path: Path, registry: CapabilityRegistry)
     assert trace.events[0]["event"] == "started" and trace.events[-1]["event"] == "finished"
     lines = path.read_text(encoding="utf-8").splitlines()
     assert all(json.loads(line) for line in lines)  # one JSON object per line
+
+
+def test_a_trace_names_the_root_causes_of_a_failed_run(
+    tmp_path: Path, registry: CapabilityRegistry
+) -> None:
+    pick = op(
+        "debug.fail", "grasp CUP", message="nothing between the fingers", error="grasp_failed"
+    )
+    ask = op("debug.fail", "ask for help", message="no one answered")
+    retry = logic(NodeKind.RETRY, pick, name="pick 4 times", count=4)
+    spec = plan(logic(NodeKind.SELECTOR, retry, ask, name="pick or ask"), name="pick")
+    path = tmp_path / "run.trace.jsonl"
+    executor = Executor(
+        build_tree(spec, registry), rate_hz=1000.0, listeners=[TraceRecorder(path, spec)]
+    )
+    executor.start()
+    assert executor.wait(5.0) is not None
+    trace = read_trace(path)
+    failures, finished = trace.events[-2:]
+    assert finished["event"] == "finished" and failures["event"] == "failures"
+    assert failures["cause"]["node"] == pick.id and failures["cause"]["times"] == 4
+    assert failures["cause"]["error"] == "grasp_failed"
+    lines = list(format_timeline(trace))[-3:-1]
+    assert [re.split(r" tick +\d+  ", line, maxsplit=1)[1] for line in lines] == [
+        "the run failed: grasp CUP failed 4 times (grasp_failed): nothing between the fingers; "
+        "passed up by Retry 'pick 4 times', Selector 'pick or ask'",
+        "on the way: ask for help failed: no one answered; passed up by Selector 'pick or ask'",
+    ]
 
 
 def test_the_recorder_closes_at_the_end_of_the_run(tmp_path: Path) -> None:

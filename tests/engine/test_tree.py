@@ -10,6 +10,8 @@ from bt_fakes import FakeClock, ScriptedLeaf, logic, op, plan, rooted, with_chil
 from capabilities.base import CapabilityRegistry
 from engine.build import build_tree
 from engine.composites import Parallel, Sequence
+from engine.error_types import ErrorType
+from engine.node import Node
 from engine.spec import NodeKind, ParameterDecl
 from engine.status import FAILURE, IDLE, RUNNING, SUCCESS, Status
 from engine.tree import RunPolicy
@@ -49,6 +51,68 @@ def test_forever_reruns_after_every_result(ctx: Any) -> None:
     assert child.updates == 10 and tree.root.runs == 10
     tree.reset()
     assert tree.root.runs == 0 and child.status is IDLE
+
+
+class Failing(Node):
+    """A leaf that fails with the next of its messages each time it runs."""
+
+    kind = "action"
+
+    def __init__(self, ctx: Any, name: str, *messages: str) -> None:
+        super().__init__(ctx, name, name)
+        self.messages = list(messages)
+        self.runs = 0
+
+    def update(self) -> Status:
+        message = self.messages[min(self.runs, len(self.messages) - 1)]
+        self.runs += 1
+        return self.fail(message, ErrorType.GRASP_FAILED)
+
+
+def test_until_success_gives_up_after_5_identical_failures_in_a_row(ctx: Any) -> None:
+    grasp = Failing(ctx, "grasp CUP", "nothing between the fingers")
+    tree = rooted(ctx, grasp, RunPolicy.UNTIL_SUCCESS)
+    assert tree.tick_until_done(max_ticks=100) is FAILURE
+    assert grasp.runs == 5 and tree.root.runs == 5
+    assert tree.root.message == (
+        "stopped after 5 identical failures in a row: "
+        "grasp CUP failed (grasp_failed): nothing between the fingers"
+    )
+    assert tree.root.error is ErrorType.GRASP_FAILED
+
+
+def test_a_different_failure_starts_the_count_again(ctx: Any) -> None:
+    grasp = Failing(ctx, "grasp", "a", "a", "b", "a", "a", "a")  # then "a" for ever
+    tree = rooted(ctx, grasp, RunPolicy.UNTIL_SUCCESS)
+    tree.root.give_up_after = 3
+    assert tree.tick_until_done(max_ticks=100) is FAILURE
+    assert grasp.runs == 6  # a a b, then three a in a row
+
+
+def test_no_limit_and_forever_never_give_up(ctx: Any) -> None:
+    for policy, limit in ((RunPolicy.UNTIL_SUCCESS, 0), (RunPolicy.FOREVER, 5)):
+        grasp = Failing(ctx, "grasp", "the same")
+        tree = rooted(ctx, grasp, policy)
+        tree.root.give_up_after = limit
+        assert tree.tick_until_done(max_ticks=50) is RUNNING
+        assert grasp.runs == 50
+
+
+def test_the_first_failed_option_of_a_fallback_is_what_counts(
+    registry: CapabilityRegistry, clock: FakeClock
+) -> None:
+    """Figure 3 without a cup: the transfer fails at "CUP found" every time, then the forced
+    failure of the wait; the root gives up naming the missing cup, not the wait.
+    """
+    tree, _ = figure3(registry, clock, failures=100)
+    assert run_by_hand(tree, clock) is FAILURE
+    assert tree.root.runs == 5
+    assert tree.root.message == (
+        "stopped after 5 identical failures in a row: OBJECT_FOUND failed: false"
+    )
+    tree, _ = figure3(registry, clock, failures=6)
+    tree.root.give_up_after = 7
+    assert run_by_hand(tree, clock, max_ticks=400) is SUCCESS
 
 
 def test_running_leaves_and_reset(ctx: Any) -> None:

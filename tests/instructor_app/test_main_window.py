@@ -217,7 +217,8 @@ def test_a_failure_is_shown_and_clicking_it_selects_the_node(
     leaf = node_named(window, "look for cup")
     assert outcome.failed_node == leaf
     button = window.failure_button
-    assert button.isVisible() and "look for cup: no cup" in button.text()
+    assert button.isVisible() and button.text() == "look for cup failed: no cup"
+    assert "passed up by Sequence 'inner', Sequence 'top'" in button.toolTip()
     button.click()
     assert window.views.canvas.selected_ids() == [leaf]
 

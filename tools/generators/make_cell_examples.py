@@ -132,6 +132,11 @@ def _figure3_tree(m: _Cell, finder: str, detect: str, title: str) -> NodeSpec:
     )
 
 
+# The Figure 3 plans wait a second and look again while the cup is not there: they give up
+# after a minute of looks that fail the same way, not after the default 5.
+LOOKS = 60
+
+
 def _figure3_plan(name: str, detect: tuple[str, str], root: str, title: str, doc: str) -> PlanSpec:
     """Figure 3's plan ``name`` on the simulated cell, finding the cup with ``detect``."""
     tree = _figure3_tree(_Cell(name), *detect, root)
@@ -140,6 +145,7 @@ def _figure3_plan(name: str, detect: tuple[str, str], root: str, title: str, doc
         title,
         doc,
         RunPolicy.UNTIL_SUCCESS,
+        give_up_after=LOOKS,
         waypoints=waypoints(),
         objects=["cup", "waste_bin"],
         reset_cell=True,  # each run in the Instructor starts from the scene's seed
@@ -172,9 +178,11 @@ def cup_to_bin() -> PlanSpec:
         "markers, checks the cup was found and grasps it at its pose with the grasp of its "
         "object model; Place over bin drops it at the waypoint taught relative to the bin. "
         "When the cup is not visible the selector falls back to Wait (forced to fail) and "
-        "the root, which runs until success, looks again. Run it with: costar run "
+        "the root, which runs until success, looks again (it gives up after 60 looks in a "
+        "row that fail the same way: over a minute without a cup). Run it with: costar run "
         "example:cup_to_bin --seed N. Runs to SUCCESS.",
         RunPolicy.UNTIL_SUCCESS,
+        give_up_after=LOOKS,
         waypoints=waypoints(),
         objects=["cup", "waste_bin"],
         reset_cell=True,  # each run in the Instructor starts from the scene's seed
@@ -195,7 +203,7 @@ def cup_to_bin_vision() -> PlanSpec:
         "hides the table from the shoulder camera'), the shoulder camera's point cloud is matched to the cup and waste-bin models, the plan checks the "
         "cup was found, queries both poses, grasps the cup at its pose with the grasp of its "
         "object model and drops it over the bin; when the cup is not recognised it waits and looks "
-        "again. Run it with: costar run example:cup_to_bin_vision --seed N.",
+        "again (60 times in a row at most). Run it with: costar run example:cup_to_bin_vision --seed N.",
     )
 
 

@@ -117,6 +117,7 @@ def test_teaching_a_waypoint_binds_the_port_in_the_same_step(doc: PlanDocument) 
         (lambda d: d.rename_plan("another name"), "Change the plan's name"),
         (lambda d: d.set_run_policy(RunPolicy.FOREVER), "Change the plan's run policy"),
         (lambda d: d.set_reset_cell(not d.plan.reset_cell), "Change the plan's reset cell"),
+        (lambda d: d.set_give_up_after(9), "Change the plan's limit of identical failures"),
         (
             lambda d: d.declare_parameter(ParameterDecl("SPEED", ParamType.NUMBER, 0.5)),
             "Change the plan's parameters",

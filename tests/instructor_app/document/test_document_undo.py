@@ -79,6 +79,7 @@ EDITS: dict[str, Edit] = {
     "plan name": lambda d: d.rename_plan("renamed plan"),
     "plan run policy": lambda d: d.set_run_policy(RunPolicy.FOREVER),
     "plan reset cell": lambda d: d.set_reset_cell(not d.plan.reset_cell),
+    "plan give up after": lambda d: d.set_give_up_after(d.plan.give_up_after + 1),
     "plan parameters": lambda d: d.declare_parameter(
         ParameterDecl("SPEED", ParamType.NUMBER, 0.25)
     ),

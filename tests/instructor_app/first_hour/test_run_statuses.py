@@ -39,3 +39,29 @@ def test_stop_keeps_the_last_statuses_until_the_next_run(
     qtbot.waitUntil(lambda: canvas.status_of(slow) is Status.RUNNING)
     with qtbot.waitSignal(window.controller.run_finished, timeout=10_000):
         window.run_actions.stop.trigger()
+
+
+def test_every_run_in_the_instructor_keeps_a_record_in_the_runs_folder(
+    qtbot: Any, none_session: CellSession, tmp_path: Path, monkeypatch: Any
+) -> None:
+    """As `costar run` does: the record is the run's trace, in $COSTAR_RUNS (here a folder
+    of the test's), and `costar runs list` names how the run ended.
+    """
+    from engine.run_records import list_records
+    from engine.trace import read_trace
+
+    runs = tmp_path / "runs"
+    monkeypatch.setenv("COSTAR_RUNS", str(runs))
+    window = make_window(qtbot, none_session, tmp_path)
+    window.document.load_text(dump_plan(endless_plan()), None)
+    slow = node_named(window, "slow")
+    window.run_actions.run.trigger()
+    qtbot.waitUntil(lambda: window.views.canvas.status_of(slow) is Status.RUNNING)
+    with qtbot.waitSignal(window.controller.run_finished, timeout=10_000):
+        window.run_actions.stop.trigger()
+    record = window.controller.last_record
+    assert record is not None and record.parent == runs
+    trace = read_trace(record)
+    assert trace.events[-1]["event"] == "finished" and trace.events[-1]["reason"] == "stopped"
+    assert any(e.get("node") == slow and e.get("new") == "RUNNING" for e in trace.events)
+    assert [s.path for s in list_records(runs)] == [record]

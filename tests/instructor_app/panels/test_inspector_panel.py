@@ -13,7 +13,8 @@ from capabilities.base import CapabilityRegistry
 from engine.spec import Binding, NodeKind, NodeSpec, ParameterDecl
 from engine.types import ParamType, Pose, Waypoint
 from instructor_app.document import PlanDocument
-from instructor_app.inspectors.editors import ChoiceEditor, NumberEditor
+from instructor_app.inspectors.base import EditorContext
+from instructor_app.inspectors.editors import ChoiceEditor, NumberEditor, WaypointEditor
 from instructor_app.inspectors.rows import MODE_REFERENCE, MODE_UNSET, MODE_VALUE
 from instructor_app.panels.inspector import InspectorPanel
 
@@ -314,3 +315,22 @@ def test_a_condition_problem_is_marked_on_its_field(
     panel.set_problems(validate_plan(document.plan, registry))
     assert "while condition of 'Go' is not a script" in panel.field_problem("while")
     assert "line 1, column" in panel.field_problem("while")
+
+
+def test_an_unset_waypoint_asks_for_a_choice_and_the_first_one_chosen_binds_it(
+    qtbot: QtBot,
+) -> None:
+    """Not the plan's first waypoint shown as if chosen: a blank that asks for one."""
+    first = Waypoint("above_cup", pose=Pose((0.4, 0.0, 0.3)))
+    second = Waypoint("over_bin", pose=Pose((0.5, -0.2, 0.3)))
+    editor = WaypointEditor()
+    qtbot.addWidget(editor)
+    editor.show_unset()
+    editor.set_context(EditorContext(waypoints=(first, second)))
+    assert editor.combo.currentIndex() == -1 and editor.combo.currentText() == ""
+    assert editor.combo.placeholderText() == "choose a waypoint"
+    with qtbot.waitSignal(editor.value_committed) as committed:
+        _choose(editor.combo, 0)
+    assert committed.args == [first]
+    editor.set_context(EditorContext(waypoints=(first, second)))  # bound: shown as chosen
+    assert editor.combo.currentText().startswith("above_cup")

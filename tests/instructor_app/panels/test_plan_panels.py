@@ -181,3 +181,25 @@ def test_plan_settings_set_the_name_and_the_run_policy(qtbot: Any, doc: PlanDocu
     doc.undo_stack.undo()
     assert panel.policy_combo.currentText() == "once"
     assert panel.name_field.text() == doc.plan.name
+
+
+def test_plan_settings_set_the_limit_of_identical_failures(qtbot: Any, doc: PlanDocument) -> None:
+    panel = PlanSettingsPanel(doc)
+    qtbot.addWidget(panel)
+    panel.show()
+    spin = panel.give_up_spin
+    assert spin.value() == 5 and not spin.isEnabled()  # only for until success
+    choose(qtbot, panel.policy_combo, "until success")
+    assert spin.isEnabled()
+    before = doc.serialized()
+    spin.lineEdit().selectAll()
+    qtbot.keyClicks(spin, "12")
+    qtbot.keyClick(spin, Qt.Key.Key_Return)
+    assert doc.plan.give_up_after == 12
+    one_undoable_step(doc, before, 1)
+    assert doc.undo_stack.undoText() == "Change the plan's limit of identical failures"
+    spin.setValue(0)
+    assert doc.plan.give_up_after == 0 and spin.text() == "never"
+    doc.undo_stack.undo()
+    doc.undo_stack.undo()
+    assert spin.value() == 5 and doc.plan.give_up_after == 5

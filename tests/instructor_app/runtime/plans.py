@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
+from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec, RunPolicy
 from engine.types import ParamType
 
 
@@ -39,3 +39,23 @@ def invalid_plan() -> PlanSpec:
     unbound = op("debug.log", "say nothing")
     top = NodeSpec(NodeKind.SEQUENCE, name="top", children=[unknown, unbound])
     return PlanSpec(tree=top, name="invalid")
+
+
+def pick_behind_a_retry_plan(give_up_after: int = 2) -> PlanSpec:
+    """A pick that fails 4 times behind a Retry, then a fallback that fails too, run until
+    success: the root gives up after ``give_up_after`` identical failures in a row.
+    """
+    pick = op(
+        "debug.fail",
+        "grasp CUP",
+        message=text("nothing between the fingers"),
+        error=text("grasp_failed"),
+    )
+    retry = NodeSpec(
+        NodeKind.RETRY, name="pick 4 times", params={"count": number(4)}, children=[pick]
+    )
+    ask = op("debug.fail", "ask for help", message=text("no one answered"))
+    top = NodeSpec(NodeKind.SELECTOR, name="pick or ask", children=[retry, ask])
+    return PlanSpec(
+        tree=top, name="pick", run_policy=RunPolicy.UNTIL_SUCCESS, give_up_after=give_up_after
+    )

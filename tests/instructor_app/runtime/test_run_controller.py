@@ -79,7 +79,9 @@ def test_a_failing_run_names_the_deepest_failed_leaf(qtbot: Any, none_session: C
     leaf = next(n.id for _, n in document.plan.walk() if n.name == "look for cup")
     assert outcome.status is Status.FAILURE
     assert (outcome.failed_node, outcome.failure_message) == (leaf, "no cup")
-    assert seen.failures[-1] == (leaf, "no cup")
+    cause = "look for cup failed: no cup; passed up by Sequence 'inner', Sequence 'top'"
+    assert seen.failures[-1] == (leaf, cause)
+    assert outcome.cause is not None and outcome.cause.describe() == cause
     assert any(level == "error" and "look for cup failed: no cup" in t for t, level in seen.logs)
 
 
@@ -175,11 +177,16 @@ def test_a_failure_shows_its_error_type_in_the_log_the_panel_and_the_canvas_tips
     controller.failures_described.connect(described.append)
     outcome = finish(qtbot, controller, controller.run)
     leaf = next(n.id for _, n in document.plan.walk() if n.name == "look for cup")
-    assert seen.failures[-1] == (leaf, "not_found: no cup")
+    assert seen.failures[-1] == (
+        leaf,
+        "look for cup failed (not_found): no cup; passed up by Sequence 'inner', Sequence 'top'",
+    )
     assert outcome.failure_message == "not_found: no cup"
     assert ("look for cup failed (not_found): no cup", "error") in seen.logs
+    assert described[0][leaf] == "not_found: no cup"  # while it runs
     merged = {k: v for batch in described for k, v in batch.items()}
-    assert merged[leaf] == "not_found: no cup"
+    # when it ended, the root cause with the nodes that passed it up
+    assert merged[leaf] == "not_found: no cup; passed up by Sequence 'inner', Sequence 'top'"
     assert merged[document.plan.tree.id] == "not_found: inner failed"  # passed up the tree
 
 
