@@ -310,7 +310,8 @@ def _report(
     why = cause if result.status is Status.FAILURE and cause else result.message
     note = f" ({why})" if why else ""
     print(f"{name}: {result.status.value} after {result.tick} ticks{note}", file=out)
-    return EXIT_SUCCESS if result.status is Status.SUCCESS else EXIT_FAILURE
+    # A run its conditions skipped (BehaviorTree.CPP's SKIPPED) did what it was told.
+    return EXIT_SUCCESS if result.status in (Status.SUCCESS, Status.SKIPPED) else EXIT_FAILURE
 
 
 def _report_caught(failures: FailureLog, out: TextIO) -> None:

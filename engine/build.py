@@ -20,6 +20,7 @@ from engine.composites import (
     Selector,
     Sequence,
 )
+from engine.conditions import Condition, NodeConditions
 from engine.context import TreeContext
 from engine.decorators import (
     Enforce,
@@ -38,6 +39,7 @@ from engine.kinds import settings_of
 from engine.leaves import OperationLeaf, ScriptLeaf, Wait
 from engine.node import Node
 from engine.operations import Direction, OperationNotFound, OperationSource
+from engine.script import ScriptSyntaxError, parse_script
 from engine.spec import NodeKind, NodeSpec, PlanSpec
 from engine.tree import BehaviorTree, Root
 from engine.types import with_article
@@ -195,8 +197,23 @@ def _instance(spec: NodeSpec, build: _Build, path: str, scope: Scope) -> Node:
         if (binding := spec.params.get(port.name)) is not None and binding.ref
     ]
     node = SubtreeInstance(build.ctx, scope.node_id(spec.id), spec.label, inputs, outputs)
+    _add_conditions(node, spec, build.ctx, path, scope)
     node.set_children([_build_node(subtree.tree, build, f"{path}/{subtree.name}", inner)])
     return node
+
+
+def _add_conditions(node: Node, spec: NodeSpec, ctx: TreeContext, path: str, scope: Scope) -> None:
+    """The node's pre- and post-conditions, run in the scope the node is in."""
+    if not spec.conditions:
+        return
+    for condition, text in spec.conditions.items():
+        try:
+            parse_script(text) if text.strip() else None
+        except ScriptSyntaxError as exc:
+            what = Condition(condition).value.replace("_", " ")
+            raise BuildError(path, f"its {what} condition is not a script: {exc}") from exc
+    conditions = NodeConditions(spec.conditions, ctx.blackboard, key=scope.key, writer=node.id)
+    node.conditions = conditions or None
 
 
 def _build_node(spec: NodeSpec, build: _Build, path: str, scope: Scope) -> Node:
@@ -207,6 +224,7 @@ def _build_node(spec: NodeSpec, build: _Build, path: str, scope: Scope) -> Node:
             node = _operation_leaf(spec, build, path, scope)
         else:
             node = _logic_node(spec, build.ctx, scope.node_id(spec.id), scope)
+        _add_conditions(node, spec, build.ctx, path, scope)
         children = [
             _build_node(child, build, f"{path}/{child.label}[{index}]", scope)
             for index, child in enumerate(spec.children)

@@ -3,7 +3,8 @@
 The body is ticked; its SUCCESS is the Catch's. When it fails with one of the caught error
 types, the caught error is written as ``"type: message"`` to the chosen parameter and the
 handler runs; its result is the Catch's. A failure of a type not caught fails the Catch with
-the same type and message, so an outer Catch can take it.
+the same type and message, so an outer Catch can take it. A skipped body skips the Catch; a
+skipped handler leaves the failure standing (the Catch fails as the body did).
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from engine.blackboard import BlackboardError
 from engine.context import TreeContext
 from engine.error_types import ErrorType
 from engine.node import Node
-from engine.status import FAILURE, Status
+from engine.status import FAILURE, SKIPPED, Status
 
 __all__ = ["Catch"]
 
@@ -73,6 +74,9 @@ class Catch(Node):
                     return self.fail(str(exc), ErrorType.INVALID_INPUT)
             self.ctx.log(self.id, f"caught {caught}")
         status = handler.tick()
+        if status is SKIPPED:
+            why = body.message or f"{body.name} failed"
+            return self.fail(f"{why} (its handler was skipped)", body.error or ErrorType.FAILED)
         if status is FAILURE:
             self.message = handler.message or f"{handler.name} failed"
         return status

@@ -4,13 +4,17 @@ Sequence and Selector keep their place (memory semantics, as BehaviorTree.CPP's 
 py_trees' ``memory=True``): a RUNNING child is resumed, finished children are not ticked
 again until the node is reset. The reactive variants re-check their condition children every
 tick and halt a running sibling when the answer changes.
+
+A SKIPPED child is passed over as BehaviorTree.CPP's composites do: a Sequence or a Selector
+goes on to the next child, and is SKIPPED itself when every child was skipped. The reactive
+variants and a Parallel check a skipped child afresh on each tick.
 """
 
 from __future__ import annotations
 
 from engine.context import TreeContext
 from engine.node import Node
-from engine.status import FAILURE, RUNNING, SUCCESS, Status
+from engine.status import FAILURE, RUNNING, SKIPPED, SUCCESS, Status
 
 __all__ = [
     "Sequence",
@@ -25,8 +29,9 @@ __all__ = [
 class _InOrder(Node):
     """The walk of a Sequence or a Selector: children in order, the next after ``next_on``.
 
-    It ends with the first child's result that is not ``next_on`` (halting nothing), or with
-    ``next_on`` when every child gave it.
+    It ends with the first child's result that is not ``next_on`` or SKIPPED (halting
+    nothing), or with ``next_on`` when every child gave it or was skipped (SKIPPED when every
+    child was skipped).
     """
 
     next_on: Status = SUCCESS
@@ -39,6 +44,10 @@ class _InOrder(Node):
         return status
 
     def _exhausted(self) -> Status:
+        children = self.children
+        if children and all(child.status is SKIPPED for child in children):
+            self.message = "every child was skipped"
+            return SKIPPED
         if self.exhausted_message:
             self.message = self.exhausted_message
         return self.next_on
@@ -59,7 +68,7 @@ class _Resuming(_InOrder):
         while index < count:
             child = children[index]
             status = child.tick()
-            if status is next_on:
+            if status is next_on or status is SKIPPED:
                 index += 1
                 continue
             self._index = index
@@ -117,6 +126,10 @@ class ParallelPolicy:
 class Parallel(Node):
     """Ticks every unfinished child each tick; finishes by its policy and then halts the
     children still running.
+
+    A skipped child is checked afresh each tick. As in BehaviorTree.CPP (a success count of
+    -1), a skipped child counts as a success for the policy "all"; when every child is
+    skipped under another policy, the Parallel is SKIPPED.
     """
 
     kind = "parallel"
@@ -138,27 +151,33 @@ class Parallel(Node):
         self._need, self._fail = self.policy.thresholds(len(self.children))
 
     def update(self) -> Status:
-        succeeded = failed = 0
+        succeeded = failed = skipped = 0
         for child in self.children:
             status = child.status
-            if status is not SUCCESS and status is not FAILURE:
+            if status is SKIPPED:
+                status = child.recheck()
+            elif status is not SUCCESS and status is not FAILURE:
                 status = child.tick()
             if status is SUCCESS:
                 succeeded += 1
             elif status is FAILURE:
                 failed += 1
+            elif status is SKIPPED:
+                skipped += 1
         if failed >= self._fail:
             self._halt_running()
             self.message = f"{failed} of {len(self.children)} failed"
             return FAILURE
-        if succeeded >= self._need:
+        if succeeded >= self._need or (
+            self.policy.success == "all" and succeeded + skipped >= self._need
+        ):
             self._halt_running()
             return SUCCESS
         if len(self.children) - failed < self._need:
             self._halt_running()
             self.message = "too many children failed to reach the success policy"
             return FAILURE
-        return RUNNING
+        return SKIPPED if skipped and skipped == len(self.children) else RUNNING
 
     def _halt_running(self) -> None:
         for child in self.children:
@@ -182,8 +201,11 @@ class _Rechecking(_InOrder):
         children = self.children
         next_on = self.next_on
         for index, child in enumerate(children):
-            status = child.recheck() if child.is_condition else child.tick()
-            if status is next_on:
+            if child.is_condition or child.status is SKIPPED:
+                status = child.recheck()
+            else:
+                status = child.tick()
+            if status is next_on or status is SKIPPED:
                 continue
             _halt_after(children, index)
             return self._stopped(child, status)

@@ -5,6 +5,8 @@ Iterator and Enforce are the paper's (section III-B): Iterator resets its child 
 an optional count and timeout. Repeat(n) and Retry(n) are their counted forms under the
 names BehaviorTree.CPP and py_trees users know. A repeated child runs at most once per tick,
 so a child that succeeds at once cannot spin the engine.
+
+Every decorator passes a SKIPPED child up (BehaviorTree.CPP's do): it is SKIPPED itself.
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ from __future__ import annotations
 from engine.context import TreeContext
 from engine.error_types import ErrorType
 from engine.node import Node
-from engine.status import FAILURE, RUNNING, SUCCESS, Status
+from engine.status import FAILURE, RUNNING, SKIPPED, SUCCESS, Status
 
 __all__ = [
     "Decorator",
@@ -49,14 +51,16 @@ class Decorator(Node):
 
 
 class _MapsResult(Decorator):
-    """A decorator that passes RUNNING through and maps the child's finished result."""
+    """A decorator that passes RUNNING and SKIPPED through and maps the child's finished
+    result.
+    """
 
     _passes_condition = True
 
     def update(self) -> Status:
         status = self.children[0].tick()
-        if status is RUNNING:
-            return RUNNING
+        if status is RUNNING or status is SKIPPED:
+            return status
         return self._finished(status)
 
     def _finished(self, status: Status) -> Status:

@@ -51,7 +51,7 @@ from engine.errors import EngineError
 from engine.json_reader import JsonFileError, read_json_file
 from engine.plan_format import MAX_NESTING, SUBTREE_FIELDS, PlanFileError
 from engine.plan_reader import read_subtree
-from engine.plan_writer import dump_json, encode_subtree, write_atomic
+from engine.plan_writer import dump_json, encode_subtree, has_conditions, write_atomic
 from engine.processes import process_alive
 from engine.spec import SubtreeSpec
 from engine.types import with_article
@@ -74,7 +74,11 @@ __all__ = [
 ]
 
 FORMAT = "costar-subtree"
-FORMAT_VERSION = 1
+# 2: nodes with pre- and post-conditions; a subtree without any is written as 1, so older
+# programs keep reading it.
+FORMAT_VERSION = 2
+PLAIN_FORMAT_VERSION = 1
+READABLE_VERSIONS = (1, 2)
 SUBTREE_SUFFIX = ".subtree.json"
 LIBRARY_ENV = "COSTAR_LIBRARY"
 SHIPPED_LIBRARY = resource_path("library")  # package data, found as every shipped file is
@@ -123,7 +127,8 @@ def library_folder(option: str | None = None, setting: str | None = None) -> Pat
 
 def dump_subtree(subtree: SubtreeSpec) -> str:
     """The file text of a subtree (deterministic: save -> load -> save gives the same bytes)."""
-    doc = {"format": FORMAT, "format_version": FORMAT_VERSION, **encode_subtree(subtree)}
+    version = FORMAT_VERSION if has_conditions(subtree.tree) else PLAIN_FORMAT_VERSION
+    doc = {"format": FORMAT, "format_version": version, **encode_subtree(subtree)}
     return dump_json(doc, subtree.name)
 
 
@@ -138,12 +143,13 @@ def load_subtree(path: str | os.PathLike[str]) -> SubtreeSpec:
     if not isinstance(doc, dict) or doc.get("format") != FORMAT:
         got = doc.get("format") if isinstance(doc, dict) else doc
         raise PlanFileError(file, "$.format", repr(FORMAT), repr(got))
-    if doc.get("format_version") != FORMAT_VERSION:
+    version = doc.get("format_version")
+    if version not in READABLE_VERSIONS or isinstance(version, bool):
         raise PlanFileError(
             file,
             "$.format_version",
-            f"format_version {FORMAT_VERSION}",
-            repr(doc.get("format_version")),
+            "format_version " + " or ".join(str(v) for v in READABLE_VERSIONS),
+            repr(version),
         )
     return read_subtree(doc, file, _FILE_FIELDS)
 

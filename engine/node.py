@@ -5,6 +5,10 @@ without evaluating anything, until it is reset. Reset clears the whole subtree a
 leaves that are running; halting happens exactly once per run of a leaf, because a reset
 node is IDLE and resetting an IDLE node does nothing.
 
+A node may carry pre- and post-conditions (:mod:`engine.conditions`, BehaviorTree.CPP's
+``_skipIf`` ...): :meth:`tick` checks them around :meth:`update`. SKIPPED latches like a
+result.
+
 Subclasses implement :meth:`update` (one evaluation; must not block), and may implement
 :meth:`on_halt` (the node was RUNNING and is being reset) and :meth:`on_reset`
 (clear private state).
@@ -14,9 +18,10 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 
+from engine.conditions import Condition, ConditionFailed, NodeConditions
 from engine.context import TreeContext
 from engine.error_types import ErrorType
-from engine.status import FAILURE, IDLE, RUNNING, SUCCESS, Status
+from engine.status import FAILURE, IDLE, RUNNING, SKIPPED, SUCCESS, Status
 
 __all__ = ["Node"]
 
@@ -33,10 +38,12 @@ class Node:
         children: child nodes in tick order (empty for leaves).
         is_condition: True for predicates (and decorators of them) that reactive
             composites re-check every tick.
+        conditions: its pre- and post-conditions (None: it has none).
     """
 
     kind = "node"
     is_condition = False
+    conditions: NodeConditions | None = None
 
     def __init__(self, ctx: TreeContext, node_id: str, name: str = "") -> None:
         self.ctx = ctx
@@ -56,8 +63,10 @@ class Node:
     def tick(self) -> Status:
         """Evaluate once, unless latched; returns the status."""
         status = self.status
-        if status is SUCCESS or status is FAILURE:
+        if status is SUCCESS or status is FAILURE or status is SKIPPED:
             return status
+        if self.conditions is not None:
+            return self._tick_with_conditions(status)
         new = self.update()
         if new is not status:
             if new is FAILURE and self.error is None:
@@ -67,6 +76,54 @@ class Node:
             if sink is not None:
                 sink(self, status, new)
         return new
+
+    def _tick_with_conditions(self, status: Status) -> Status:
+        """:meth:`tick` as BehaviorTree.CPP's executeTick runs a node's conditions."""
+        conditions = self.conditions
+        assert conditions is not None
+        try:
+            given = conditions.before(running=status is RUNNING)
+        except ConditionFailed as exc:
+            if status is RUNNING:  # a `while` that cannot be checked stops the node
+                self.reset()
+                status = IDLE
+            new = self.fail(str(exc), ErrorType.INVALID_INPUT)
+        else:
+            if given is None:
+                new = self.update()
+            else:
+                new, condition = given
+                if new is SKIPPED and status is RUNNING:  # `while` turned false: halt it
+                    self.reset()
+                    status = IDLE
+                self._given(new, condition)
+            if new is SUCCESS or new is FAILURE:
+                try:
+                    conditions.after(new)
+                except ConditionFailed as exc:
+                    new = self.fail(str(exc), ErrorType.INVALID_INPUT)
+        if new is not status:
+            if new is FAILURE and self.error is None:
+                self.error = self._child_error()
+            self.status = new
+            sink = self.ctx.status_sink
+            if sink is not None:
+                sink(self, status, new)
+        return new
+
+    def _given(self, status: Status, condition: Condition) -> None:
+        """The message of a result a pre-condition gave."""
+        script = self.conditions.scripts[condition] if self.conditions is not None else None
+        text = script.text.strip() if script is not None else ""
+        if condition is Condition.WHILE:
+            self.message = f"skipped: its while condition ({text}) is false"
+        elif status is SKIPPED:
+            self.message = f"skipped: its skip condition ({text}) is true"
+        elif status is FAILURE:
+            self.message = f"its failure condition ({text}) is true"
+            self.error = ErrorType.FAILED
+        else:
+            self.message = f"its success condition ({text}) is true"
 
     def update(self) -> Status:
         """One evaluation. Must return quickly; long work returns RUNNING."""
@@ -89,6 +146,7 @@ class Node:
                 self.on_halt()
             except Exception as exc:  # a capability's cancel must not break the reset
                 self.ctx.log(self.id, f"error while halting: {type(exc).__name__}: {exc}")
+            self._run_on_halted()
         self.on_reset()
         self.message = ""
         self.error = None
@@ -111,6 +169,7 @@ class Node:
             self.on_halt()
         except Exception as exc:  # a capability's cancel must not break the throw
             self.ctx.log(self.id, f"error while halting: {type(exc).__name__}: {exc}")
+        self._run_on_halted()
         self.message = message
         self.error = error
         self.status = FAILURE
@@ -141,6 +200,15 @@ class Node:
                 if node.status is not old:
                     sink(node, old, node.status)
         return status
+
+    def _run_on_halted(self) -> None:
+        """The ``on_halted`` condition of a node halted while RUNNING (never raises)."""
+        if self.conditions is None:
+            return
+        try:
+            self.conditions.halted()
+        except ConditionFailed as exc:
+            self.ctx.log(self.id, str(exc))
 
     def on_halt(self) -> None:
         """The node was RUNNING and is being reset: stop the work it started."""

@@ -14,6 +14,7 @@ __all__ = [
     "MAX_NESTING",
     "MAX_TREE_DEPTH",
     "PLAIN_FORMAT_VERSION",
+    "SUBTREES_FORMAT_VERSION",
     "PLAN_SUFFIX",
     "READABLE_VERSIONS",
     "PlanFileError",
@@ -25,9 +26,12 @@ FORMAT = "costar-plan"
 # 2: the settings of logic nodes are typed port bindings in "params" (1: a "config" object);
 # the operation timing.wait is the Wait node. 3: subtree instances and the "subtrees" they
 # run; a plan without them is still written as 2, so older programs keep reading it.
-FORMAT_VERSION = 3
+# 4: nodes with pre- and post-conditions ("conditions"); a plan without any is written as 3
+# or 2 as before.
+FORMAT_VERSION = 4
+SUBTREES_FORMAT_VERSION = 3
 PLAIN_FORMAT_VERSION = 2
-READABLE_VERSIONS: tuple[int, ...] = (1, 2, 3)
+READABLE_VERSIONS: tuple[int, ...] = (1, 2, 3, 4)
 PLAN_SUFFIX = ".costar.json"
 # Python's JSON reader and writer recurse about twice per tree level; 400 levels stay well
 # inside the default recursion limit of 1000 even when called from a deep GUI stack.
@@ -52,7 +56,7 @@ TOP_FIELDS += (
 )
 TOP_FIELDS += ("objects", "layout")
 TOP_FIELDS += ("subtrees",)
-NODE_FIELDS = ("id", "kind", "name", "op", "params", "children", "subtree")
+NODE_FIELDS = ("id", "kind", "name", "op", "params", "children", "subtree", "conditions")
 # A subtree definition: embedded in a plan's "subtrees", or the body of a library file.
 SUBTREE_FIELDS: tuple[str, ...] = ("id", "name", "version", "date", "description")
 SUBTREE_FIELDS += ("inputs", "outputs", "shared_names", "tree", "layout")

@@ -6,6 +6,7 @@ import os
 from collections.abc import Mapping
 from typing import Any, NoReturn
 
+from engine.conditions import Condition
 from engine.json_reader import JsonFileError, JsonReader, parse_json, read_json_file
 from engine.kinds import setting as kind_setting
 from engine.plan_format import (
@@ -221,11 +222,24 @@ class _Reader:
         }
         if self.version == 1:
             self.v1_settings(node, obj.get("config", {}), at(path, "config"))
+        node.conditions = self.conditions(obj.get("conditions", {}), at(path, "conditions"))
         children = self.items(obj.get("children", []), at(path, "children"), "nodes")
         self.check_children(kind, len(children), at(path, "children"))
         for index, child in enumerate(children):
             node.children.append(self.node(child, at(at(path, "children"), index), depth + 1))
         return node
+
+    def conditions(self, value: Any, path: str) -> dict[Condition, str]:
+        """A node's pre- and post-conditions: condition -> script (parsed when validated)."""
+        given = self.mapping(value, path, "condition -> script")
+        out: dict[Condition, str] = {}
+        for key, text in given.items():
+            here = at(path, key)
+            condition = Condition(self.choice(key, here, [c.value for c in Condition]))
+            script = self.text(text, here)
+            if script.strip():
+                out[condition] = script
+        return out
 
     def kind(self, value: Any, path: str) -> NodeKind:
         if isinstance(value, str) and value in KIND_ALIASES:

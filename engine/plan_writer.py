@@ -9,11 +9,13 @@ import uuid
 from pathlib import Path
 from typing import Any
 
+from engine.conditions import Condition
 from engine.plan_format import (
     FORMAT,
     FORMAT_VERSION,
     MAX_TREE_DEPTH,
     PLAIN_FORMAT_VERSION,
+    SUBTREES_FORMAT_VERSION,
     PlanFileError,
 )
 from engine.spec import (
@@ -30,7 +32,14 @@ from engine.spec import (
 from engine.tree import DEFAULT_GIVE_UP_AFTER
 from engine.types import ParamType, encode_value
 
-__all__ = ["dump_json", "dump_plan", "encode_subtree", "save_plan", "write_atomic"]
+__all__ = [
+    "dump_json",
+    "dump_plan",
+    "encode_subtree",
+    "has_conditions",
+    "save_plan",
+    "write_atomic",
+]
 
 # --------------------------------------------------------------------------- writing
 
@@ -70,9 +79,23 @@ def _encode_node(node: NodeSpec, depth: int) -> dict[str, Any]:
     }
     if params:
         out["params"] = {port: _encode_binding(params[port]) for port in sorted(params)}
+    conditions = _encode_conditions(node)
+    if conditions:
+        out["conditions"] = conditions
     if node.children:
         out["children"] = [_encode_node(child, depth + 1) for child in node.children]
     return out
+
+
+def _encode_conditions(node: NodeSpec) -> dict[str, str]:
+    """The node's conditions in their fixed order; an empty script says nothing."""
+    given = {Condition(c): text for c, text in node.conditions.items()}
+    return {c.value: given[c] for c in Condition if given.get(c, "").strip()}
+
+
+def has_conditions(tree: NodeSpec | None) -> bool:
+    """Whether any node of ``tree`` has a pre- or post-condition that says something."""
+    return tree is not None and any(_encode_conditions(node) for _, node in tree.walk())
 
 
 def _encode_layout(tree: NodeSpec | None, layout: dict[str, NodeLayout]) -> dict[str, Any]:
@@ -134,9 +157,13 @@ def dump_plan(plan: PlanSpec) -> str:
     uses_subtrees = bool(plan.subtrees) or any(
         node.kind is NodeKind.SUBTREE for _, node in plan.walk()
     )
+    if has_conditions(plan.tree) or any(has_conditions(s.tree) for s in plan.subtrees):
+        version = FORMAT_VERSION
+    else:
+        version = SUBTREES_FORMAT_VERSION if uses_subtrees else PLAIN_FORMAT_VERSION
     doc = {
         "format": FORMAT,
-        "format_version": FORMAT_VERSION if uses_subtrees else PLAIN_FORMAT_VERSION,
+        "format_version": version,
         "id": plan.id,
         "name": plan.name,
         "description": plan.description,

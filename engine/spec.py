@@ -14,6 +14,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
+from engine.conditions import Condition
 from engine.tree import DEFAULT_GIVE_UP_AFTER, RunPolicy
 from engine.types import ParamType, Waypoint
 
@@ -140,6 +141,8 @@ class NodeSpec:
             or of a subtree instance (its subtree's declared inputs and outputs).
         children: in tick order.
         subtree: for kind SUBTREE, which subtree (id and version) the instance runs.
+        conditions: its pre- and post-conditions (BehaviorTree.CPP's ``_skipIf`` ...), scripts
+            run in the node's scope (engine.conditions); any node kind may have them.
     """
 
     kind: NodeKind
@@ -149,6 +152,7 @@ class NodeSpec:
     params: dict[str, Binding] = field(default_factory=dict)
     children: list[NodeSpec] = field(default_factory=list)
     subtree: SubtreeRef | None = None
+    conditions: dict[Condition, str] = field(default_factory=dict)
 
     @property
     def category(self) -> Category:

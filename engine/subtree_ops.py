@@ -293,10 +293,19 @@ def _free_name(name: str, used: set[str]) -> str:
 
 
 def update(instance: NodeSpec, newer: SubtreeSpec) -> NodeSpec:
-    """A copy of ``instance`` running ``newer``, with the bindings of the ports still there."""
+    """A copy of ``instance`` running ``newer``, with the bindings of the ports still there
+    (and its conditions).
+    """
     ports = {p.name for p in instance_manifest(newer).ports}
     params = {k: b for k, b in instance.params.items() if k in ports}
-    return NodeSpec(NodeKind.SUBTREE, instance.name, instance.id, params=params, subtree=newer.ref)
+    return NodeSpec(
+        NodeKind.SUBTREE,
+        instance.name,
+        instance.id,
+        params=params,
+        subtree=newer.ref,
+        conditions=dict(instance.conditions),
+    )
 
 
 def subtrees_in_use(tree: NodeSpec | None, available: Iterable[SubtreeSpec]) -> list[SubtreeSpec]:

@@ -4,7 +4,10 @@ The root holds the run policy: ``once`` returns its child's result; ``until_succ
 resets the child after a FAILURE and runs it again (the paper's "evaluated until it returns
 SUCCESS"), but gives up after ``give_up_after`` identical failures in a row (the same first
 failing node with the same error type and message: trying again changes nothing); ``forever``
-resets the child after every result (a plan meant to run until stopped, with no limit).
+resets the child after every result (a plan meant to run until stopped, with no limit). A
+child that is SKIPPED (its pre-conditions, or all its children, skipped it) ends a ``once``
+or ``until_success`` run with SKIPPED, as BehaviorTree.CPP's tree returns it; ``forever``
+starts it again.
 """
 
 from __future__ import annotations
@@ -16,7 +19,7 @@ from engine.blackboard import Blackboard
 from engine.context import TreeContext
 from engine.failure_words import failed_words, node_title, stopped_words
 from engine.node import Node
-from engine.status import FAILURE, IDLE, RUNNING, SUCCESS, Status
+from engine.status import FAILURE, IDLE, RUNNING, SKIPPED, SUCCESS, Status
 
 __all__ = ["RunPolicy", "Root", "BehaviorTree", "DEFAULT_GIVE_UP_AFTER", "first_failed"]
 
@@ -84,10 +87,12 @@ class Root(Node):
             return RUNNING
         self.runs += 1
         if self.policy is RunPolicy.ONCE or (
-            self.policy is RunPolicy.UNTIL_SUCCESS and status is SUCCESS
+            self.policy is RunPolicy.UNTIL_SUCCESS and (status is SUCCESS or status is SKIPPED)
         ):
             if status is FAILURE:
                 self.message = child.message or f"{child.name} failed"
+            elif status is SKIPPED:
+                self.message = child.message or f"{child.name} was skipped"
             return status
         if self.policy is RunPolicy.UNTIL_SUCCESS and self._gives_up(first_failed(child)):
             return FAILURE

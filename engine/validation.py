@@ -11,6 +11,12 @@ writes, an Inverter or ForceSuccess/ForceFailure nothing, and the looping decora
 Retry and Timeout what their child writes (an Iterator with a time limit nothing: it may
 succeed before its child has finished once). Plan parameters with an initial value are
 written before everything.
+
+A node's pre- and post-conditions (engine.conditions) are scripts like a Script node's: one
+that does not parse is an error naming the line and column; the names they write are
+written (of any type), the names they read are checked as references, pre-conditions
+before the node and post-conditions after it. A node that may be passed over by its
+conditions (success_if, skip_if, while) guarantees nothing it writes itself.
 """
 
 from __future__ import annotations
@@ -18,6 +24,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+from engine.conditions import PRE_CONDITIONS, Condition
 from engine.kinds import KIND_PORTS, check_setting, kind_port
 from engine.operations import (
     BoundPort,
@@ -125,6 +132,8 @@ def validate_plan(
             check_instance(check, node, library, stack, validate_plan)
         elif node.kind in _SCRIPTS:
             _script_writes(check, node)
+        if node.conditions:
+            _condition_writes(check, node)
     check_crossings(check)
     _check_writer_types(check)
     _check_rules(check)
@@ -167,6 +176,98 @@ def _script_reads(check: Check, node: NodeSpec, available: frozenset[str]) -> fr
     for name in names.reads:
         _check_reference(check, node, "code", name, (ParamType.ANY,), available)
     return frozenset(names.sure)
+
+
+def _condition_names(node: NodeSpec) -> dict[Condition, ScriptNames]:
+    """What each condition of a node that parses reads and writes, in the fixed order."""
+    out: dict[Condition, ScriptNames] = {}
+    given = {Condition(c): text for c, text in node.conditions.items()}
+    for condition in Condition:
+        text = given.get(condition, "")
+        if not text.strip():
+            continue
+        try:
+            out[condition] = script_names(parse_script(text))
+        except ScriptError:
+            continue  # reported by _condition_writes
+    return out
+
+
+def _condition_label(condition: Condition) -> str:
+    return condition.value.replace("_", " ")
+
+
+def _condition_writes(check: Check, node: NodeSpec) -> None:
+    """A condition that does not parse is an error; the names conditions write are written."""
+    given = {Condition(c): text for c, text in node.conditions.items()}
+    for condition in Condition:
+        text = given.get(condition, "")
+        if not text.strip():
+            continue
+        try:
+            names = script_names(parse_script(text))
+        except ScriptError as exc:
+            check.add(
+                ERROR,
+                node,
+                f"The {_condition_label(condition)} condition of {node.label!r} is not a script "
+                f"of BehaviorTree.CPP's language: {exc}.",
+                condition.value,
+            )
+            continue
+        for name in names.writes:
+            check.writers.setdefault(name, []).append(
+                Writer(
+                    f"the {_condition_label(condition)} condition of {node.label}",
+                    (ParamType.ANY,),
+                    node,
+                )
+            )
+
+
+def _condition_reads(
+    check: Check,
+    node: NodeSpec,
+    names: dict[Condition, ScriptNames],
+    conditions: tuple[Condition, ...],
+    available: frozenset[str],
+) -> frozenset[str]:
+    """Check what these conditions read, each after the ones before it; what they surely wrote."""
+    written: frozenset[str] = frozenset()
+    for condition in conditions:
+        found = names.get(condition)
+        if found is None:
+            continue
+        for name in found.reads:
+            _check_reference(
+                check, node, condition.value, name, (ParamType.ANY,), available | written
+            )
+        written |= frozenset(found.sure)
+    return written
+
+
+_PASSED_OVER = (Condition.SUCCESS_IF, Condition.SKIP_IF, Condition.WHILE)
+
+
+def _check_reads(check: Check, node: NodeSpec, available: frozenset[str]) -> frozenset[str]:
+    """Check the references this subtree reads, its conditions' included; return what it
+    guarantees after SUCCESS (or after it was passed over: a Sequence goes on past SKIPPED).
+    """
+    if not node.conditions:
+        return _check_reads_of(check, node, available)
+    names = _condition_names(node)
+    # The pre-conditions are checked one after the other; a later one runs only when the
+    # earlier ones did not decide, so their sure writes hold for the later ones.
+    before = _condition_reads(check, node, names, PRE_CONDITIONS, available)
+    written = _check_reads_of(check, node, available | before)
+    after_success = _condition_reads(
+        check, node, names, (Condition.ON_SUCCESS, Condition.POST), available | before | written
+    )
+    _condition_reads(check, node, names, (Condition.ON_FAILURE,), available | before)
+    _condition_reads(check, node, names, (Condition.ON_HALTED,), available | before)
+    if any(node.conditions.get(c, "").strip() for c in _PASSED_OVER):
+        return frozenset()
+    return written | after_success
 
 
 def _check_parameters(check: Check) -> None:
@@ -337,8 +438,8 @@ def _check_writer_types(check: Check) -> None:
                 )
 
 
-def _check_reads(check: Check, node: NodeSpec, available: frozenset[str]) -> frozenset[str]:
-    """Check the references this subtree reads; return what it guarantees after SUCCESS."""
+def _check_reads_of(check: Check, node: NodeSpec, available: frozenset[str]) -> frozenset[str]:
+    """:func:`_check_reads` of the node itself (its kind), without its conditions."""
     if node.kind is NodeKind.OPERATION:
         return _operation_reads(check, node, available)
     if node.kind in _SCRIPTS:

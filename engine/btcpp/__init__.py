@@ -36,9 +36,13 @@ A plan is written as::
   queries as ``<Action>`` with output ports.
 - Import knows: the mapped built-ins, Iterator and Enforce, ``<SubTree>`` of a tree in the
   file, and operations (those of the given manifests; without manifests, the Actions and
-  Conditions the file's TreeNodesModel declares). Any other node type, BehaviorTree.CPP
-  scripts (``_skipIf``...), ``_autoremap="true"``, unknown ports and values not in their
-  port's form are problems, all of them reported with their lines (:class:`XmlFileError`).
+  Conditions the file's TreeNodesModel declares). Any other node type,
+  ``_autoremap="true"``, unknown ports and values not in their port's form are problems, all
+  of them reported with their lines (:class:`XmlFileError`).
+- The pre- and post-conditions of any node as BehaviorTree.CPP's own attributes
+  (``_failureIf``, ``_successIf``, ``_skipIf``, ``_while``, ``_onSuccess``, ``_onFailure``,
+  ``_post``, ``_onHalted``), read and written as they are and run by
+  :mod:`engine.conditions`; a script that does not parse is reported by validation.
 - Logic nodes as BehaviorTree.CPP's built-ins, Iterator and Enforce as declared
   decorators (:mod:`engine.btcpp.logic`); ``Script`` and ``ScriptCondition`` with their
   ``code`` as it is, run by :mod:`engine.script`.

@@ -13,6 +13,7 @@ from engine.btcpp.names import decode_id, decode_port
 from engine.btcpp.read_parts import Model, ReaderBase, read_models
 from engine.btcpp.writer import UNUSED_OUTPUT
 from engine.btcpp.xmltree import Element, XmlSyntaxError, XmlTooLarge, parse, parse_file
+from engine.conditions import Condition
 from engine.kinds import setting as kind_setting
 from engine.operations import Direction, OperationManifest
 from engine.spec import (
@@ -31,9 +32,8 @@ from engine.types import ParamType
 __all__ = ["import_xml", "load_xml", "read_xml"]
 
 _EXPLICIT = ("Action", "Condition", "Control", "Decorator")
-# BehaviorTree.CPP's pre- and post-conditions: scripts we cannot run, so not dropped quietly.
-_SCRIPTS: tuple[str, ...] = ("_skipIf", "_successIf", "_failureIf", "_while", "_onSuccess")
-_SCRIPTS += ("_onFailure", "_onHalted", "_post")
+# BehaviorTree.CPP's pre- and post-conditions (_skipIf ...): attribute -> ours.
+_CONDITIONS: Mapping[str, Condition] = {c.attribute: c for c in Condition}
 
 
 class _Reader(ReaderBase):
@@ -155,17 +155,17 @@ class _Reader(ReaderBase):
 
     def _node(self, element: Element, layout: dict[str, NodeLayout]) -> NodeSpec | None:
         node = self._kind_of(element)
-        for attr in _SCRIPTS:
-            if attr in element.attrs:
-                self.problem(
-                    element.line, "no BehaviorTree.CPP scripts (pre/post conditions)", attr
-                )
         children = [self._node(child, layout) for child in element.children]
         if node is None:
             return None
         node.name = element.attrs.get("_name", element.attrs.get("name", ""))
         if self.foreign and node.name == (element.attrs.get("ID") or element.tag):
             node.name = ""  # BehaviorTree.CPP names an unnamed node after its type
+        node.conditions = {
+            condition: text
+            for attr, condition in _CONDITIONS.items()
+            if (text := element.attrs.get(attr, "")).strip()
+        }
         node.id = element.attrs.get("_uid") or new_id()
         if node.id in self.ids:
             self.problem(element.line, "a _uid no other node has", repr(node.id))

@@ -13,6 +13,7 @@ from engine.btcpp.errors import XmlExportError
 from engine.btcpp.logic import BUILTIN_MODELS, LOGIC, LOGIC_BY_MODEL
 from engine.btcpp.names import encode_id, encode_port, readable_tree_id
 from engine.btcpp.values import MODEL_TYPE, value_text
+from engine.conditions import Condition
 from engine.kinds import KIND_PORTS
 from engine.operations import Direction, OperationKind, OperationManifest
 from engine.spec import Binding, NodeKind, NodeLayout, NodeSpec, PlanSpec, SubtreeSpec
@@ -190,6 +191,11 @@ class _Writer:
             element.set("name", node.name)
         for key, value in attrs.items():
             element.set(key, value)
+        given = {Condition(c): text for c, text in node.conditions.items()}
+        for condition in Condition:  # BehaviorTree.CPP's own attributes: it runs them
+            text = given.get(condition, "")
+            if text.strip():
+                element.set(condition.attribute, text)
         element.set("_uid", node.id)
         if node.id in layout:
             for key, value in self._layout_attrs(layout[node.id]).items():

@@ -32,6 +32,8 @@ STATUS_COLOURS: dict[Status, RGB] = {
     Status.RUNNING: (255, 190, 40),
     Status.SUCCESS: (96, 192, 96),
     Status.FAILURE: (226, 84, 72),
+    # Passed over by its pre-conditions (skip_if, while) or because all its children were.
+    Status.SKIPPED: (190, 150, 220),
 }
 # A node that was running when the run was stopped: halted, no longer running.
 HALTED_COLOUR: RGB = (140, 162, 200)

@@ -106,7 +106,7 @@ class CanvasView(QWidget):
         for node_id, item in self._run_state_items(mapping):
             status = mapping[node_id]
             item.set_status(status)
-            if status is Status.RUNNING or status is Status.SUCCESS:
+            if status in (Status.RUNNING, Status.SUCCESS, Status.SKIPPED):
                 item.set_status_tip("")  # tried again: the old failure is gone
 
     def set_failure_tips(self, mapping: Mapping[str, str]) -> None:

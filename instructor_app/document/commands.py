@@ -20,6 +20,7 @@ from typing import Any, ClassVar
 
 from PySide6.QtGui import QUndoCommand
 
+from engine.conditions import Condition
 from engine.spec import Binding, NodeLayout, NodeSpec, ParameterDecl
 from engine.tree import RunPolicy
 from engine.types import ParamType, Waypoint
@@ -35,6 +36,7 @@ __all__ = [
     "ReparentCommand",
     "SetParamCommand",
     "RenameCommand",
+    "SetConditionCommand",
     "SetLayoutCommand",
     "ReplaceNodeCommand",
     "RenamePlanCommand",
@@ -219,6 +221,27 @@ class SetParamCommand(_Command):
 
     def undo(self) -> None:
         self.document.set_binding(self.node_id, self.port, self.old)
+
+
+class SetConditionCommand(_Command):
+    """Set a node's pre- or post-condition (a script; "" removes it)."""
+
+    def __init__(
+        self, document: PlanModel, node_id: str, condition: Condition, script: str
+    ) -> None:
+        node = document.node(node_id)
+        what = condition.value.replace("_", " ")
+        super().__init__(document, f"Set the {what} condition of {node.label}")
+        self.node_id = node_id
+        self.condition = condition
+        self.new = script
+        self.old = node.conditions.get(condition, "")
+
+    def redo(self) -> None:
+        self.document.apply_condition(self.node_id, self.condition, self.new)
+
+    def undo(self) -> None:
+        self.document.apply_condition(self.node_id, self.condition, self.old)
 
 
 class RenameCommand(_Command):

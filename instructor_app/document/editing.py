@@ -13,6 +13,7 @@ from pathlib import Path
 from PySide6.QtCore import QObject
 from PySide6.QtGui import QUndoCommand, QUndoStack
 
+from engine.conditions import Condition
 from engine.files import PlanFileError, load_plan, loads_plan, save_plan
 from engine.spec import Binding, NodeLayout, NodeSpec, ParameterDecl, PlanSpec
 from engine.subtree_ops import instance_name
@@ -31,6 +32,7 @@ from instructor_app.document.commands import (
     RenamePlanCommand,
     ReparentCommand,
     ReplaceWaypointCommand,
+    SetConditionCommand,
     SetGiveUpAfterCommand,
     SetLayoutCommand,
     SetParamCommand,
@@ -161,6 +163,15 @@ class PlanDocument(PlanModel):
         if named != node.name:
             command.add(RenameCommand(self, node_id, named))
         self.push(command)
+
+    def set_condition(self, node_id: str, condition: Condition, script: str) -> None:
+        """Set a node's pre- or post-condition as one undo step ("" removes it); a script
+        that says what is there already pushes nothing.
+        """
+        old = self.node(node_id).conditions.get(condition, "")
+        if old.strip() == script.strip():
+            return
+        self.push(SetConditionCommand(self, node_id, condition, script))
 
     def rename(self, node_id: str, name: str) -> None:
         if self.node(node_id).name != name:

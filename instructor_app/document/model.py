@@ -14,6 +14,7 @@ from typing import Any
 
 from PySide6.QtCore import QObject, Signal
 
+from engine.conditions import Condition
 from engine.files import dump_plan
 from engine.spec import Binding, NodeLayout, NodeSpec, PlanSpec
 from engine.subtree_ops import subtrees_in_use
@@ -141,6 +142,16 @@ class PlanModel(QObject):
             node.params.pop(port, None)
         else:
             node.params[port] = binding
+        self.node_changed.emit(node_id)
+        self.plan_changed.emit()
+
+    def apply_condition(self, node_id: str, condition: Condition, script: str) -> None:
+        """Set a pre- or post-condition of a node ("": remove it)."""
+        conditions = self.node(node_id).conditions
+        if script.strip():
+            conditions[condition] = script
+        else:
+            conditions.pop(condition, None)
         self.node_changed.emit(node_id)
         self.plan_changed.emit()
 

@@ -2,7 +2,9 @@
 
 It shows the node's name (editable), what it is and its doc, then the settings of a logic
 node kind (engine.kinds.KIND_PORTS) or of an operation (from its manifest), one row type.
-Every finished edit is exactly one document command; edits that change nothing push none.
+Below them, the Advanced section holds the node's pre- and post-conditions (BehaviorTree.CPP's
+``_skipIf`` ...: engine.conditions), one script field each; it opens by itself for a node
+that has any. Every finished edit is exactly one document command; edits that change nothing push none.
 The panel follows the document: a change of the shown node refreshes the rows in place.
 """
 
@@ -18,10 +20,12 @@ from PySide6.QtWidgets import (
     QLineEdit,
     QScrollArea,
     QSizePolicy,
+    QToolButton,
     QVBoxLayout,
     QWidget,
 )
 
+from engine.conditions import Condition
 from engine.instances import instance_manifest
 from engine.kinds import KIND_DOC, KIND_PORTS
 from engine.operations import Direction, OperationSource, PortSpec
@@ -46,7 +50,23 @@ from instructor_app.inspectors.teach_buttons import (
 from instructor_app.node_factory import manifest_or_none, readable
 from instructor_app.runtime.waypoint_teach import TeachError
 
-__all__ = ["InspectorPanel"]
+__all__ = ["InspectorPanel", "CONDITION_TIPS"]
+
+# What each condition does, for its field's tooltip (BehaviorTree.CPP's attribute first).
+CONDITION_TIPS: dict[Condition, str] = {
+    Condition.FAILURE_IF: "checked when the node is about to start: true makes it fail "
+    "without running",
+    Condition.SUCCESS_IF: "checked when the node is about to start: true makes it succeed "
+    "without running",
+    Condition.SKIP_IF: "checked when the node is about to start: true skips it (SKIPPED), "
+    "its parent goes on",
+    Condition.WHILE: "false when the node is about to start skips it; false while it runs "
+    "halts it and skips it",
+    Condition.ON_SUCCESS: "runs after the node succeeded",
+    Condition.ON_FAILURE: "runs after the node failed",
+    Condition.POST: "runs after the node succeeded or failed (not when halted)",
+    Condition.ON_HALTED: "runs when the node is halted while it runs",
+}
 
 
 class InspectorPanel(QWidget):
@@ -101,6 +121,7 @@ class InspectorPanel(QWidget):
         self.form.setFieldGrowthPolicy(QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
         self.form.setContentsMargins(2, 2, 2, 2)  # the fields, not margins, get the width
         holder_layout.addWidget(form_widget)
+        self._build_advanced(holder_layout)
         holder_layout.addStretch(1)
         # The parameter area takes every pixel the panel has below the name and the doc line.
         self.parameter_area = QScrollArea()
@@ -114,6 +135,43 @@ class InspectorPanel(QWidget):
         for widget in (self.name_field, self.kind_label, self.doc_label):
             layout.addWidget(widget, 0)
         layout.addWidget(self.parameter_area, 1)
+
+    def _build_advanced(self, holder: QVBoxLayout) -> None:
+        """The Advanced section: a toggle, then one script field per condition."""
+        self.advanced_toggle = QToolButton()
+        self.advanced_toggle.setText("Advanced: pre- and post-conditions")
+        self.advanced_toggle.setCheckable(True)
+        self.advanced_toggle.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextBesideIcon)
+        self.advanced_toggle.setArrowType(Qt.ArrowType.RightArrow)
+        self.advanced_toggle.toggled.connect(self._show_advanced)
+        self.advanced = QWidget()
+        form = QFormLayout(self.advanced)
+        form.setRowWrapPolicy(QFormLayout.RowWrapPolicy.WrapLongRows)
+        form.setFieldGrowthPolicy(QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
+        form.setContentsMargins(2, 2, 2, 2)
+        self.condition_fields: dict[Condition, QLineEdit] = {}
+        self._condition_labels: dict[str, QLabel] = {}
+        for condition in Condition:
+            field = QLineEdit()
+            field.setPlaceholderText("a script, e.g. count >= 3")
+            field.setObjectName(f"condition_{condition.value}")
+            field.editingFinished.connect(lambda c=condition: self._set_condition(c))
+            tip = f"{condition.attribute}: {CONDITION_TIPS[condition]}"
+            label = QLabel(condition.value.replace("_", " "))
+            label.setToolTip(tip)
+            label.setProperty("tip", tip)
+            field.setToolTip(tip)
+            self.condition_fields[condition] = field
+            self._condition_labels[condition.value] = label
+            form.addRow(label, field)
+        self.advanced.setVisible(False)
+        holder.addWidget(self.advanced_toggle)
+        holder.addWidget(self.advanced)
+
+    def _show_advanced(self, shown: bool) -> None:
+        self.advanced.setVisible(shown)
+        arrow = Qt.ArrowType.DownArrow if shown else Qt.ArrowType.RightArrow
+        self.advanced_toggle.setArrowType(arrow)
 
     # ------------------------------------------------------------------ public
 
@@ -217,9 +275,14 @@ class InspectorPanel(QWidget):
 
     def _rebuild(self, node: NodeSpec | None) -> None:
         self._clear_form()
+        self._field_labels.update(self._condition_labels)
         self._shown_op = node.op if node is not None else None
         self.name_field.setEnabled(node is not None)
         self.name_field.setText(node.name if node is not None else "")
+        self.advanced_toggle.setVisible(node is not None)
+        self.advanced_toggle.setChecked(node is not None and bool(node.conditions))
+        for field in self.condition_fields.values():
+            field.setText("")
         if node is None:
             self.kind_label.setText("Select a node to see its parameters.")
             self.doc_label.setText("")
@@ -295,6 +358,10 @@ class InspectorPanel(QWidget):
             self.name_field.setText(node.name)
         for port, row in self._port_rows.items():
             row.load(node.params.get(port))
+        for condition, field in self.condition_fields.items():
+            text = node.conditions.get(condition, "")
+            if field.text() != text and not field.hasFocus():
+                field.setText(text)
         for buttons in self.teach_buttons.values():
             buttons.update_enabled()
 
@@ -397,6 +464,11 @@ class InspectorPanel(QWidget):
     def _rename(self) -> None:
         if self._node_id is not None:
             self.document.rename(self._node_id, self.name_field.text().strip())
+
+    def _set_condition(self, condition: Condition) -> None:
+        node = self._find(self._node_id)
+        if node is not None:
+            self.document.set_condition(node.id, condition, self.condition_fields[condition].text())
 
     def _set_param(self, port: str, binding: Binding | None) -> None:
         node = self._find(self._node_id)

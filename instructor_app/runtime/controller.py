@@ -487,7 +487,7 @@ class RunController(QObject):
             self.running_nodes_changed.emit([])
         for other in others:
             self.log_message.emit(f"On the way: {other.describe()}", "info")
-        level = "info" if event.status is Status.SUCCESS else "warning"
+        level = "info" if event.status in (Status.SUCCESS, Status.SKIPPED) else "warning"
         self.log_message.emit(self._summary(event, self._failure[1] if failed else ""), level)
         self._set_state(ExecutorState.FINISHED)
         outcome = RunOutcome(event, failed, message, dict(self._statuses), cause, others)

@@ -97,6 +97,29 @@ def test_run_failure_exits_1_with_the_message(tmp_path: Path) -> None:
     assert "gripper empty" in out
 
 
+def test_run_skipped_by_its_conditions_exits_0_saying_skipped(tmp_path: Path) -> None:
+    from engine.conditions import Condition
+
+    tree = _op("debug.fail", message=Binding.fixed("never", ParamType.TEXT))
+    tree.conditions = {Condition.SKIP_IF: "true"}
+    code, out, _ = run_cli(
+        "run", "--cell", "none", _save(tmp_path, tree), "--rate", "100", "--verbose"
+    )
+    assert code == 0
+    assert "plan: SKIPPED after 1 ticks" in out and "IDLE -> SKIPPED" in out
+    trace = tmp_path / "skipped.trace.jsonl"
+    plan_file = str(tmp_path / "plan.costar.json")
+    assert run_cli("run", "--cell", "none", plan_file, "--trace", str(trace))[0] == 0
+    from engine.status import Status
+    from engine.trace import read_trace
+
+    read = read_trace(trace)
+    assert read.final_status is Status.SKIPPED
+    assert "SKIPPED" in read.statuses(tree.id)
+    code, out, _ = run_cli("trace", "show", str(trace))
+    assert code == 0 and "run finished: SKIPPED" in out
+
+
 def test_run_invalid_plan_is_not_started_exits_2(tmp_path: Path) -> None:
     code, _, err = run_cli("run", "--cell", "none", _save(tmp_path, _op("debug.pretend_move")))
     assert code == 2

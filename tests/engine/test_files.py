@@ -256,7 +256,7 @@ BAD: list[tuple[str, Any, str, str]] = [
     ("not an object", [], "$", "costar-plan object"),
     ("other format", {"format": "word", "format_version": 1}, "$.format", "'costar-plan'"),
     ("no version", {"format": "costar-plan"}, "$.format_version", "versions 1"),
-    ("newer version", plan_doc(format_version=4), "$.format_version", "newer CoSTAR Instructor"),
+    ("newer version", plan_doc(format_version=5), "$.format_version", "newer CoSTAR Instructor"),
     ("version as text", plan_doc(format_version="1"), "$.format_version", "versions 1"),
     ("unknown top field", plan_doc(trea=None), "$.trea", "one of the fields format"),
     ("name a number", plan_doc(name=3), "$.name", "a text"),
@@ -353,7 +353,7 @@ def test_invalid_json_gives_line_and_column(name: str, line: int, column: int, g
 
 def test_data_files_of_newer_version_and_duplicate_keys() -> None:
     with pytest.raises(
-        PlanFileError, match=r"newer_version.costar.json: \$.format_version: .*reads \(1, 2, 3\)"
+        PlanFileError, match=r"newer_version.costar.json: \$.format_version: .*reads \(1, 2, 3, 4\)"
     ):
         load_plan(DATA / "newer_version.costar.json")
     with pytest.raises(PlanFileError) as info:

@@ -13,7 +13,7 @@ from engine.status import FAILURE, IDLE, RUNNING, SUCCESS, Status
 
 
 def test_status_finished_only_for_success_and_failure() -> None:
-    assert [s.finished for s in Status] == [False, False, True, True]
+    assert [s.finished for s in Status] == [False, False, True, True, False]
     assert Status("SUCCESS") is SUCCESS
 
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from engine.conditions import Condition
 from engine.files import save_plan
 from engine.spec import Binding, NodeKind, NodeSpec, ParameterDecl, PlanSpec, RunPolicy
 from engine.types import ParamType, Pose
@@ -387,6 +388,38 @@ def _decorators() -> dict[str, PlanSpec]:
     }
 
 
+def _given(node: NodeSpec, **scripts: str) -> NodeSpec:
+    """``node`` with pre- and post-conditions (``while_`` for while)."""
+    node.conditions = {Condition(key.rstrip("_")): text for key, text in scripts.items()}
+    return node
+
+
+def _conditions_example() -> PlanSpec:
+    """Pre- and post-conditions on nodes (BehaviorTree.CPP's _skipIf ...)."""
+    return _one(
+        "conditions",
+        "Pre- and post-conditions",
+        "Conditions on nodes (BehaviorTree.CPP's _skipIf, _while, _onSuccess, _successIf): the "
+        "alarm is skipped while the door is closed, the part is placed while it stays closed "
+        "and counted when placed, and the inspection is not needed once one part is in. "
+        "Runs to SUCCESS.",
+        lambda m: m.node(
+            N.SEQUENCE,
+            "place a part",
+            m.node(N.SCRIPT, "start", code="PARTS := 0; DOOR := 'closed'"),
+            _given(m.debug("fail", "alarm"), skip_if="DOOR == 'closed'"),
+            _given(
+                m.running("place part", 2),
+                while_="DOOR == 'closed'",
+                on_success="PARTS += 1",
+                on_halted="PARTS := -1",
+            ),
+            _given(m.debug("fail", "inspect"), success_if="PARTS == 1"),
+            m.node(N.SCRIPT_CONDITION, "one part in", code="PARTS == 1"),
+        ),
+    )
+
+
 def _leaves() -> dict[str, PlanSpec]:
     """Wait, an action, a query, a condition and the script leaves."""
     return {
@@ -456,6 +489,7 @@ def node_examples() -> dict[str, PlanSpec]:
         **_decorators(),
         **_leaves(),
         "subtree": _subtree_example(),
+        "conditions": _conditions_example(),
     }
 
 

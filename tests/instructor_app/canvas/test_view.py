@@ -435,3 +435,16 @@ def test_dragging_a_placed_node_onto_another_is_one_move_step(
     assert doc.serialized() == before and doc.plan.layout[c] == NodeLayout(400.0, 400.0)
     doc.undo_stack.redo()
     assert doc.serialized() == after
+
+
+def test_a_skipped_node_has_its_own_colour(view: CanvasView, doc: PlanDocument) -> None:
+    colours = {status: STATUS_COLOURS[status] for status in Status}
+    assert len(set(colours.values())) == len(colours)  # every status its own colour
+    a = nid(doc, "a")
+    view.set_statuses({a: Status.SKIPPED})
+    assert view.status_of(a) is Status.SKIPPED
+    image = view.grab().toImage()
+    item = view.item(a)
+    point = view.viewer.mapFromScene(item.mapToScene(item.shape_rect().center() + QPointF(40, 8)))
+    colour = image.pixelColor(view.viewer.mapTo(view, point))
+    assert (colour.red(), colour.green(), colour.blue()) == STATUS_COLOURS[Status.SKIPPED]

@@ -267,6 +267,56 @@ def test_an_unset_port_shows_its_editor_and_a_value_entered_there_binds_it(
     _undo_all_restores(document, before)
 
 
+def test_conditions_are_edited_in_the_advanced_section_one_command_each(
+    qtbot: QtBot, panel: InspectorPanel, document: PlanDocument
+) -> None:
+    from engine.conditions import Condition
+
+    before = document.serialized()
+    panel.show()
+    panel.show_node("move")
+    assert not panel.advanced.isVisible()  # closed for a node without conditions
+    qtbot.mouseClick(panel.advanced_toggle, Qt.MouseButton.LeftButton)
+    assert panel.advanced.isVisible()
+    field = panel.condition_fields[Condition.SKIP_IF]
+    qtbot.keyClicks(field, "count >= 3")
+    assert document.undo_stack.count() == 0
+    qtbot.keyClick(field, Qt.Key.Key_Return)
+    field.editingFinished.emit()  # the focus leaving afterwards: no second step
+    assert document.node("move").conditions == {Condition.SKIP_IF: "count >= 3"}
+    assert document.undo_stack.count() == 1
+    post = panel.condition_fields[Condition.ON_HALTED]
+    qtbot.keyClicks(post, "halted := true")
+    qtbot.keyClick(post, Qt.Key.Key_Return)
+    assert document.undo_stack.count() == 2
+    # another node: empty fields, closed; back: the scripts, opened by themselves
+    panel.show_node("wait")
+    assert field.text() == "" and not panel.advanced.isVisible()
+    panel.show_node("move")
+    assert panel.advanced.isVisible() and field.text() == "count >= 3"
+    # clearing a field removes the condition
+    field.clear()
+    qtbot.keyClick(field, Qt.Key.Key_Return)
+    assert Condition.SKIP_IF not in document.node("move").conditions
+    document.undo_stack.undo()
+    assert field.text() == "count >= 3"  # the panel follows the document
+    _undo_all_restores(document, before)
+    assert field.text() == "" and document.node("move").conditions == {}
+
+
+def test_a_condition_problem_is_marked_on_its_field(
+    panel: InspectorPanel, document: PlanDocument, registry: CapabilityRegistry
+) -> None:
+    from engine.conditions import Condition
+    from engine.validation import validate_plan
+
+    panel.show_node("move")
+    document.set_condition("move", Condition.WHILE, "ready ==")
+    panel.set_problems(validate_plan(document.plan, registry))
+    assert "while condition of 'Go' is not a script" in panel.field_problem("while")
+    assert "line 1, column" in panel.field_problem("while")
+
+
 def test_an_unset_waypoint_asks_for_a_choice_and_the_first_one_chosen_binds_it(
     qtbot: QtBot,
 ) -> None:
