@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import os
 import threading
+import time
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,6 +27,7 @@ from engine.events import (
     StatusChanged,
 )
 from engine.json_reader import JsonFileError, errors_as, parse_json
+from engine.plan_writer import dump_plan
 from engine.run_report import FailureLog, RootCause
 from engine.spec import PlanSpec
 from engine.status import Status
@@ -85,9 +87,15 @@ class TraceRecorder:
         self._lock = threading.Lock()
         self._file: TextIO | None = self.path.open("w", encoding="utf-8")
         self._failures = FailureLog(plan) if plan is not None else None
-        header: dict[str, Any] = {"format": TRACE_FORMAT, "format_version": TRACE_VERSION}
+        header: dict[str, Any] = {
+            "format": TRACE_FORMAT,
+            "format_version": TRACE_VERSION,
+            "started_us": time.time_ns() // 1000,  # wall clock: events carry monotonic times
+        }
         if plan is not None:
             header["plan"] = plan.name
+            # The plan as it ran, so that the record can be read (and exported) without it.
+            header["plan_document"] = json.loads(dump_plan(plan))
             header["nodes"] = [
                 {
                     "id": node.id,
