@@ -1,0 +1,146 @@
+"""``costar run --groot2``: a client written from groot2_protocol.h watches the run."""
+
+from __future__ import annotations
+
+import io
+import os
+import socket
+import threading
+import time
+import xml.etree.ElementTree as ET
+from pathlib import Path
+from typing import Any
+
+import zmq
+
+from capabilities.cli import _parser, main
+from capabilities.groot2.protocol import ReplyHeader, RequestHeader, RequestType, decode_status
+from engine.files import save_plan
+from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
+from engine.types import ParamType
+
+IDLE, RUNNING, SUCCESS = 0, 1, 2
+
+
+def free_port_pair() -> int:
+    """A port that is free, with the next one free too (the publisher takes both)."""
+    for _ in range(100):
+        with socket.socket() as first:
+            first.bind(("127.0.0.1", 0))
+            port = int(first.getsockname()[1])
+            if port >= 65535:
+                continue
+            with socket.socket() as second:
+                try:
+                    second.bind(("127.0.0.1", port + 1))
+                except OSError:
+                    continue
+        return port
+    raise RuntimeError("no two free ports in a row")
+
+
+def _plan(folder: Path) -> str:
+    """A plan that waits on the operator at its second step: RUNNING until the test answers."""
+    steps = [
+        NodeSpec(NodeKind.OPERATION, name="first", op="debug.succeed"),
+        NodeSpec(NodeKind.OPERATION, name="ask", op="collaboration.confirm",
+                 params={"prompt": Binding.fixed("Go on?", ParamType.TEXT)}),
+    ]  # fmt: skip
+    path = folder / "groot2.costar.json"
+    save_plan(PlanSpec(NodeSpec(NodeKind.SEQUENCE, "steps", children=steps), "watched"), path)
+    return str(path)
+
+
+class Client:
+    """Groot2's side: a REQ socket, one request at a time, each checked against its reply."""
+
+    def __init__(self, port: int) -> None:
+        self.context = zmq.Context()
+        self.socket = self.context.socket(zmq.REQ)
+        self.socket.setsockopt(zmq.LINGER, 0)
+        self.socket.setsockopt(zmq.RCVTIMEO, 20_000)
+        self.socket.connect(f"tcp://127.0.0.1:{port}")
+
+    def ask(self, kind: RequestType) -> tuple[ReplyHeader, list[bytes]]:
+        request = RequestHeader.new(kind)
+        self.socket.send(request.encode())
+        parts = self.socket.recv_multipart()
+        header = ReplyHeader.decode(parts[0])
+        assert header.request == request
+        return header, parts[1:]
+
+    def close(self) -> None:
+        self.socket.close(0)
+        self.context.term()
+
+
+def _run_in_thread(argv: list[str], inp: io.TextIOBase) -> tuple[threading.Thread, dict[str, Any]]:
+    result: dict[str, Any] = {"out": io.StringIO(), "err": io.StringIO()}
+
+    def run() -> None:
+        result["code"] = main(argv, result["out"], result["err"], inp)  # type: ignore[arg-type]
+
+    thread = threading.Thread(target=run, daemon=True)
+    thread.start()
+    return thread, result
+
+
+def test_a_client_gets_the_tree_and_every_node_with_its_status(tmp_path: Path) -> None:
+    port = free_port_pair()
+    read_end, write_end = os.pipe()
+    answers = os.fdopen(write_end, "w")
+    with os.fdopen(read_end) as inp:
+        argv = ["run", _plan(tmp_path), "--cell", "none", "--groot2", str(port)]
+        thread, result = _run_in_thread([*argv, "--timeout", "60", "--confirm", "ask"], inp)
+        client = Client(port)
+        try:
+            tree_header, (xml,) = client.ask(RequestType.FULLTREE)
+            root = ET.fromstring(xml)
+            uid_of = {
+                node.get("name"): int(node.get("_uid", ""))
+                for tree in root.iter("BehaviorTree")
+                for node in tree.iter()
+                if node is not tree
+            }
+            assert set(uid_of) == {"steps", "first", "ask"}
+            deadline = time.monotonic() + 30
+            while True:  # until the run reaches the prompt (asked, not slept on)
+                header, (payload,) = client.ask(RequestType.STATUS)
+                statuses = dict(decode_status(payload))
+                if statuses[uid_of["ask"]] == RUNNING or time.monotonic() > deadline:
+                    break
+            assert header.tree_id == tree_header.tree_id
+            assert sorted(statuses) == sorted(uid_of.values())  # every node Groot2 sees
+            assert statuses == {
+                uid_of["steps"]: RUNNING,
+                uid_of["first"]: SUCCESS,
+                uid_of["ask"]: RUNNING,
+            }
+        finally:
+            answers.write("y\n")
+            answers.close()
+            client.close()
+            thread.join(30)
+    assert result["code"] == 0, result["out"].getvalue() + result["err"].getvalue()
+    assert f"Groot2: publishing the run on 127.0.0.1:{port}" in result["out"].getvalue()
+    with socket.socket() as again:  # the run's end freed the port
+        again.bind(("127.0.0.1", port))
+
+
+def test_a_taken_port_is_a_clear_error(tmp_path: Path) -> None:
+    port = free_port_pair()
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", port))
+        taken.listen()
+        out, err = io.StringIO(), io.StringIO()
+        argv = ["run", _plan(tmp_path), "--cell", "none", "--groot2", str(port)]
+        code = main([*argv, "--confirm", "yes"], out, err)
+    assert code == 2
+    assert f"127.0.0.1:{port}" in err.getvalue()
+    assert "taken" in err.getvalue()
+
+
+def test_groot2_defaults_to_btcpp_port_on_the_loopback() -> None:
+    args = _parser().parse_args(["run", "plan.costar.json", "--groot2"])
+    assert (args.groot2, args.groot2_host) == (1667, "127.0.0.1")
+    assert _parser().parse_args(["run", "p"]).groot2 is None
