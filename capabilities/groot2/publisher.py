@@ -67,6 +67,10 @@ class Groot2Publisher:
         self._thread = threading.Thread(target=self._serve, name="costar-groot2", daemon=True)
         self._thread.start()
 
+    def serve(self, monitor: Groot2Monitor) -> None:
+        """Serve another run from now on (its tree has a new tree id: Groot2 fetches it)."""
+        self.monitor = monitor
+
     @property
     def address(self) -> str:
         """Where Groot2 connects: host:port."""

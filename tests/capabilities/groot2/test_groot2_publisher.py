@@ -6,37 +6,17 @@ import io
 import os
 import socket
 import threading
-import time
-import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Any
 
-import zmq
-
 from capabilities.cli import _parser, main
-from capabilities.groot2.protocol import ReplyHeader, RequestHeader, RequestType, decode_status
+from capabilities.groot2.protocol import RequestType
 from engine.files import save_plan
 from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
 from engine.types import ParamType
+from tests.capabilities.groot2.groot2_client import Client, free_port_pair
 
 IDLE, RUNNING, SUCCESS = 0, 1, 2
-
-
-def free_port_pair() -> int:
-    """A port that is free, with the next one free too (the publisher takes both)."""
-    for _ in range(100):
-        with socket.socket() as first:
-            first.bind(("127.0.0.1", 0))
-            port = int(first.getsockname()[1])
-            if port >= 65535:
-                continue
-            with socket.socket() as second:
-                try:
-                    second.bind(("127.0.0.1", port + 1))
-                except OSError:
-                    continue
-        return port
-    raise RuntimeError("no two free ports in a row")
 
 
 def _plan(folder: Path) -> str:
@@ -49,29 +29,6 @@ def _plan(folder: Path) -> str:
     path = folder / "groot2.costar.json"
     save_plan(PlanSpec(NodeSpec(NodeKind.SEQUENCE, "steps", children=steps), "watched"), path)
     return str(path)
-
-
-class Client:
-    """Groot2's side: a REQ socket, one request at a time, each checked against its reply."""
-
-    def __init__(self, port: int) -> None:
-        self.context = zmq.Context()
-        self.socket = self.context.socket(zmq.REQ)
-        self.socket.setsockopt(zmq.LINGER, 0)
-        self.socket.setsockopt(zmq.RCVTIMEO, 20_000)
-        self.socket.connect(f"tcp://127.0.0.1:{port}")
-
-    def ask(self, kind: RequestType) -> tuple[ReplyHeader, list[bytes]]:
-        request = RequestHeader.new(kind)
-        self.socket.send(request.encode())
-        parts = self.socket.recv_multipart()
-        header = ReplyHeader.decode(parts[0])
-        assert header.request == request
-        return header, parts[1:]
-
-    def close(self) -> None:
-        self.socket.close(0)
-        self.context.term()
 
 
 def _run_in_thread(argv: list[str], inp: io.TextIOBase) -> tuple[threading.Thread, dict[str, Any]]:
@@ -94,28 +51,17 @@ def test_a_client_gets_the_tree_and_every_node_with_its_status(tmp_path: Path) -
         thread, result = _run_in_thread([*argv, "--timeout", "60", "--confirm", "ask"], inp)
         client = Client(port)
         try:
-            tree_header, (xml,) = client.ask(RequestType.FULLTREE)
-            root = ET.fromstring(xml)
-            uid_of = {
-                node.get("name"): int(node.get("_uid", ""))
-                for tree in root.iter("BehaviorTree")
-                for node in tree.iter()
-                if node is not tree
-            }
+            tree_id, uid_of = client.uids()
             assert set(uid_of) == {"steps", "first", "ask"}
-            deadline = time.monotonic() + 30
-            while True:  # until the run reaches the prompt (asked, not slept on)
-                header, (payload,) = client.ask(RequestType.STATUS)
-                statuses = dict(decode_status(payload))
-                if statuses[uid_of["ask"]] == RUNNING or time.monotonic() > deadline:
-                    break
-            assert header.tree_id == tree_header.tree_id
+            statuses = client.statuses_once(uid_of["ask"], RUNNING)  # the run reached the prompt
             assert sorted(statuses) == sorted(uid_of.values())  # every node Groot2 sees
             assert statuses == {
                 uid_of["steps"]: RUNNING,
                 uid_of["first"]: SUCCESS,
                 uid_of["ask"]: RUNNING,
             }
+            header, _ = client.ask(RequestType.STATUS)
+            assert header.tree_id == tree_id
         finally:
             answers.write("y\n")
             answers.close()
