@@ -292,7 +292,7 @@ def _groot2(
     if args.groot2 is None:
         return None
     from capabilities.groot2.protocol import Groot2Monitor
-    from capabilities.groot2.publisher import Groot2Error, Groot2Publisher
+    from capabilities.groot2.publisher import DEFAULT_HOST, Groot2Error, Groot2Publisher
     from engine.btcpp import XmlExportError
     from engine.btcpp.runtime import loaded_tree
 
@@ -300,9 +300,8 @@ def _groot2(
         loaded = loaded_tree(plan, {m.id: m for m in registry.manifests()})
     except XmlExportError as exc:
         raise Groot2Error(f"cannot publish for Groot2: {exc}") from exc
-    publisher = Groot2Publisher(
-        Groot2Monitor(loaded, tree.blackboard.snapshot()), args.groot2, args.groot2_host
-    )
+    monitor = Groot2Monitor(loaded, tree.blackboard.snapshot())
+    publisher = Groot2Publisher(monitor, args.groot2, args.groot2_host or DEFAULT_HOST)
     print(f"Groot2: publishing the run on {publisher.address}", file=out, flush=True)
     return publisher
 
@@ -506,7 +505,6 @@ def _parser() -> argparse.ArgumentParser:
     )
     run.add_argument(
         "--groot2-host",
-        default="127.0.0.1",
         metavar="HOST",
         help="the interface --groot2 binds (default 127.0.0.1; * for all)",
     )
@@ -578,6 +576,9 @@ def main(
         return EXIT_INVALID
     if args.command == "run" and args.hold_timeout <= 0:
         print("error: --hold-timeout must be above 0", file=err)
+        return EXIT_INVALID
+    if args.command == "run" and args.groot2_host is not None and args.groot2 is None:
+        print("error: --groot2-host needs --groot2", file=err)
         return EXIT_INVALID
     if getattr(args, "plan", None):
         try:

@@ -88,5 +88,16 @@ def test_a_taken_port_is_a_clear_error(tmp_path: Path) -> None:
 
 def test_groot2_defaults_to_btcpp_port_on_the_loopback() -> None:
     args = _parser().parse_args(["run", "plan.costar.json", "--groot2"])
-    assert (args.groot2, args.groot2_host) == (1667, "127.0.0.1")
+    assert (args.groot2, args.groot2_host) == (1667, None)  # None: 127.0.0.1
     assert _parser().parse_args(["run", "p"]).groot2 is None
+
+
+def test_a_port_out_of_range_or_a_host_alone_is_refused(tmp_path: Path) -> None:
+    plan = _plan(tmp_path)
+    for extra, says in (
+        (["--groot2", "65535"], "from 1 to 65534"),
+        (["--groot2-host", "*"], "--groot2-host needs --groot2"),
+    ):
+        err = io.StringIO()
+        code = main(["run", plan, "--cell", "none", "--confirm", "yes", *extra], io.StringIO(), err)
+        assert code == 2 and says in err.getvalue(), err.getvalue()
