@@ -72,8 +72,13 @@ _NODE_STATUS = struct.Struct("<HB")
 _TRANSITION_TAIL = struct.Struct("<HB")
 TREE_ID_SIZE = 16
 
-STATUS_CODES = {Status.IDLE: 0, Status.RUNNING: 1, Status.SUCCESS: 2, Status.FAILURE: 3}
-SKIPPED = 4
+STATUS_CODES = {
+    Status.IDLE: 0,
+    Status.RUNNING: 1,
+    Status.SUCCESS: 2,
+    Status.FAILURE: 3,
+    Status.SKIPPED: 4,
+}
 IDLE_FROM = 10  # a node reset to IDLE: 10 + the status it had
 
 

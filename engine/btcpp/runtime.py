@@ -5,7 +5,8 @@ publisher sends) writes a *loaded* tree, not the file it came from: every SubTre
 a ``<BehaviorTree ID=".." _fullpath="..">`` of its own, every node has a ``_uid`` (its
 number, counted from 1 in the order the nodes were made: depth first, an instance's inside
 right after its SubTree node), the SubTree nodes carry the ``_fullpath`` of the instance they
-run, and the other nodes a ``name`` (their type when they have none). This module makes that
+run, and the other nodes a ``name`` (their type when they have none), with their ports and
+their pre- and post-conditions. This module makes that
 document from our own export (:func:`engine.btcpp.writer.export_xml`), and tells which runtime
 node id (:class:`engine.instances.Scope`) has which number, and which blackboard names each
 instance sees.
@@ -19,11 +20,16 @@ from dataclasses import dataclass, field
 
 from engine.btcpp.errors import XmlExportError
 from engine.btcpp.writer import export_xml
+from engine.conditions import Condition
 from engine.instances import ROOT_SCOPE, Scope
 from engine.operations import OperationManifest
 from engine.spec import NodeKind, NodeSpec, PlanSpec
 
 __all__ = ["LoadedInstance", "LoadedTree", "loaded_tree"]
+
+# BehaviorTree.CPP writes a node's pre- and post-conditions (_skipIf ...) with its ports; our
+# other ``_`` attributes (our ids, the canvas) are not its.
+_CONDITIONS = frozenset(condition.attribute for condition in Condition)
 
 
 @dataclass
@@ -111,7 +117,7 @@ class _Loader:
             element.set("name", source.get("name") or source.tag)
         element.set("_uid", str(uid))
         for key, value in source.attrib.items():
-            if key not in ("ID", "name") and not key.startswith("_"):
+            if key not in ("ID", "name") and (not key.startswith("_") or key in _CONDITIONS):
                 element.set(key, value)
         if spec.kind is NodeKind.SUBTREE and sub:
             self.instance(element.get("ID", ""), inner_path, sub.tree, scope.inside(spec, sub))

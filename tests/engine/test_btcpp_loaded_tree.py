@@ -8,6 +8,7 @@ from typing import Any
 from capabilities.base import CapabilityRegistry
 from engine.btcpp.runtime import loaded_tree
 from engine.build import ROOT_ID, build_tree
+from engine.conditions import Condition
 from engine.files import load_plan
 from engine.spec import NodeKind, NodeSpec, PlanSpec
 from resources import resource_path
@@ -69,3 +70,12 @@ def test_nodes_without_a_name_are_named_by_their_type_and_private_attributes_go(
     assert sorted(sequence.attrib) == ["_uid", "name"]
     leaf = sequence.find("debug__succeed")
     assert leaf is not None and leaf.get("name") == "debug__succeed"
+
+
+def test_pre_and_post_conditions_stay_as_btcpp_writes_them(registry: CapabilityRegistry) -> None:
+    leaf = NodeSpec(NodeKind.OPERATION, op="debug.succeed")
+    leaf.conditions = {Condition.SKIP_IF: "done == true", Condition.POST: "count += 1"}
+    root = ET.fromstring(loaded_tree(PlanSpec(leaf, "kept"), _manifests(registry)).xml)
+    element = root.find("BehaviorTree/debug__succeed")
+    assert element is not None
+    assert (element.get("_skipIf"), element.get("_post")) == ("done == true", "count += 1")

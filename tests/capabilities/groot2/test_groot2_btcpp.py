@@ -17,6 +17,7 @@ from capabilities.groot2.protocol import Groot2Monitor, RequestHeader, RequestTy
 from engine.btcpp import export_xml
 from engine.btcpp.runtime import loaded_tree
 from engine.build import build_tree
+from engine.conditions import Condition
 from engine.executor import run_to_end
 from engine.spec import NodeKind, NodeSpec, PlanSpec, SubtreeSpec
 from tests.capabilities.groot2.groot2_client import Client, free_port_pair
@@ -24,6 +25,9 @@ from tests.capabilities.groot2.groot2_client import Client, free_port_pair
 bt = pytest.importorskip("behaviortreepy", reason="behaviortreepy (a dev dependency) is missing")
 if not getattr(bt, "GROOT2_AVAILABLE", False):
     pytest.skip("this behaviortreepy was built without Groot2", allow_module_level=True)
+
+
+IDLE, SUCCESS, FAILURE, SKIPPED = 0, 2, 3, 4
 
 
 def ok() -> NodeSpec:
@@ -35,7 +39,9 @@ def bad() -> NodeSpec:
 
 
 def nested_instances() -> PlanSpec:
-    """Named and unnamed instances, an instance inside an instance, one subtree used thrice."""
+    """Named and unnamed instances, an instance inside an instance, one subtree used thrice,
+    a node its pre-condition skips.
+    """
     inner = SubtreeSpec("t.inner", "Inner", NodeSpec(NodeKind.SEQUENCE, children=[ok(), ok()]))
     deep = NodeSpec(NodeKind.SUBTREE, "deep", subtree=inner.ref)
     outer = SubtreeSpec(
@@ -44,8 +50,11 @@ def nested_instances() -> PlanSpec:
     fallback = NodeSpec(
         NodeKind.SELECTOR, children=[bad(), NodeSpec(NodeKind.SUBTREE, subtree=outer.ref)]
     )
+    skipped = ok()
+    skipped.conditions = {Condition.SKIP_IF: "true"}
     steps = [
         ok(),
+        skipped,
         NodeSpec(NodeKind.SUBTREE, "first", subtree=inner.ref),
         fallback,
         NodeSpec(NodeKind.SUBTREE, "second", subtree=outer.ref),
@@ -61,7 +70,14 @@ def _shape(xml: bytes | str) -> list[list[tuple[str, ...]]]:
     return [
         [(tree.tag, tree.get("ID", ""), tree.get("_fullpath", ""))]
         + [
-            (n.tag, n.get("ID", ""), n.get("name", ""), n.get("_fullpath", ""), n.get("_uid", ""))
+            (
+                n.tag,
+                n.get("ID", ""),
+                n.get("name", ""),
+                n.get("_fullpath", ""),
+                n.get("_uid", ""),
+                n.get("_skipIf", ""),
+            )
             for n in tree.iter()
             if n is not tree
         ]
@@ -101,11 +117,16 @@ def test_btcpp_publishes_our_plan_as_we_do() -> None:
     run_to_end(build_tree(plan, registry), 1000.0, 10.0, [monitor])
     ours_end = decode_status(monitor.handle([_status_request()])[1])
     # BehaviorTree.CPP resets every node at the end (IDLE after SUCCESS is 12); our engine
-    # keeps each node's last status: the same outcome either way.
-    assert [(uid, code % 10) for uid, code in ours_end] == [
-        (uid, code % 10) for uid, code in decode_status(their_end)
-    ]
-    assert {code % 10 for _, code in ours_end} == {2, 3}
+    # keeps each node's last status: the same outcome either way. A skipped node stays IDLE
+    # there; ours shows SKIPPED (engine.status: it latches, for the canvas and Groot2).
+    skipped = next(
+        int(n.get("_uid", "")) for n in ET.fromstring(loaded.xml).iter() if n.get("_skipIf")
+    )
+    ours_outcome = {uid: code % 10 for uid, code in ours_end}
+    their_outcome = {uid: code % 10 for uid, code in decode_status(their_end)}
+    assert (ours_outcome.pop(skipped), their_outcome.pop(skipped)) == (SKIPPED, IDLE)
+    assert ours_outcome == their_outcome
+    assert {code % 10 for _, code in ours_end} == {SUCCESS, FAILURE, SKIPPED}
 
 
 def _status_request() -> bytes:

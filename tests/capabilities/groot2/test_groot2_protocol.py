@@ -75,6 +75,7 @@ def test_status_codes_are_btcpp_and_a_reset_tells_what_it_was() -> None:
     assert status_code(Status.RUNNING, Status.FAILURE) == 3
     assert status_code(Status.SUCCESS, Status.IDLE) == 12
     assert status_code(Status.RUNNING, Status.IDLE) == 11
+    assert status_code(Status.IDLE, Status.SKIPPED) == 4
 
 
 def test_transitions_are_nine_bytes_each() -> None:
