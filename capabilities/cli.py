@@ -17,7 +17,7 @@ import sys
 import threading
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, NamedTuple, TextIO
+from typing import TYPE_CHECKING, Any, NamedTuple, TextIO
 
 from capabilities.base import CapabilityError, CapabilityRegistry
 from capabilities.cell_features import ClosableCell, lockstep_of
@@ -48,15 +48,20 @@ from engine.run_report import FailureLog
 from engine.spec import PlanSpec
 from engine.status import Status
 from engine.trace import TraceError, TraceRecorder, format_timeline, read_trace
+from engine.tree import BehaviorTree
 from engine.types import encode_value
 from engine.units import format_value
 from engine.validation import Problem, has_errors, validate_plan
 from resources import plan_argument
 
+if TYPE_CHECKING:
+    from capabilities.groot2.publisher import Groot2Publisher
+
 __all__ = ["main"]
 
 EXIT_SUCCESS, EXIT_FAILURE, EXIT_INVALID, EXIT_STOPPED = 0, 1, 2, 3
 CELL_HELP = "the cell: sim, the simulated cell (default), or none, no robot"
+GROOT2_PORT = 1667  # BehaviorTree.CPP's Groot2Publisher's default
 PLAN_HELP = "a plan file, or example:NAME for a shipped plan (costar examples lists them)"
 
 
@@ -210,11 +215,15 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         except BuildError as exc:
             print(f"error: {exc}", file=err)
             return EXIT_INVALID
+        # Before anything that must be undone (the trace file, the signals): it may refuse.
+        publisher = _groot2(args, plan, registry, tree, out)  # Groot2Error: exit 2
         failures = FailureLog(plan)
         listeners: list[Callable[[Event], None]] = []
         record = _record_path(args, plan.name, err)
         if record is not None:  # first: what a line on screen says is already in the record
             listeners.append(TraceRecorder(record, plan))
+        if publisher is not None:
+            listeners.append(publisher.monitor)
         holds = HoldWatch(out, args.hold_timeout, cell)
         listeners += [failures, holds]
         if args.verbose:
@@ -237,6 +246,8 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             restore()
             if answerer is not None:
                 answerer.detach()
+            if publisher is not None:
+                publisher.close()
         if record is not None:
             print(f"run record: {record}", file=out)
         code = _report(
@@ -263,6 +274,36 @@ def _record_path(args: argparse.Namespace, plan_name: str, err: TextIO) -> Path 
         return None
     prune_records(folder, keep=path)
     return path
+
+
+def _groot2(
+    args: argparse.Namespace,
+    plan: PlanSpec,
+    registry: CapabilityRegistry,
+    tree: BehaviorTree,
+    out: TextIO,
+) -> Groot2Publisher | None:
+    """The Groot2 publisher ``--groot2`` asks for, serving already; None without the option.
+    pyzmq is imported only here.
+
+    Raises:
+        Groot2Error: it cannot publish (a port taken, a plan BehaviorTree.CPP cannot hold).
+    """
+    if args.groot2 is None:
+        return None
+    from capabilities.groot2.protocol import Groot2Monitor
+    from capabilities.groot2.publisher import DEFAULT_HOST, Groot2Error, Groot2Publisher
+    from engine.btcpp import XmlExportError
+    from engine.btcpp.runtime import loaded_tree
+
+    try:
+        loaded = loaded_tree(plan, {m.id: m for m in registry.manifests()})
+    except XmlExportError as exc:
+        raise Groot2Error(f"cannot publish for Groot2: {exc}") from exc
+    monitor = Groot2Monitor(loaded, tree.blackboard.snapshot())
+    publisher = Groot2Publisher(monitor, args.groot2, args.groot2_host or DEFAULT_HOST)
+    print(f"Groot2: publishing the run on {publisher.address}", file=out, flush=True)
+    return publisher
 
 
 def _wait(executor: Executor, timeout: float | None, holds: HoldWatch, out: TextIO) -> RunFinished:
@@ -453,6 +494,20 @@ def _parser() -> argparse.ArgumentParser:
         help="answer operator prompts: yes, no, or ask (read y/n lines from stdin, a pipe "
         "too; at the end of the input every prompt is answered no). Default: ask",
     )
+    run.add_argument(
+        "--groot2",
+        type=int,
+        nargs="?",
+        const=GROOT2_PORT,
+        metavar="PORT",
+        help="publish the run for Groot2 as BehaviorTree.CPP's Groot2Publisher does: "
+        f"requests on PORT (default {GROOT2_PORT}), PUB on PORT+1",
+    )
+    run.add_argument(
+        "--groot2-host",
+        metavar="HOST",
+        help="the interface --groot2 binds (default 127.0.0.1; * for all)",
+    )
     add_cell(run)
     run.set_defaults(func=_cmd_run)
 
@@ -521,6 +576,9 @@ def main(
         return EXIT_INVALID
     if args.command == "run" and args.hold_timeout <= 0:
         print("error: --hold-timeout must be above 0", file=err)
+        return EXIT_INVALID
+    if args.command == "run" and args.groot2_host is not None and args.groot2 is None:
+        print("error: --groot2-host needs --groot2", file=err)
         return EXIT_INVALID
     if getattr(args, "plan", None):
         try:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from PySide6.QtWidgets import QFileDialog, QMessageBox, QWidget
+from PySide6.QtWidgets import QFileDialog, QInputDialog, QMessageBox, QWidget
 
 __all__ = [
     "APP_TITLE",
@@ -95,6 +95,18 @@ class Dialogs:
         return QFileDialog.getSaveFileName(
             parent, "Export as BehaviorTree.CPP XML", suggested, XML_FILTER
         )[0]
+
+    def ask_groot2_port(self, parent: QWidget, current: int) -> int | None:
+        """The port to publish runs on for Groot2 (None: cancelled)."""
+        port, ok = QInputDialog.getInt(
+            parent,
+            "Groot2 port",
+            "Publish runs for Groot2 on port (it uses this port and the next one):",
+            current,
+            1,
+            65534,
+        )
+        return int(port) if ok else None
 
     def about(self, parent: QWidget, text: str) -> None:
         QMessageBox.about(parent, f"About {APP_TITLE}", text)

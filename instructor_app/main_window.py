@@ -211,6 +211,14 @@ class MainWindow(QMainWindow):
         run_menu.addActions(self.run_actions.all())
         run_menu.addSeparator()
         run_menu.addAction(reset)
+        run_menu.addSeparator()
+        groot2 = self._action("groot2", "Publish Runs for &Groot2", self._set_groot2)
+        groot2.setCheckable(True)
+        groot2.setChecked(self.settings.groot2_publish())
+        groot2.setToolTip("Serve each run to Groot2's monitor, as BehaviorTree.CPP does")
+        run_menu.addAction(groot2)
+        run_menu.addAction(self._action("groot2_port", "Groot2 &Port…", self._ask_groot2_port))
+        self._apply_groot2()
         self.library.fill_menu(bar.addMenu("&Library"))
         help_menu = bar.addMenu("&Help")
         help_menu.addAction(self._action("about", f"&About {APP_TITLE}", self._about))
@@ -221,6 +229,27 @@ class MainWindow(QMainWindow):
         toolbar.addAction(reset)
         toolbar.addWidget(self.cells.label)
         toolbar.addWidget(self.cells.combo)
+
+    def _apply_groot2(self) -> None:
+        publish = self.settings.groot2_publish()
+        self.controller.set_groot2_port(self.settings.groot2_port() if publish else None)
+
+    def _set_groot2(self, publish: bool) -> None:
+        """Run > Publish Runs for Groot2: from the next run on (off: at once)."""
+        self.settings.set_groot2_publish(publish)
+        self._apply_groot2()
+        port = self.settings.groot2_port()
+        self.show_message(
+            f"Runs are published for Groot2 on 127.0.0.1:{port} from the next run"
+            if publish
+            else "Runs are no longer published for Groot2"
+        )
+
+    def _ask_groot2_port(self) -> None:
+        port = self.dialogs.ask_groot2_port(self, self.settings.groot2_port())
+        if port is not None:
+            self.settings.set_groot2_port(port)
+            self._apply_groot2()
 
     def _build_edit_menus(self) -> None:
         edit = self.menuBar().addMenu("&Edit")

@@ -1,4 +1,4 @@
-"""The Instructor's user settings (QSettings): recent files, folders, window layout.
+"""The Instructor's user settings (QSettings): recent files, folders, window layout, Groot2.
 
 Everything goes through :class:`AppSettings`, made with a QSettings the caller chooses, so
 that tests use a temporary file and never the user's settings.
@@ -23,6 +23,7 @@ __all__ = [
     "APPLICATION",
     "MAX_RECENT",
     "EXAMPLES_DIR",
+    "GROOT2_PORT",
     "app_version",
     "is_shipped_example",
 ]
@@ -40,6 +41,9 @@ _LAST_DIR = "files/last_dir"
 _LIBRARY = "library/folder"
 _GEOMETRY = "window/geometry"
 _STATE = "window/state"
+_GROOT2 = "groot2/publish"
+_GROOT2_PORT = "groot2/port"
+GROOT2_PORT = 1667  # BehaviorTree.CPP's Groot2Publisher's default
 
 
 def app_version() -> str:
@@ -104,6 +108,26 @@ class AppSettings:
 
     def set_library_folder(self, folder: str | Path) -> None:
         self.qsettings.setValue(_LIBRARY, str(folder))
+
+    def groot2_publish(self) -> bool:
+        """Whether runs are published for Groot2 (Run > Publish Runs for Groot2)."""
+        return str(self.qsettings.value(_GROOT2, "false")).lower() == "true"
+
+    def set_groot2_publish(self, publish: bool) -> None:
+        self.qsettings.setValue(_GROOT2, "true" if publish else "false")
+        self.qsettings.sync()
+
+    def groot2_port(self) -> int:
+        """The port runs are published on for Groot2 (and the next one), 1667 by default."""
+        try:
+            port = int(str(self.qsettings.value(_GROOT2_PORT, GROOT2_PORT)))
+        except ValueError:
+            return GROOT2_PORT
+        return port if 1 <= port <= 65534 else GROOT2_PORT
+
+    def set_groot2_port(self, port: int) -> None:
+        self.qsettings.setValue(_GROOT2_PORT, int(port))
+        self.qsettings.sync()
 
     def save_window(self, geometry: QByteArray, state: QByteArray) -> None:
         self.qsettings.setValue(_GEOMETRY, geometry)

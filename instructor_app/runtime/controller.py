@@ -12,6 +12,7 @@ from __future__ import annotations
 import copy
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QObject, QTimer, Signal
 
@@ -19,7 +20,7 @@ from capabilities.cell_features import ReportsStatus, lockstep_of
 from capabilities.faults import hold_check
 from engine.blackboard import Blackboard, BlackboardError
 from engine.build import BuildError, build_tree
-from engine.events import RunFinished
+from engine.events import Listener, RunFinished
 from engine.executor import Executor, ExecutorState
 from engine.failure_words import failed_words
 from engine.run_records import RunRecordError, new_record_path, prune_records, runs_folder
@@ -32,6 +33,9 @@ from engine.validation import ERROR, Problem, has_errors, validate_plan
 from instructor_app.document.editing import PlanDocument
 from instructor_app.runtime.pump import Batch, EventPump, failure_text
 from instructor_app.runtime.session import CellSession
+
+if TYPE_CHECKING:
+    from capabilities.groot2.publisher import Groot2Publisher
 
 __all__ = ["RunController", "RunOutcome"]
 
@@ -146,6 +150,8 @@ class RunController(QObject):
         self._held = ""  # why the cell holds the run ("" when it does not)
         self.last_record: Path | None = None  # the record of the last run started
         self._idled: set[str] = set()  # nodes that went RUNNING -> IDLE at the last drain
+        self._groot2_port: int | None = None  # publish runs for Groot2 on it (None: do not)
+        self._groot2: Groot2Publisher | None = None  # serving, once a run was published
 
     # ------------------------------------------------------------------ state
 
@@ -212,6 +218,7 @@ class RunController(QObject):
 
     def shutdown(self, timeout: float = 2.0) -> None:
         """Stop and wait (bounded) for the engine: for closing the application only."""
+        self.set_groot2_port(None)
         executor = self._executor
         if executor is None:
             return
@@ -219,6 +226,50 @@ class RunController(QObject):
         executor.wait(timeout)
         self._drain()
         self._timer.stop()
+
+    # ------------------------------------------------------------------ Groot2
+
+    @property
+    def groot2_port(self) -> int | None:
+        """The port runs are published on for Groot2 (None: they are not)."""
+        return self._groot2_port
+
+    def set_groot2_port(self, port: int | None) -> None:
+        """Publish the runs for Groot2 on ``port`` from the next run on (None: stop now).
+
+        The publisher (ZeroMQ on 127.0.0.1, ``port`` and ``port + 1``) stays up between runs,
+        showing the last run, so Groot2 stays connected; each run is a new tree to it.
+        """
+        if self._groot2 is not None and port != self._groot2.port:
+            self._groot2.close()
+            self._groot2 = None
+        self._groot2_port = port
+
+    def _groot2_monitor(self, plan: PlanSpec, tree: BehaviorTree) -> Listener | None:
+        """The listener that publishes this run for Groot2, when asked to; a problem is
+        logged and the run goes on without it.
+        """
+        if self._groot2_port is None:
+            return None
+        from capabilities.groot2.protocol import Groot2Monitor
+        from capabilities.groot2.publisher import Groot2Error, Groot2Publisher
+        from engine.btcpp import XmlExportError
+        from engine.btcpp.runtime import loaded_tree
+
+        manifests = {m.id: m for m in self.session.registry.manifests()}
+        try:
+            monitor = Groot2Monitor(loaded_tree(plan, manifests), tree.blackboard.snapshot())
+            if self._groot2 is None:
+                self._groot2 = Groot2Publisher(monitor, self._groot2_port)
+                self.log_message.emit(
+                    f"Groot2: publishing the runs on {self._groot2.address}", "info"
+                )
+            else:
+                self._groot2.serve(monitor)
+        except (Groot2Error, XmlExportError) as exc:
+            self.log_message.emit(f"Groot2: not published: {exc}", "warning")
+            return None
+        return monitor
 
     # ------------------------------------------------------------------ starting
 
@@ -277,10 +328,14 @@ class RunController(QObject):
         recorder = self._recorder(plan)  # first: what the views show is already recorded
         # On the simulated cell the engine drives the world, paced to real time: the run
         # is the one `costar run` gives for the same plan, scene and seed.
+        listeners: list[Listener] = [*recorder, self._pump.put, self._failures]
+        groot2 = self._groot2_monitor(plan, tree)
+        if groot2 is not None:
+            listeners.append(groot2)
         self._executor = Executor(
             tree,
             self.rate_hz,
-            [*recorder, self._pump.put, self._failures],
+            listeners,
             plan_name=plan.name,
             hold=hold,
             lockstep=lockstep_of(self.session.cell),

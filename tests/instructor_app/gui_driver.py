@@ -83,6 +83,7 @@ class ScriptedDialogs(Dialogs):
         overwrite_answers: answers to "teach again a waypoint other nodes use?"; when
             empty, False.
         open_paths / save_paths / cell_paths: what the file dialogs return ("" = cancelled).
+        port_answers: what the Groot2 port dialog returns (None = cancelled; when empty, None).
         asked: ("save" | "restore" | "overwrite", text) in order; errors: (title, text) in order.
     """
 
@@ -95,10 +96,15 @@ class ScriptedDialogs(Dialogs):
         self.cell_paths: list[str] = []
         self.asked: list[tuple[str, str]] = []
         self.errors: list[tuple[str, str]] = []
+        self.port_answers: list[int | None] = []
 
     def ask_save_changes(self, parent: QWidget, name: str) -> str:
         self.asked.append(("save", name))
         return self.save_answers.pop(0) if self.save_answers else DISCARD
+
+    def ask_groot2_port(self, parent: QWidget, current: int) -> int | None:
+        self.asked.append(("groot2_port", str(current)))
+        return self.port_answers.pop(0) if self.port_answers else None
 
     def ask_restore(self, parent: QWidget, description: str) -> bool:
         self.asked.append(("restore", description))
