@@ -22,7 +22,7 @@ from engine.library import SHIPPED_LIBRARY, load_subtree
 from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
 from engine.status import FAILURE, SUCCESS
 from engine.types import JointConfig, ParamType
-from tests.capabilities.ur.emulators import HOME, wait_for
+from tests.capabilities.ur.emulators import FAST, HOME, wait_for
 
 pytestmark = pytest.mark.sim
 
@@ -100,7 +100,9 @@ def test_a_collision_of_the_emulated_arm_is_the_controllers_protective_stop(
     from capabilities.sim.testing import down_at
 
     cell_file = tmp_path / "emulated.cell.json"
-    emulator = start_emulator("5.12", write_cell=cell_file)
+    # Nothing here is paced by the wall clock (the moves only have to end, the collision is
+    # the simulated arm's force in simulated time): the cell runs faster than real time.
+    emulator = start_emulator("5.12", speed=FAST, write_cell=cell_file)
     subtree = load_subtree(CLEAR_STOP)
     body = NodeSpec(NodeKind.SEQUENCE, "pick", "pick", children=[
         NodeSpec(NodeKind.OPERATION, "above", "above", op="motion.move_to", params={
