@@ -332,7 +332,7 @@ def test_a_controller_not_heard_from_holds_the_run_until_it_answers_again(
     once the thread reads the controller again.
     """
     cell_file = tmp_path / "emulated.cell.json"
-    start_emulator("5.12", write_cell=cell_file)
+    start_emulator("5.12", speed=FAST, write_cell=cell_file)  # held before the move starts
     plan, _ = _plan(tmp_path, (0.3,), speed=0.5)
     events: list[Event] = []
     with open_cell(str(cell_file)) as cell:
