@@ -45,6 +45,12 @@ def _failures(events: list[Event], node_id: str) -> list[tuple[str, str]]:
     ]
 
 
+def _where(executor: Executor) -> tuple[str, list[tuple[str, str, str]]]:
+    """Why the run is held, and every node's status and message."""
+    nodes = [(n.name, n.status.value, n.message) for n in executor.tree.iterate()]
+    return executor.held, nodes
+
+
 def test_a_protective_stop_is_thrown_into_the_catch_and_cleared_by_the_plan(
     tmp_path: Path, start_emulator
 ) -> None:
@@ -123,7 +129,8 @@ def test_a_collision_of_the_emulated_arm_is_the_controllers_protective_stop(
         executor = Executor(tree, 20.0, [events.append], hold=hold_check(cell))
         executor.start()
         result = executor.wait(90)
-        assert result is not None and result.status is SUCCESS, result
+        # What held it or where it stands, should it not end (it once ran out the 90 s).
+        assert result is not None and result.status is SUCCESS, (result, *_where(executor))
     (error, message), *_ = _failures(events, "down")
     assert error == ErrorType.PROTECTIVE_STOP.value and PROTECTIVE_STOP in message, message
     assert any("on the table" in m for m in emulator.state()["messages"])  # the arm's cause
