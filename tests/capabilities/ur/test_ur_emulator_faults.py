@@ -4,8 +4,6 @@ its popup, which the pendant (the ``unlock`` control command) unlocks after the 
 
 from __future__ import annotations
 
-import socket
-
 import pytest
 
 from capabilities.robot.commands import CommandHandle
@@ -32,32 +30,6 @@ def test_a_blocked_move_is_a_protective_stop_with_the_controllers_popup() -> Non
         assert ctl.unlock_protective_stop() == "Protective stop releasing"
         assert ctl.safety_mode == SafetyMode.NORMAL and ctl.popup == ""
     finally:
-        ctl.close()
-        cell.close()
-
-
-def test_a_package_taken_from_the_socket_and_not_yet_applied_is_not_the_clients_silence() -> None:
-    """The watchdog's question: bytes the emulator has not read, or has read and not yet
-    applied (its server thread waiting for the controller's lock on a loaded machine), are
-    the emulator's delay; only a client that sent nothing is silent.
-    """
-    cell = SimCell(speed=None)
-    cell.start()
-    ctl = EmulatedController(cell, unlock_delay=0.0)
-    ours, client = socket.socketpair()
-    try:
-        ctl.add_input_socket(ours)
-        assert not ctl.inputs_pending()
-        client.sendall(b"package")
-        assert wait_for(ctl.inputs_pending, 5)  # unread
-        ctl.input_in_hand(ours, True)
-        assert ours.recv(64) == b"package"
-        assert ctl.inputs_pending()  # read, not yet applied
-        ctl.input_in_hand(ours, False)
-        assert not ctl.inputs_pending()  # applied: any silence from now on is the client's
-    finally:
-        ours.close()
-        client.close()
         ctl.close()
         cell.close()
 
