@@ -80,9 +80,6 @@ class EmulatedController:
         self._inputs: dict[str, Any] = {}
         self._input_stamps: dict[str, float] = {}  # when each input was last written
         self._input_sockets: set[socket.socket] = set()  # the RTDE clients' connections
-        # The connections whose package the emulator has taken from the socket and not yet
-        # applied (see inputs_pending); a set's add and discard are atomic.
-        self._inputs_in_hand: set[socket.socket] = set()
         self._out_int = [0] * 48
         self._out_double = [0.0] * 48
         self.robot_mode = RobotMode.RUNNING
@@ -237,22 +234,10 @@ class EmulatedController:
             else:
                 self._input_sockets.discard(conn)
 
-    def input_in_hand(self, conn: socket.socket, in_hand: bool) -> None:
-        """The RTDE server takes a package of ``conn`` from its socket (True) or has applied
-        it (False): in between its bytes are neither unread nor written to the inputs.
-        """
-        if in_hand:
-            self._inputs_in_hand.add(conn)
-        else:
-            self._inputs_in_hand.discard(conn)
-
     def inputs_pending(self) -> bool:
-        """True while an RTDE client has sent bytes the emulator has not read yet, or has
-        read and not yet applied (its server thread waits for this lock, or for the GIL):
-        then a silence is the emulator's own delay (a loaded machine), not the client's.
+        """True while an RTDE client has sent bytes the emulator has not read yet: then a
+        silence is the emulator's own delay (a loaded machine), not the client's.
         """
-        if self._inputs_in_hand:
-            return True
         with self._lock:
             conns = [c for c in self._input_sockets if c.fileno() >= 0]
         try:

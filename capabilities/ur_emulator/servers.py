@@ -10,7 +10,6 @@ import ipaddress
 import itertools
 import logging
 import re
-import select
 import socket
 import struct
 import threading
@@ -283,27 +282,13 @@ class _RTDESession:
 
 
 def rtde_client(conn: socket.socket, ctl: EmulatedController, stop: threading.Event) -> None:
-    """Serve one RTDE client until it disconnects.
-
-    The watchdog asks whether the client's bytes wait unread; a package is marked in hand
-    before it is taken from the socket and until it is applied, so that no moment of a loaded
-    emulator's own delay (the bytes read, the thread waiting for the controller's lock or the
-    GIL to apply them) looks like the client's silence.
-    """
+    """Serve one RTDE client until it disconnects."""
     session = _RTDESession(conn, ctl, stop)
-    ctl.add_input_socket(conn)
+    ctl.add_input_socket(conn)  # the watchdog asks whether its bytes wait unread
     try:
         while not stop.is_set():
-            try:
-                select.select([conn], [], [])  # until a package (or the end) arrives, unread
-            except ValueError:  # closed meanwhile (drop_clients)
-                return
-            ctl.input_in_hand(conn, True)
-            try:
-                size, kind = struct.unpack(">HB", _read_exact(conn, 3))
-                body = _read_exact(conn, size - 3) if size > 3 else b""
-                session.handle(kind, body)
-            finally:
-                ctl.input_in_hand(conn, False)
+            size, kind = struct.unpack(">HB", _read_exact(conn, 3))
+            body = _read_exact(conn, size - 3) if size > 3 else b""
+            session.handle(kind, body)
     finally:
         ctl.add_input_socket(conn, present=False)
