@@ -12,10 +12,16 @@ import os
 import time
 from collections.abc import Callable
 
-__all__ = ["HOME", "next_host", "wait_for"]
+__all__ = ["FAST", "HOME", "next_host", "wait_for"]
 
 _COUNTER = itertools.count(2)
 HOME = (0.0, -1.5708, 1.5708, -1.5708, -1.5708, 0.0)
+# The emulated cell's real-time factor (EmulatorProcess(speed=...)) for a test whose checks do
+# not depend on the arm's pace in wall-clock time: its moves only have to end, and what they
+# meet (a collision's force, a grasp) is simulated time. A test that injects a fault while a
+# move is under way, or checks how far the arm went before something stopped it (a watchdog,
+# a halt, all in real time), keeps the real-time pace.
+FAST = 4.0
 
 
 def next_host() -> str:

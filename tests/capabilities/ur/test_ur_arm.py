@@ -13,13 +13,13 @@ from capabilities.ur.modes import RobotMode
 from capabilities.ur.tool_io import DigitalPin, URSuctionCup
 from engine.error_types import ErrorType
 from engine.types import Pose
-from tests.capabilities.ur.emulators import wait_for
+from tests.capabilities.ur.emulators import FAST, wait_for
 
 pytestmark = pytest.mark.sim
 
 
 def test_connect_read_move_joints_and_linear(start_emulator, connect) -> None:
-    emulator = start_emulator("5.12")
+    emulator = start_emulator("5.12", speed=FAST)  # moves that only have to end
     connection, arm = connect(emulator)
     assert connection.version == (5, 12)
     q = arm.joint_positions()

@@ -30,7 +30,7 @@ from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
 from engine.status import RUNNING, SUCCESS
 from engine.trace import read_trace
 from engine.types import JointConfig, ParamType
-from tests.capabilities.ur.emulators import HOME, wait_for
+from tests.capabilities.ur.emulators import FAST, HOME, wait_for
 
 ROOT = Path(__file__).resolve().parents[3]
 SCHEMA = json.loads((ROOT / "resources" / "schemas" / "cell.schema.json").read_text("utf-8"))
@@ -132,7 +132,7 @@ def test_costar_run_with_a_cell_file_written_by_the_emulator(
     tmp_path: Path, start_emulator
 ) -> None:
     cell_file = tmp_path / "emulated.cell.json"
-    emulator = start_emulator("5.12", write_cell=cell_file)
+    emulator = start_emulator("5.12", speed=FAST, write_cell=cell_file)  # moves that end
     assert CellConfig.load(cell_file).robot.host == emulator.host
     spec, _ = _plan(tmp_path, (0.25, -0.1))
     assert spec.tree is not None
@@ -241,7 +241,7 @@ def test_cup_to_bin_runs_on_the_emulated_ur_cell_through_ur_rtde(
     from tests.capabilities.sim.test_cup_to_bin import cup_in_bin
 
     cell_file = tmp_path / "emulated.cell.json"
-    emulator = start_emulator("5.12", speed=2.0, scene="cup_to_bin", seed=3, write_cell=cell_file)
+    emulator = start_emulator("5.12", speed=FAST, scene="cup_to_bin", seed=3, write_cell=cell_file)
     out, err = io.StringIO(), io.StringIO()
     plan = str(ROOT / "resources" / "examples" / "cup_to_bin.costar.json")
     code = main(["run", plan, "--cell", str(cell_file), "--timeout", "120"], out, err)
@@ -332,7 +332,7 @@ def test_a_controller_not_heard_from_holds_the_run_until_it_answers_again(
     once the thread reads the controller again.
     """
     cell_file = tmp_path / "emulated.cell.json"
-    start_emulator("5.12", write_cell=cell_file)
+    start_emulator("5.12", speed=FAST, write_cell=cell_file)  # held before the move starts
     plan, _ = _plan(tmp_path, (0.3,), speed=0.5)
     events: list[Event] = []
     with open_cell(str(cell_file)) as cell:

@@ -11,7 +11,7 @@ import rtde_receive
 from capabilities.ur_emulator import UREmulator
 from capabilities.ur_emulator.errors import EmulatorError
 from capabilities.ur_emulator.servers import check_loopback
-from tests.capabilities.ur.emulators import wait_for
+from tests.capabilities.ur.emulators import FAST, wait_for
 
 pytestmark = pytest.mark.sim
 
@@ -25,7 +25,7 @@ def test_refuses_addresses_beyond_loopback(host: str) -> None:
 
 
 def test_ur_rtde_connects_reads_and_moves(start_emulator) -> None:
-    emulator = start_emulator("5.12")
+    emulator = start_emulator("5.12", speed=FAST)  # a move that only has to end
     dashboard = dashboard_client.DashboardClient(emulator.host)
     dashboard.connect()
     assert dashboard.polyscopeVersion().startswith("5.12.")

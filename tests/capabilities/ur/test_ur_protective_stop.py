@@ -22,7 +22,7 @@ from engine.library import SHIPPED_LIBRARY, load_subtree
 from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
 from engine.status import FAILURE, SUCCESS
 from engine.types import JointConfig, ParamType
-from tests.capabilities.ur.emulators import HOME, wait_for
+from tests.capabilities.ur.emulators import FAST, HOME, wait_for
 
 pytestmark = pytest.mark.sim
 
@@ -43,6 +43,12 @@ def _failures(events: list[Event], node_id: str) -> list[tuple[str, str]]:
         for e in events
         if isinstance(e, StatusChanged) and e.node_id == node_id and e.new is FAILURE
     ]
+
+
+def _where(executor: Executor) -> tuple[str, list[tuple[str, str, str]]]:
+    """Why the run is held, and every node's status and message."""
+    nodes = [(n.name, n.status.value, n.message) for n in executor.tree.iterate()]
+    return executor.held, nodes
 
 
 def test_a_protective_stop_is_thrown_into_the_catch_and_cleared_by_the_plan(
@@ -100,7 +106,9 @@ def test_a_collision_of_the_emulated_arm_is_the_controllers_protective_stop(
     from capabilities.sim.testing import down_at
 
     cell_file = tmp_path / "emulated.cell.json"
-    emulator = start_emulator("5.12", write_cell=cell_file)
+    # Nothing here is paced by the wall clock (the moves only have to end, the collision is
+    # the simulated arm's force in simulated time): the cell runs faster than real time.
+    emulator = start_emulator("5.12", speed=FAST, write_cell=cell_file)
     subtree = load_subtree(CLEAR_STOP)
     body = NodeSpec(NodeKind.SEQUENCE, "pick", "pick", children=[
         NodeSpec(NodeKind.OPERATION, "above", "above", op="motion.move_to", params={
@@ -121,7 +129,8 @@ def test_a_collision_of_the_emulated_arm_is_the_controllers_protective_stop(
         executor = Executor(tree, 20.0, [events.append], hold=hold_check(cell))
         executor.start()
         result = executor.wait(90)
-        assert result is not None and result.status is SUCCESS, result
+        # What held it or where it stands, should it not end (it once ran out the 90 s).
+        assert result is not None and result.status is SUCCESS, (result, *_where(executor))
     (error, message), *_ = _failures(events, "down")
     assert error == ErrorType.PROTECTIVE_STOP.value and PROTECTIVE_STOP in message, message
     assert any("on the table" in m for m in emulator.state()["messages"])  # the arm's cause

@@ -8,6 +8,7 @@ import pytest
 
 from capabilities.ur.errors import URError
 from capabilities.ur.robotiq import ROBOTIQ_PORT, RobotiqGripper
+from tests.capabilities.ur.emulators import FAST
 
 pytestmark = pytest.mark.sim
 
@@ -36,7 +37,7 @@ def test_the_urcap_protocol_activates_moves_and_reports(start_emulator) -> None:
 
 
 def test_the_gripper_backend_closes_and_opens_the_emulated_gripper(start_emulator, connect) -> None:
-    emulator = start_emulator("5.12")
+    emulator = start_emulator("5.12", speed=FAST)  # the fingers' moves only have to end
     connection, _ = connect(emulator)
     gripper = RobotiqGripper(connection)
     handle = gripper.close()
