@@ -31,7 +31,7 @@ from capabilities.xml_commands import add_xml_commands
 from engine.build import BuildError, build_tree
 from engine.events import Event, LogMessage, RunFinished, StatusChanged
 from engine.executor import Executor
-from engine.files import PlanFileError, load_plan, plan_scene
+from engine.files import PlanFileError, load_plan, loads_plan, plan_scene
 from engine.instances import runtime_paths
 from engine.library import Library, library_folder
 from engine.operations import OperationManifest
@@ -432,6 +432,40 @@ def _cmd_runs_list(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     return EXIT_SUCCESS
 
 
+def _cmd_runs_export(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    if not (args.btlog or args.sqlite):
+        print("error: say what to write: --btlog FILE and/or --sqlite FILE", file=err)
+        return EXIT_INVALID
+    from engine.btcpp import XmlExportError
+    from engine.btcpp.run_logs import transitions, write_btlog, write_sqlite
+    from engine.btcpp.runtime import loaded_tree
+
+    try:
+        path = find_record(runs_folder(args.runs), args.record)
+        trace = read_trace(path)
+        document = trace.header.get("plan_document")
+        if not isinstance(document, dict):
+            raise RunRecordError(f"{path}: the record does not hold its plan (an older record)")
+        registry = CapabilityRegistry()
+        plan = loads_plan(json.dumps(document), f"{path} (its plan)", registry.aliases())
+        loaded = loaded_tree(plan, {m.id: m for m in registry.manifests()})
+        changes = list(transitions(trace.events, loaded.uids))
+        started = int(trace.header.get("started_us", 0))
+        written = []
+        if args.btlog:
+            write_btlog(Path(args.btlog), loaded, started, changes)
+            written.append(args.btlog)
+        if args.sqlite:
+            write_sqlite(Path(args.sqlite), loaded, started, changes)
+            written.append(args.sqlite)
+    except (TraceError, RunRecordError, PlanFileError, XmlExportError, OSError) as exc:
+        print(f"error: {exc}", file=err)
+        return EXIT_INVALID
+    nodes = len(loaded.uids)
+    print(f"{len(changes)} transitions of {nodes} nodes written to {', '.join(written)}", file=out)
+    return EXIT_SUCCESS
+
+
 def _cmd_trace_show(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     try:
         trace = read_trace(find_record(runs_folder(getattr(args, "runs", None)), args.file))
@@ -539,6 +573,14 @@ def _parser() -> argparse.ArgumentParser:
     shown.add_argument("file", help="a record's path or name (its start is enough), or last")
     shown.add_argument("--runs", help=f"the runs folder (default: ${RUNS_ENV}, else the user's)")
     shown.set_defaults(func=_cmd_trace_show)
+    export = runs_sub.add_parser(
+        "export", help="write a run record as BehaviorTree.CPP's loggers write a run"
+    )
+    export.add_argument("record", help="a record's path or name (its start is enough), or last")
+    export.add_argument("--btlog", help="a Groot2 file log (FileLogger2) to write: *.btlog")
+    export.add_argument("--sqlite", help="a SqliteLogger database to write: *.db3 or *.btdb")
+    export.add_argument("--runs", help=f"the runs folder (default: ${RUNS_ENV}, else the user's)")
+    export.set_defaults(func=_cmd_runs_export)
     trace = sub.add_parser("trace", help="traces of runs (as `costar runs show`)")
     trace_sub = trace.add_subparsers(dest="trace_command", required=True)
     show = trace_sub.add_parser("show", help="print a trace as a readable timeline")
