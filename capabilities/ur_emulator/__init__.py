@@ -66,7 +66,8 @@ class UREmulator(ClosesOnExit):
         if version not in VERSIONS:
             raise ValueError(f"version must be one of {sorted(VERSIONS)}, got {version!r}")
         self._own_cell = cell is None
-        self.cell = cell if cell is not None else SimCell(speed=speed)
+        # The arm alone: no camera draws its world.
+        self.cell = cell if cell is not None else SimCell(speed=speed, drawn=False)
         self.controller: EmulatedController | None = None
         self._servers: list[Server] = []
         self._version = version
