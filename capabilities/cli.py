@@ -26,6 +26,7 @@ from capabilities.collaboration.answers import CONFIRM_MODES, PromptAnswerer
 from capabilities.doctor import cmd_doctor
 from capabilities.faults import hold_check
 from capabilities.hold_watch import DEFAULT_HOLD_TIMEOUT, HoldWatch
+from capabilities.run_sampler import JointSampler
 from capabilities.shipped_examples import cmd_examples
 from capabilities.xml_commands import add_xml_commands
 from engine.build import BuildError, build_tree
@@ -221,7 +222,11 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         listeners: list[Callable[[Event], None]] = []
         record = _record_path(args, plan.name, err)
         if record is not None:  # first: what a line on screen says is already in the record
-            listeners.append(TraceRecorder(record, plan))
+            recorder = TraceRecorder(record, plan)
+            listeners.append(recorder)
+            arm = cell.interfaces().get("arm")
+            if arm is not None:
+                listeners.append(JointSampler(arm, recorder))
         if publisher is not None:
             listeners.append(publisher.monitor)
         holds = HoldWatch(out, args.hold_timeout, cell)

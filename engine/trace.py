@@ -130,6 +130,13 @@ class TraceRecorder:
             failures(event)
         self._write(_event_record(event))
 
+    def note(self, record: dict[str, Any]) -> None:
+        """Add a record of the cell's own between the run's events (the robot's joints; any
+        thread): ``record`` with its ``event`` kind, stamped with the events' clock. Ignored
+        once the run's record is closed.
+        """
+        self._write({**record, "time": time.monotonic()})
+
     def _write_failures(self, failures: FailureLog, event: RunFinished) -> None:
         cause = failures.failed_run() if event.reason == "finished" else None
         others = [c for c in failures.root_causes() if c != cause]

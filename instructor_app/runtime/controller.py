@@ -18,6 +18,7 @@ from PySide6.QtCore import QObject, QTimer, Signal
 
 from capabilities.cell_features import ReportsStatus, lockstep_of
 from capabilities.faults import hold_check
+from capabilities.run_sampler import JointSampler
 from engine.blackboard import Blackboard, BlackboardError
 from engine.build import BuildError, build_tree
 from engine.events import Listener, RunFinished
@@ -356,7 +357,7 @@ class RunController(QObject):
             self.log_message.emit(f"Run of {plan.name or 'the plan'} started", "info")
         return True
 
-    def _recorder(self, plan: PlanSpec) -> list[TraceRecorder]:
+    def _recorder(self, plan: PlanSpec) -> list[Listener]:
         """This run's record in the runs folder ($COSTAR_RUNS, else the user's; the oldest
         removed past its size limit), as `costar run` keeps one; none when it cannot be
         written (said in the Log: the run goes on).
@@ -370,7 +371,9 @@ class RunController(QObject):
             return []
         prune_records(folder, keep=path)
         self.last_record = path
-        return [recorder]
+        cell = self.session.cell
+        arm = cell.interfaces().get("arm") if cell is not None else None
+        return [recorder] if arm is None else [recorder, JointSampler(arm, recorder)]
 
     def _resume_at(self, tree: BehaviorTree, node_id: str) -> dict[str, Status] | None:
         """Mark the nodes before ``node_id`` done and carry the last run's values over."""
