@@ -43,6 +43,7 @@ from typing import Any
 
 import msgpack
 
+from capabilities.base import CapabilityError
 from engine.btcpp.runtime import LoadedTree
 from engine.events import BlackboardWritten, Event, StatusChanged
 from engine.status import Status
@@ -100,7 +101,7 @@ class RequestType(enum.IntEnum):
     UNDEFINED = 0
 
 
-class ProtocolError(ValueError):
+class ProtocolError(CapabilityError):
     """Bytes that are not a message of the protocol."""
 
 
@@ -330,7 +331,7 @@ class Groot2Monitor:
         return packed
 
 
-class _Refused(Exception):
+class _Refused(CapabilityError):
     """A request answered with the error reply."""
 
 
