@@ -84,13 +84,16 @@ def _open(args: argparse.Namespace, err: TextIO, start: bool) -> ClosableCell | 
     """The cell the command asked for, or None after saying why it could not be opened.
     The simulated cell opens ``--scene``, else the scene the plan was taught on; for a run
     its world waits for the run (lockstep from simulated time 0: the same seed gives the
-    same run).
+    same run), paced to real time as a robot moves unless ``--fast``.
     """
     plan = getattr(args, "plan", None)
     scene = args.scene or (plan_scene(plan) if plan else None)
     run = args.command == "run"
+    speed = None if not run or args.fast else 1.0
     try:
-        return open_cell(args.cell, seed=args.seed, start=start, scene=scene, still_until_run=run)
+        return open_cell(
+            args.cell, seed=args.seed, start=start, scene=scene, speed=speed, still_until_run=run
+        )
     except CellError as exc:
         print(f"error: {exc}", file=err)
         return None
@@ -516,6 +519,12 @@ def _parser() -> argparse.ArgumentParser:
         help=f"the runs folder for the run's record (default: ${RUNS_ENV}, else the user's)",
     )
     run.add_argument("--no-record", action="store_true", help="keep no record of this run")
+    run.add_argument(
+        "--fast",
+        action="store_true",
+        help="the simulated cell as fast as it can (the same run: it is in lockstep); "
+        "default: at the pace of a real robot",
+    )
     run.add_argument("--timeout", type=float, help="stop after this many seconds (exit 3)")
     run.add_argument(
         "--hold-timeout",

@@ -44,7 +44,7 @@ def test_the_installed_wheel_runs_an_example_from_any_folder(
     assert all(Path(path).is_relative_to(venv) for path in where), where
 
     done = subprocess.run(
-        [str(venv / "bin" / "costar"), "run", "example:cup_to_bin", "--seed", "3"],
+        [str(venv / "bin" / "costar"), "run", "example:cup_to_bin", "--seed", "3", "--fast"],
         cwd=elsewhere, env=env, capture_output=True, text=True, timeout=300,
     )  # fmt: skip
     assert done.returncode == 0, done.stdout + done.stderr

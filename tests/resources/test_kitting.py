@@ -68,7 +68,7 @@ def test_kitting_composes_the_library_as_in_figure_7() -> None:
 @pytest.mark.parametrize("seed", range(10))
 def test_costar_run_kitting_succeeds(seed: int) -> None:
     out, err = io.StringIO(), io.StringIO()
-    args = ["run", str(KITTING), "--seed", str(seed)]  # the plan names its scene
+    args = ["run", str(KITTING), "--seed", str(seed), "--fast"]  # the plan names its scene
     code = costar([*args, "--timeout", "240"], out, err)  # before the suite's 300 s
     assert code == 0, out.getvalue() + err.getvalue()
     assert "SUCCESS" in out.getvalue()

@@ -80,7 +80,7 @@ def test_waits_while_the_cup_is_hidden_and_completes_when_it_appears() -> None:
 
 
 def test_costar_run_on_the_sim_cell_exits_0(capsys: pytest.CaptureFixture[str]) -> None:
-    assert costar(["run", str(PLAN), "--cell", "sim", "--seed", "5", "--rate", "50"]) == 0
+    assert costar(["run", str(PLAN), "--cell", "sim", "--seed", "5", "--rate", "50", "--fast"]) == 0
     assert "SUCCESS" in capsys.readouterr().out
 
 
@@ -98,7 +98,17 @@ def test_costar_run_on_the_simulated_cell_gives_the_same_run_twice(tmp_path: Pat
     for name in ("first", "second"):
         trace = tmp_path / f"{name}.jsonl"
         out, err = io.StringIO(), io.StringIO()
-        args = ["run", str(PLAN), "--seed", "61", "--trace", str(trace), "--timeout", "120"]
+        args = [
+            "run",
+            str(PLAN),
+            "--seed",
+            "61",
+            "--trace",
+            str(trace),
+            "--timeout",
+            "120",
+            "--fast",
+        ]
         assert costar(args, out, err) == 0, out.getvalue() + err.getvalue()
         runs.append(_transitions(trace))
     assert len(runs[0]) > 20
