@@ -108,21 +108,33 @@ class LibraryConflict(LibraryError):
     """Someone else saved a version of this subtree since the one this save started from."""
 
 
-def default_user_library() -> Path:
-    """The per-user library folder (``~/.local/share/costar/library`` on Linux)."""
+def user_data_folder(leaf: str) -> Path:
+    """A per-user data folder of the application (``~/.local/share/costar/LEAF`` on Linux)."""
     if sys.platform == "win32":
         base = Path(os.environ.get("APPDATA", Path.home() / "AppData" / "Roaming"))
     elif sys.platform == "darwin":
         base = Path.home() / "Library" / "Application Support"
     else:
         base = Path(os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share")
-    return base / "costar" / "library"
+    return base / "costar" / leaf
+
+
+def chosen_folder(option: str | None, variable: str, setting: str | None, leaf: str) -> Path:
+    """A folder the user may choose: a command's option, else the environment ``variable``,
+    else the Instructor's setting, else the user's data folder ``leaf``.
+    """
+    chosen = option or os.environ.get(variable) or setting
+    return Path(chosen).expanduser() if chosen else user_data_folder(leaf)
+
+
+def default_user_library() -> Path:
+    """The per-user library folder (``~/.local/share/costar/library`` on Linux)."""
+    return user_data_folder("library")
 
 
 def library_folder(option: str | None = None, setting: str | None = None) -> Path:
     """The writable library folder: the option, else $COSTAR_LIBRARY, else the setting."""
-    chosen = option or os.environ.get(LIBRARY_ENV) or setting
-    return Path(chosen).expanduser() if chosen else default_user_library()
+    return chosen_folder(option, LIBRARY_ENV, setting, "library")
 
 
 def dump_subtree(subtree: SubtreeSpec) -> str:

@@ -67,7 +67,10 @@ class Node:
             return status
         if self.conditions is not None:
             return self._tick_with_conditions(status)
-        new = self.update()
+        return self._settle(status, self.update())
+
+    def _settle(self, status: Status, new: Status) -> Status:
+        """Take the tick's result ``new`` (was ``status``) and tell the sink of a change."""
         if new is not status:
             if new is FAILURE and self.error is None:
                 self.error = self._child_error()
@@ -102,14 +105,7 @@ class Node:
                     conditions.after(new)
                 except ConditionFailed as exc:
                     new = self.fail(str(exc), ErrorType.INVALID_INPUT)
-        if new is not status:
-            if new is FAILURE and self.error is None:
-                self.error = self._child_error()
-            self.status = new
-            sink = self.ctx.status_sink
-            if sink is not None:
-                sink(self, status, new)
-        return new
+        return self._settle(status, new)
 
     def _given(self, status: Status, condition: Condition) -> None:
         """The message of a result a pre-condition gave."""

@@ -10,14 +10,13 @@ the user's data folder (``~/.local/share/costar/runs`` on Linux), as for the lib
 from __future__ import annotations
 
 import json
-import os
 import re
-import sys
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
 
 from engine.errors import EngineError
+from engine.library import chosen_folder, user_data_folder
 
 __all__ = [
     "RUNS_ENV",
@@ -43,19 +42,12 @@ class RunRecordError(EngineError):
 
 def default_runs_folder() -> Path:
     """The per-user runs folder (``~/.local/share/costar/runs`` on Linux)."""
-    if sys.platform == "win32":
-        base = Path(os.environ.get("APPDATA", Path.home() / "AppData" / "Roaming"))
-    elif sys.platform == "darwin":
-        base = Path.home() / "Library" / "Application Support"
-    else:
-        base = Path(os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share")
-    return base / "costar" / "runs"
+    return user_data_folder("runs")
 
 
 def runs_folder(option: str | None = None, setting: str | None = None) -> Path:
     """The runs folder: the option, else $COSTAR_RUNS, else the setting, else the user's."""
-    chosen = option or os.environ.get(RUNS_ENV) or setting
-    return Path(chosen).expanduser() if chosen else default_runs_folder()
+    return chosen_folder(option, RUNS_ENV, setting, "runs")
 
 
 def _slug(name: str) -> str:

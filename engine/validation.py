@@ -21,7 +21,7 @@ conditions (success_if, skip_if, while) guarantees nothing it writes itself.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from typing import Any
 
 from engine.conditions import PRE_CONDITIONS, Condition
@@ -178,19 +178,26 @@ def _script_reads(check: Check, node: NodeSpec, available: frozenset[str]) -> fr
     return frozenset(names.sure)
 
 
-def _condition_names(node: NodeSpec) -> dict[Condition, ScriptNames]:
-    """What each condition of a node that parses reads and writes, in the fixed order."""
-    out: dict[Condition, ScriptNames] = {}
+def _parsed_conditions(node: NodeSpec) -> Iterator[tuple[Condition, ScriptNames | ScriptError]]:
+    """Each condition a node has, in the fixed order, with what its script reads and writes
+    (or why it does not parse).
+    """
     given = {Condition(c): text for c, text in node.conditions.items()}
     for condition in Condition:
         text = given.get(condition, "")
         if not text.strip():
             continue
         try:
-            out[condition] = script_names(parse_script(text))
-        except ScriptError:
-            continue  # reported by _condition_writes
-    return out
+            yield condition, script_names(parse_script(text))
+        except ScriptError as exc:
+            yield condition, exc
+
+
+def _condition_names(node: NodeSpec) -> dict[Condition, ScriptNames]:
+    """What each condition of a node that parses reads and writes, in the fixed order (one
+    that does not parse is reported by _condition_writes).
+    """
+    return {c: names for c, names in _parsed_conditions(node) if not isinstance(names, ScriptError)}
 
 
 def _condition_label(condition: Condition) -> str:
@@ -199,19 +206,13 @@ def _condition_label(condition: Condition) -> str:
 
 def _condition_writes(check: Check, node: NodeSpec) -> None:
     """A condition that does not parse is an error; the names conditions write are written."""
-    given = {Condition(c): text for c, text in node.conditions.items()}
-    for condition in Condition:
-        text = given.get(condition, "")
-        if not text.strip():
-            continue
-        try:
-            names = script_names(parse_script(text))
-        except ScriptError as exc:
+    for condition, names in _parsed_conditions(node):
+        if isinstance(names, ScriptError):
             check.add(
                 ERROR,
                 node,
                 f"The {_condition_label(condition)} condition of {node.label!r} is not a script "
-                f"of BehaviorTree.CPP's language: {exc}.",
+                f"of BehaviorTree.CPP's language: {names}.",
                 condition.value,
             )
             continue
