@@ -225,7 +225,7 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         listeners: list[Callable[[Event], None]] = []
         record = _record_path(args, plan.name, err)
         if record is not None:  # first: what a line on screen says is already in the record
-            recorder = TraceRecorder(record, plan)
+            recorder = TraceRecorder(record, plan, _run_settings(args))
             listeners.append(recorder)
             arm = cell.interfaces().get("arm")
             if arm is not None:
@@ -263,6 +263,12 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         )
         _report_caught(failures, out)
         return code
+
+
+def _run_settings(args: argparse.Namespace) -> dict[str, Any]:
+    """How this run was started, kept in its record for a replay."""
+    scene = args.scene or plan_scene(args.plan)
+    return {"cell": args.cell, "scene": scene, "seed": args.seed, "rate": args.rate}
 
 
 def _record_path(args: argparse.Namespace, plan_name: str, err: TextIO) -> Path | None:
@@ -474,6 +480,75 @@ def _cmd_runs_export(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     return EXIT_SUCCESS
 
 
+def _changes(events: list[dict[str, Any]]) -> list[tuple[int, str, str]]:
+    return [(e["tick"], e["node"], e["new"]) for e in events if e.get("event") == "status"]
+
+
+def _cmd_runs_replay(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    """Run a recorded simulated run again (in lockstep, as fast as it can) and say whether
+    it is the same run: every status change at the same tick; else the first that differs.
+    """
+    try:
+        path = find_record(runs_folder(args.runs), args.record)
+        trace = read_trace(path)
+        document, settings = trace.header.get("plan_document"), trace.header.get("run")
+        if not isinstance(document, dict) or not isinstance(settings, dict):
+            raise RunRecordError(f"{path}: the record does not hold its plan and how it ran")
+        if settings.get("cell") != "sim":
+            raise RunRecordError(
+                f"{path}: only a run on the simulated cell replays, not on {settings.get('cell')!r}"
+            )
+        cell = open_cell(
+            "sim", int(settings.get("seed") or 0), scene=settings.get("scene"), still_until_run=True
+        )
+    except (TraceError, RunRecordError, CellError) as exc:
+        print(f"error: {exc}", file=err)
+        return EXIT_INVALID
+    recorded = _changes(trace.events)
+    replayed: list[tuple[int, str, str]] = []
+
+    def heard(event: Event) -> None:
+        if isinstance(event, StatusChanged):
+            replayed.append((event.tick, event.node_id, event.new.value))
+
+    with cell:
+        registry = CapabilityRegistry(cell=cell)
+        try:
+            plan = loads_plan(json.dumps(document), f"{path} (its plan)", registry.aliases())
+            tree = build_tree(plan, registry, clock=cell.clock)
+        except (PlanFileError, BuildError) as exc:
+            print(f"error: {exc}", file=err)
+            return EXIT_INVALID
+        executor = Executor(
+            tree, float(settings.get("rate") or 20.0), [heard], lockstep=lockstep_of(cell)
+        )
+        executor.start()
+        if executor.wait(args.timeout) is None:
+            executor.stop("timed out")
+    first = next(
+        (i for i, (a, b) in enumerate(zip(recorded, replayed, strict=False)) if a != b), None
+    )
+    if first is None and len(recorded) == len(replayed):
+        print(f"the same run: {len(recorded)} status changes at the same ticks", file=out)
+        return EXIT_SUCCESS
+    at = first if first is not None else min(len(recorded), len(replayed))
+    labels = trace.labels()
+
+    def said(change: tuple[int, str, str] | None) -> str:
+        if change is None:
+            return "nothing (the run had ended)"
+        tick, node, status = change
+        return f"tick {tick}: {labels.get(node, node)} -> {status}"
+
+    was = recorded[at] if at < len(recorded) else None
+    now = replayed[at] if at < len(replayed) else None
+    print(
+        f"the runs part at status change {at + 1}: recorded {said(was)}; replayed {said(now)}",
+        file=out,
+    )
+    return EXIT_FAILURE
+
+
 def _cmd_trace_show(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     try:
         trace = read_trace(find_record(runs_folder(getattr(args, "runs", None)), args.file))
@@ -595,6 +670,13 @@ def _parser() -> argparse.ArgumentParser:
     export.add_argument("--sqlite", help="a SqliteLogger database to write: *.db3 or *.btdb")
     export.add_argument("--runs", help=f"the runs folder (default: ${RUNS_ENV}, else the user's)")
     export.set_defaults(func=_cmd_runs_export)
+    replay = runs_sub.add_parser(
+        "replay", help="run a recorded simulated run again and say where it differs"
+    )
+    replay.add_argument("record", help="a record's path or name (its start is enough), or last")
+    replay.add_argument("--runs", help=f"the runs folder (default: ${RUNS_ENV}, else the user's)")
+    replay.add_argument("--timeout", type=float, default=600.0, help="wall seconds (600)")
+    replay.set_defaults(func=_cmd_runs_replay)
     trace = sub.add_parser("trace", help="traces of runs (as `costar runs show`)")
     trace_sub = trace.add_subparsers(dest="trace_command", required=True)
     show = trace_sub.add_parser("show", help="print a trace as a readable timeline")

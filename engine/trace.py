@@ -82,7 +82,13 @@ class TraceRecorder:
     event is flushed as it is written: a run that is killed leaves its trace up to that moment.
     """
 
-    def __init__(self, path: str | os.PathLike[str], plan: PlanSpec | None = None) -> None:
+    def __init__(
+        self,
+        path: str | os.PathLike[str],
+        plan: PlanSpec | None = None,
+        run: dict[str, Any] | None = None,
+    ) -> None:
+        """``run``: how the run was started (cell, scene, seed, rate), for a replay."""
         self.path = Path(path)
         self._lock = threading.Lock()
         self._file: TextIO | None = self.path.open("w", encoding="utf-8")
@@ -105,6 +111,8 @@ class TraceRecorder:
                 }
                 for path, node in plan.walk()
             ]
+        if run is not None:
+            header["run"] = run
         self._write(header)
 
     def _write(self, record: dict[str, Any]) -> None:

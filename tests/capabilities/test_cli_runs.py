@@ -74,3 +74,10 @@ def test_a_killed_run_leaves_a_readable_record(tmp_path: Path) -> None:
     code, shown, err = _cli("runs", "show", "last", "--runs", str(runs))
     assert code == 0, err
     assert "spin" in shown and "RUNNING" in shown
+
+
+def test_only_a_run_on_the_simulated_cell_replays(tmp_path: Path) -> None:
+    runs = tmp_path / "runs"
+    assert _cli("run", "--cell", "none", str(FIGURE3), "--rate", "200", "--runs", str(runs))[0] == 0
+    code, _, err = _cli("runs", "replay", "last", "--runs", str(runs))
+    assert code == 2 and "only a run on the simulated cell replays, not on 'none'" in err

@@ -113,3 +113,26 @@ def test_costar_run_on_the_simulated_cell_gives_the_same_run_twice(tmp_path: Pat
         runs.append(_transitions(trace))
     assert len(runs[0]) > 20
     assert runs[0] == runs[1]
+
+
+@pytest.mark.sim
+def test_runs_replay_gives_the_recorded_run_again_or_says_where_it_parts(tmp_path: Path) -> None:
+    """A paced run (as a worker runs it) replayed as fast as it can is the same run; a record
+    whose fifth status change came a tick later is named as parting there.
+    """
+    runs = tmp_path / "runs"
+    out, err = io.StringIO(), io.StringIO()
+    args = ["run", str(PLAN), "--seed", "61", "--runs", str(runs), "--timeout", "120"]
+    assert costar(args, out, err) == 0, out.getvalue() + err.getvalue()
+    out, err = io.StringIO(), io.StringIO()
+    assert costar(["runs", "replay", "last", "--runs", str(runs)], out, err) == 0, err.getvalue()
+    assert out.getvalue().startswith("the same run: ")
+    record = next(runs.iterdir())
+    lines = record.read_text(encoding="utf-8").splitlines()
+    changes = [i for i, line in enumerate(lines) if json.loads(line).get("event") == "status"]
+    fifth = json.loads(lines[changes[4]])
+    lines[changes[4]] = json.dumps(fifth | {"tick": fifth["tick"] + 1})
+    record.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    out, err = io.StringIO(), io.StringIO()
+    assert costar(["runs", "replay", str(record)], out, err) == 1, err.getvalue()
+    assert out.getvalue().startswith("the runs part at status change 5: recorded tick ")
