@@ -569,13 +569,13 @@ def test_at_names_the_entry_at_the_top_of_the_tree() -> None:
     bb = Blackboard()
     inner = Scope(names="Pick#ab12cd/", outer=Scope())
     env = ScriptEnv(bb, key=inner.key)
-    parse_script("local := 1; @shared := 2; @shared += local").run(env)
-    assert bb.snapshot() == {"Pick#ab12cd/local": 1, "shared": 3}
-    assert parse_script("@shared").run(env) == 3
-    with pytest.raises(ScriptNameError, match="'shared' does not exist"):
-        parse_script("shared").run(env)
+    parse_script("local := 1; @total := 2; @total += local").run(env)
+    assert bb.snapshot() == {"Pick#ab12cd/local": 1, "total": 3}
+    assert parse_script("@total").run(env) == 3
+    with pytest.raises(ScriptNameError, match="'total' does not exist"):
+        parse_script("total").run(env)
     top = ScriptEnv(bb)
-    assert parse_script("@shared == shared").run(top) is True
+    assert parse_script("@total == total").run(top) is True
 
 
 def test_a_bare_at_sign_is_not_a_name() -> None:
