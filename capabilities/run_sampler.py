@@ -44,6 +44,12 @@ class JointSampler:
         elif isinstance(event, RunFinished):
             self._done.set()
 
+    def wait(self, timeout: float | None = None) -> bool:
+        """Wait until the sampling thread ended (after the run's end); whether it has."""
+        if self._thread.is_alive():
+            self._thread.join(timeout)
+        return not self._thread.is_alive()
+
     def _sample(self) -> None:
         while not self._done.is_set():
             try:
