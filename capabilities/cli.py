@@ -551,7 +551,7 @@ def _cmd_runs_replay(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
 def _cmd_trace_show(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     try:
-        trace = read_trace(find_record(runs_folder(getattr(args, "runs", None)), args.file))
+        trace = read_trace(find_record(runs_folder(getattr(args, "runs", None)), args.record))
     except (TraceError, RunRecordError) as exc:
         print(f"error: {exc}", file=err)
         return EXIT_INVALID
@@ -654,33 +654,34 @@ def _parser() -> argparse.ArgumentParser:
 
     runs = sub.add_parser("runs", help="the records of runs (every `costar run` keeps one)")
     runs_sub = runs.add_subparsers(dest="runs_command", required=True)
-    listing = runs_sub.add_parser("list", help="the run records, newest first")
-    listing.add_argument("--runs", help=f"the runs folder (default: ${RUNS_ENV}, else the user's)")
+
+    def runs_command(name: str, what: str, func: Callable[..., int], one: bool = True) -> Any:
+        """A ``costar runs`` command: of one record (``one``) or of the folder."""
+        command = runs_sub.add_parser(name, help=what)
+        if one:
+            command.add_argument("record", help="a record's path or name (its start), or last")
+        command.add_argument(
+            "--runs", help=f"the runs folder (default: ${RUNS_ENV}, else the user's)"
+        )
+        command.set_defaults(func=func)
+        return command
+
+    listing = runs_command("list", "the run records, newest first", _cmd_runs_list, one=False)
     listing.add_argument("--most", type=int, default=50, help="list at most this many (50)")
-    listing.set_defaults(func=_cmd_runs_list)
-    shown = runs_sub.add_parser("show", help="print a run record as a readable timeline")
-    shown.add_argument("file", help="a record's path or name (its start is enough), or last")
-    shown.add_argument("--runs", help=f"the runs folder (default: ${RUNS_ENV}, else the user's)")
-    shown.set_defaults(func=_cmd_trace_show)
-    export = runs_sub.add_parser(
-        "export", help="write a run record as BehaviorTree.CPP's loggers write a run"
+    runs_command("show", "print a run record as a readable timeline", _cmd_trace_show)
+    export = runs_command(
+        "export", "write a run record as BehaviorTree.CPP's loggers write a run", _cmd_runs_export
     )
-    export.add_argument("record", help="a record's path or name (its start is enough), or last")
     export.add_argument("--btlog", help="a Groot2 file log (FileLogger2) to write: *.btlog")
     export.add_argument("--sqlite", help="a SqliteLogger database to write: *.db3 or *.btdb")
-    export.add_argument("--runs", help=f"the runs folder (default: ${RUNS_ENV}, else the user's)")
-    export.set_defaults(func=_cmd_runs_export)
-    replay = runs_sub.add_parser(
-        "replay", help="run a recorded simulated run again and say where it differs"
+    replay = runs_command(
+        "replay", "run a recorded simulated run again and say where it differs", _cmd_runs_replay
     )
-    replay.add_argument("record", help="a record's path or name (its start is enough), or last")
-    replay.add_argument("--runs", help=f"the runs folder (default: ${RUNS_ENV}, else the user's)")
     replay.add_argument("--timeout", type=float, default=600.0, help="wall seconds (600)")
-    replay.set_defaults(func=_cmd_runs_replay)
     trace = sub.add_parser("trace", help="traces of runs (as `costar runs show`)")
     trace_sub = trace.add_subparsers(dest="trace_command", required=True)
     show = trace_sub.add_parser("show", help="print a trace as a readable timeline")
-    show.add_argument("file")
+    show.add_argument("record", metavar="file")
     show.set_defaults(func=_cmd_trace_show)
     add_xml_commands(sub, (EXIT_SUCCESS, EXIT_INVALID))
     return parser
