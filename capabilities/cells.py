@@ -91,16 +91,18 @@ def open_cell(
         return _open_cell_file(Path(name), seed, scene, speed, still_until_run)
     if name == "sim":
         try:
-            from capabilities.sim.session import SimCellSession
+            from capabilities.sim.session import PERCEPTION_S, SimCellSession
         except ImportError as exc:
             raise CellError(f"the simulated cell cannot load: {exc}") from exc
         try:
-            lockstep = _lockstep(speed)
+            # Always in lockstep, paced or not: each look costs a fixed simulated time while
+            # the world stands still and a run's engine drives the world, so what a plan sees
+            # does not depend on how busy the machine is.
             return SimCellSession(
                 scene or DEFAULT_SCENE,
                 seed,
                 speed,
-                lockstep=lockstep,
+                lockstep=PERCEPTION_S,
                 still_until_run=still_until_run,
             )
         except Exception as exc:  # scene or model errors: say which, do not crash the CLI/GUI
@@ -108,18 +110,6 @@ def open_cell(
     raise CellError(
         f"unknown cell {name!r}; cells: {', '.join(CELL_NAMES)}, or a cell file (*.cell.json)"
     )
-
-
-def _lockstep(speed: float | None) -> float:
-    """The simulated cell's lockstep, paced (the GUI) or not (the CLI, tests): each
-    perception job costs a fixed simulated time while the world stands still, and a run's
-    engine drives the world, so what a plan sees does not depend on how busy the machine is
-    (a loaded machine made kitting miss plates when the world stepped on meanwhile).
-    """
-    del speed  # the same for every pace: the engine's ticks are paced instead
-    from capabilities.sim.session import PERCEPTION_S
-
-    return PERCEPTION_S
 
 
 def cell_argument(value: str) -> str:
@@ -162,7 +152,7 @@ def _open_cell_file(
         except CapabilityError as exc:
             raise CellError(f"{path}: {exc}") from exc
     try:
-        from capabilities.sim.session import SimCellSession
+        from capabilities.sim.session import PERCEPTION_S, SimCellSession
     except ImportError as exc:
         raise CellError(f"the simulated cell cannot load: {exc}") from exc
     try:
@@ -171,7 +161,7 @@ def _open_cell_file(
             seed,
             speed,
             config=config,
-            lockstep=_lockstep(speed),
+            lockstep=PERCEPTION_S,
             still_until_run=still_until_run,
         )
     except Exception as exc:
