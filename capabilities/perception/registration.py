@@ -32,6 +32,9 @@ __all__ = ["Fit", "best_fit", "free_space_consistency", "planar_icp"]
 _COARSE, _FINE = 0.03, 0.012  # m: correspondence gates of the first and last ICP rounds
 _POINT_WEIGHT = 0.3  # weight of the point-to-point rows next to the point-to-plane ones
 _CHECK_POINTS = 1500
+# ICP fits three unknowns: a few hundred points pin them as well as thousands do, and a kit
+# bin's cluster (3,300 points, 4 hypotheses, 2 models) took a second a look on every point.
+_ICP_POINTS = 600
 _GOOD_SCORE = 0.85  # a footprint fit this good needs no global registration
 _RANSAC_SEED = 0
 
@@ -83,7 +86,12 @@ def _icp_step(
 def planar_icp(
     points: np.ndarray, model: ModelCloud, x: float, y: float, yaw: float, rotate: bool = True
 ) -> tuple[float, float, float]:
-    """Refine (x, y, yaw) of ``model`` on scene ``points`` (table frame)."""
+    """Refine (x, y, yaw) of ``model`` on scene ``points`` (table frame).
+
+    Larger clouds are thinned to about ``_ICP_POINTS`` by a fixed stride (the same points
+    every time: recognition stays reproducible); the fit is scored on all of them.
+    """
+    points = points[:: -(-len(points) // _ICP_POINTS)]
     for i in range(24):
         gate = _COARSE if i < 8 else _FINE
         p = _to_model(points, x, y, yaw)
