@@ -13,7 +13,15 @@ from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QAbstractItemView, QLineEdit, QTreeWidgetItem
 
 from engine.files import dump_plan
-from engine.spec import Binding, NodeKind, NodeSpec, ParameterDecl, PlanSpec
+from engine.spec import (
+    Binding,
+    NodeKind,
+    NodeSpec,
+    ParameterDecl,
+    PlanSpec,
+    SubtreePort,
+    SubtreeSpec,
+)
 from engine.status import Status
 from engine.types import ParamType, Pose
 from instructor_app.main_window import MainWindow
@@ -112,3 +120,62 @@ def test_a_target_changed_while_paused_is_where_the_move_goes(
     assert not panel.editable and window.blackboard_edits.stack.count() == 0
     window.actions_by_name["undo"].trigger()  # the plan's stack again: nothing to undo
     assert panel.text_of("TARGET").startswith("(500.0, 100.0, 250.0)")
+
+
+def _instance_plan() -> PlanSpec:
+    """An instance of Pick: a private PICKED, an output RESULT, a shared name SEEN."""
+    inside = NodeSpec(
+        NodeKind.SEQUENCE,
+        name="Pick",
+        children=[
+            op("debug.query", "find", value=Binding.reference("OBJECT"), result=ref("PICKED")),
+            set_param("keep", ref("PICKED"), "RESULT"),
+            set_param("count", number(1), "SEEN"),
+        ],
+    )
+    pick = SubtreeSpec(
+        id="test.pick",
+        name="Pick",
+        tree=inside,
+        inputs=[SubtreePort("OBJECT", ParamType.TEXT, "what to pick")],
+        outputs=[SubtreePort("RESULT", ParamType.ANY, "what was picked")],
+        shared_names=["SEEN"],
+    )
+    instance = NodeSpec(
+        NodeKind.SUBTREE,
+        name="Pick cup",
+        subtree=pick.ref,
+        params={"OBJECT": Binding.fixed("cup", ParamType.TEXT), "RESULT": ref("GOT")},
+    )
+    top = NodeSpec(NodeKind.SEQUENCE, name="top", children=[instance])
+    return PlanSpec(tree=top, name="pick", subtrees=[pick])
+
+
+def ref(name: str) -> Binding:
+    return Binding.reference(name)
+
+
+def set_param(label: str, value: Binding, name: str) -> NodeSpec:
+    params = {"value": value, "name": ref(name)}
+    return NodeSpec(NodeKind.OPERATION, name=label, op="debug.set_param", params=params)
+
+
+def test_each_scope_shows_its_names_and_the_nodes_that_wrote_them(
+    qtbot: Any, none_session: CellSession, tmp_path: Path
+) -> None:
+    window = make_window(qtbot, none_session, tmp_path)
+    window.document.load_text(dump_plan(_instance_plan()), None)
+    panel = window.views.blackboard
+    with qtbot.waitSignal(window.controller.run_finished, timeout=10000) as finished:
+        window.run_actions.run.trigger()
+    assert finished.args[0].status is Status.SUCCESS
+    qtbot.waitUntil(lambda: "GOT" in panel.values(), timeout=5000)
+    assert panel.scopes() == ["Plan", "Shared names", "Pick cup"]
+    picked = next(key for key in panel.values() if key.endswith("/PICKED"))
+    assert panel.item(picked).parent().text(0) == "Pick cup"
+    assert panel.text_of(picked) == "cup"
+    assert panel.text_of(picked, WRITER) == "Pick cup > find"
+    assert panel.item("SEEN").parent().text(0) == "Shared names"
+    assert panel.text_of("SEEN", WRITER) == "Pick cup > count"
+    assert panel.text_of("GOT", WRITER) == "Pick cup"  # copied out by the instance
+    assert not panel.editable  # the run is over
