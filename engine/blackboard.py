@@ -37,6 +37,13 @@ MISSING: Any = _Missing()
 _NO_DEFAULT: Any = object()
 
 WriteListener = Callable[[str, Any, str], None]
+_now = time.monotonic
+
+
+def _wrong_type(key: str, ptype: ParamType, value: Any) -> BlackboardError:
+    return BlackboardError(
+        f"parameter {key!r} holds {ptype.value}, not {type(value).__name__} {value!r}"
+    )
 
 
 @dataclass(frozen=True, slots=True)
@@ -97,15 +104,15 @@ class Blackboard:
         """
         ptype = self._types.get(key)
         if ptype is not None and not check_value(ptype, value):
-            raise BlackboardError(
-                f"parameter {key!r} holds {ptype.value}, not {type(value).__name__} {value!r}"
-            )
+            raise _wrong_type(key, ptype, value)
 
     def set(self, key: str, value: Any, writer: str = "") -> None:
         """Write a value; raises BlackboardError when it does not match the key's type."""
-        self.check(key, value)
+        ptype = self._types.get(key)  # check() inline: a write is on the tick's path
+        if ptype is not None and not check_value(ptype, value):
+            raise _wrong_type(key, ptype, value)
         self._values[key] = value
-        self._written[key] = (writer, self._ticks(), time.monotonic())
+        self._written[key] = (writer, self._ticks(), _now())
         for listener in self._listeners:
             listener(key, value, writer)
 
