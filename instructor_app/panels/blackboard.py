@@ -4,7 +4,7 @@ in mm and degrees), and which node wrote it last and when.
 Scopes: the plan's own names, the names that cross into subtree instances on purpose (a
 subtree's shared names) and one scope per subtree instance (its private names, keys
 ``"label#id6/NAME"``). While a run is paused a value can be changed: double-click it and
-type it as it is shown (mm, degrees); text that is not a value of the entry's type is refused
+or press Enter on it, and type it as it is shown (mm, degrees); text that is not a value of the entry's type is refused
 with a message under the table. The panel only says what was typed (``value_edited``); the
 run's undo stack sets it (:mod:`instructor_app.runtime.blackboard_edits`).
 """
@@ -94,11 +94,16 @@ class BlackboardPanel(QWidget):
         self.tree.setColumnCount(5)
         self.tree.setHeaderLabels(["Parameter", "Value", "Written by", "Tick", "Time"])
         header = self.tree.header()
-        header.setSectionResizeMode(VALUE, QHeaderView.ResizeMode.Stretch)
         header.setStretchLastSection(False)
+        fit = QHeaderView.ResizeMode.ResizeToContents
+        for column, mode in ((NAME, fit), (VALUE, QHeaderView.ResizeMode.Stretch), (TICK, fit)):
+            header.setSectionResizeMode(column, mode)
+        header.setSectionResizeMode(TIME, fit)
+        header.resizeSection(WRITER, self.fontMetrics().horizontalAdvance("M" * 14))
         self.tree.setEditTriggers(QTreeWidget.EditTrigger.NoEditTriggers)
         self.tree.setItemDelegateForColumn(VALUE, _ValueDelegate(self))
         self.tree.itemDoubleClicked.connect(self._double_clicked)
+        self.tree.itemActivated.connect(lambda item, _column: self._double_clicked(item, VALUE))
         self.message = QLabel("")
         self.message.setObjectName("BlackboardMessage")
         self.message.setWordWrap(True)
@@ -261,6 +266,7 @@ class BlackboardPanel(QWidget):
                 at = i
                 break
         self.tree.insertTopLevelItem(at, item)
+        item.setFirstColumnSpanned(True)  # a scope's title takes the whole row
         item.setExpanded(True)
         self._scopes[scope] = item
         return item
