@@ -93,13 +93,19 @@ class BlackboardPanel(QWidget):
         self.tree.setObjectName("BlackboardTree")
         self.tree.setColumnCount(5)
         self.tree.setHeaderLabels(["Parameter", "Value", "Written by", "Tick", "Time"])
+        # Widths from the font, never from the contents: a column fitted to its contents is
+        # measured again at every change, which a run writing hundreds of names cannot afford.
         header = self.tree.header()
         header.setStretchLastSection(False)
-        fit = QHeaderView.ResizeMode.ResizeToContents
-        for column, mode in ((NAME, fit), (VALUE, QHeaderView.ResizeMode.Stretch), (TICK, fit)):
-            header.setSectionResizeMode(column, mode)
-        header.setSectionResizeMode(TIME, fit)
-        header.resizeSection(WRITER, self.fontMetrics().horizontalAdvance("M" * 14))
+        header.setSectionResizeMode(VALUE, QHeaderView.ResizeMode.Stretch)
+        width = self.fontMetrics().horizontalAdvance
+        for column, sample in (
+            (NAME, "M" * 12),
+            (WRITER, "M" * 14),
+            (TICK, "0000000"),
+            (TIME, "00000.00 s"),
+        ):
+            header.resizeSection(column, width(sample))
         self.tree.setEditTriggers(QTreeWidget.EditTrigger.NoEditTriggers)
         self.tree.setItemDelegateForColumn(VALUE, _ValueDelegate(self))
         self.tree.itemDoubleClicked.connect(self._double_clicked)
@@ -143,9 +149,24 @@ class BlackboardPanel(QWidget):
     # ------------------------------------------------------------------ values
 
     def set_entries(self, entries: Iterable[BlackboardEntry]) -> None:
-        """Show the newest write of several entries (``time``: seconds since the run started)."""
+        """Show the newest write of several entries (``time``: seconds since the run started).
+
+        New rows are added as usual; the texts of the rows already there change with the
+        model's signals held and one repaint after (a change signal per cell costs more
+        than the rest of the update: a run writing hundreds of names would feel it).
+        """
+        entries = list(entries)
         for entry in entries:
-            self.set_entry(entry)
+            if entry.key not in self._items:
+                self.set_entry(entry)
+        model = self.tree.model()
+        held = model.blockSignals(True)
+        try:
+            for entry in entries:
+                self.set_entry(entry)
+        finally:
+            model.blockSignals(held)
+        self.tree.viewport().update()
 
     def set_entry(self, entry: BlackboardEntry) -> None:
         """Show one entry's value, writer, tick and time (adds its row, and its scope's)."""

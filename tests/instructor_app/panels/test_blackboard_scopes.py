@@ -65,3 +65,15 @@ def test_typed_values_are_read_in_their_type_or_refused(qtbot: QtBot) -> None:
     assert edited[0][1].position == (0.5, 0.0, 0.2)  # type: ignore[attr-defined]
     assert "COUNT holds a Number" in panel.message.text()
     assert panel.message.property("error") is True
+
+
+def test_a_run_writing_many_names_costs_no_change_signal_per_cell(qtbot: QtBot) -> None:
+    panel = BlackboardPanel()
+    qtbot.addWidget(panel)
+    keys = [f"Pick#ab12cd/K{i}" if i % 2 else f"K{i}" for i in range(200)]
+    panel.set_entries([entry(key, 0.0, "n1", 1) for key in keys])
+    changes: list[object] = []
+    panel.tree.model().dataChanged.connect(lambda *args: changes.append(args))
+    panel.set_entries([entry(key, 2.0, "n1", 2) for key in keys])
+    assert changes == []  # held: one repaint instead
+    assert all(panel.text_of(key) == "2" and panel.text_of(key, TICK) == "2" for key in keys)
