@@ -224,10 +224,6 @@ class RunController(QObject):
             raise RuntimeError(f"{key} can be set only while a run is paused")
         self._executor.set_entry(key, value, OPERATOR)
 
-    def entry_type(self, key: str) -> Any:
-        """The declared ParamType of a named parameter of the current run (None: undeclared)."""
-        return self._last_board.type_of(key) if self._last_board is not None else None
-
     def label(self, node_id: str) -> str:
         """What the Instructor calls a node of the current run (runtime ids inside instances
         too: "greet > say"); the id itself when the plan has no such node.
