@@ -47,6 +47,7 @@ class TreeContext:
         self.status_sink: StatusSink | None = None
         self.log_sink: LogSink | None = None
         self.tick_count = 0
+        self.blackboard.count_ticks_with(lambda: self.tick_count)
 
     def log(self, node_id: str, message: str) -> None:
         sink = self.log_sink

@@ -27,8 +27,9 @@ import collections
 import enum
 import threading
 import time
-from typing import Protocol
+from typing import Any, Protocol
 
+from engine.blackboard import OPERATOR
 from engine.error_types import ErrorType
 from engine.events import (
     BlackboardWritten,
@@ -154,6 +155,7 @@ class Executor:
         self._paused = False
         self._steps = 0
         self._stop_reason: str | None = None
+        self._edits: collections.deque[tuple[str, Any, str]] = collections.deque()
         self._state = ExecutorState.READY
         self._hold = hold
         self._lockstep = lockstep
@@ -215,6 +217,21 @@ class Executor:
             self._steps += 1
             self._cond.notify()
 
+    def set_entry(self, key: str, value: Any, writer: str = OPERATOR) -> None:
+        """Set a blackboard entry while the run is paused (any thread).
+
+        The value is checked here against the entry's declared type (BlackboardError,
+        naming the entry and the type); the engine thread writes it between ticks, and the
+        write is reported as a BlackboardWritten event like any other. Raises RuntimeError
+        when the run is not paused.
+        """
+        self.tree.blackboard.check(key, value)
+        with self._cond:
+            if self._state is not ExecutorState.PAUSED:
+                raise RuntimeError(f"{key} can be set only while the run is paused")
+            self._edits.append((key, value, writer))
+            self._cond.notify()
+
     def stop(self, reason: str = "stopped", timeout: float | None = 5.0) -> None:
         """Halt what runs and end the run; waits for the engine thread (up to ``timeout``)."""
         with self._cond:
@@ -267,6 +284,7 @@ class Executor:
             while True:
                 if self._stop_reason is not None:
                     return self._stop_reason
+                self._apply_edits()
                 if self._paused:
                     if self._steps:
                         self._steps -= 1
@@ -284,6 +302,15 @@ class Executor:
                 if remaining <= 0:
                     return None
                 self._cond.wait(remaining)
+
+    def _apply_edits(self) -> None:
+        """Write the values set while paused (engine thread, between ticks)."""
+        while self._edits:
+            key, value, writer = self._edits.popleft()
+            try:
+                self.tree.blackboard.set(key, value, writer)
+            except Exception as exc:  # checked when asked; a listener's bug must not end it
+                self._emit(LogMessage(0, "root", f"{key} was not set: {exc}", time.monotonic()))
 
     def _run(self) -> None:
         self._emit(RunStarted(time.monotonic(), self.plan_name))

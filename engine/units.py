@@ -1,7 +1,8 @@
 """What people read versus what the plan stores: mm and degrees shown, m and rad inside.
 
 The Instructor's editors and panels and ``costar run`` show values through these pure
-functions, so the command line reads like the GUI. Orientation is shown as roll, pitch, yaw
+functions, so the command line reads like the GUI; :func:`parse_shown` reads back what a
+person types in the same units (the Blackboard panel's edits while a run is paused). Orientation is shown as roll, pitch, yaw
 about the fixed world axes x, y, z (R = Rz(yaw) Ry(pitch) Rx(roll)), the convention of ROS
 and of the UR teach pendant's RPY view.
 """
@@ -9,10 +10,12 @@ and of the UR teach pendant's RPY view.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from typing import Any
 
-from engine.types import JointConfig, ObjectModel, Pose, Region, Waypoint
+from engine.errors import EngineError
+from engine.types import JointConfig, ObjectModel, ParamType, Pose, Region, Waypoint, with_article
 
 __all__ = [
     "DisplayUnit",
@@ -22,6 +25,8 @@ __all__ = [
     "pose_to_display",
     "pose_from_display",
     "format_value",
+    "parse_shown",
+    "ShownValueError",
 ]
 
 
@@ -125,3 +130,95 @@ def format_value(value: Any) -> str:
     if isinstance(value, (list, tuple)):
         return "[" + ", ".join(format_value(v) for v in value) + "]"
     return str(value)
+
+
+class ShownValueError(EngineError):
+    """Typed text that is not a value of the type asked for; the message says what is."""
+
+
+_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+_TRUE = {"true", "yes", "on", "1"}
+_FALSE = {"false", "no", "off", "0"}
+
+# What each type takes, in the units shown (for the messages).
+_HOW: dict[ParamType, str] = {
+    ParamType.POSE: "x, y, z in mm and roll, pitch, yaw in degrees, "
+    "e.g. (400, 0, 300) mm, rpy (180, 0, 0)°",
+    ParamType.JOINTS: "the joint angles in degrees, e.g. (0, -90, 90, -90, -90, 0)°",
+    ParamType.REGION: "a centre x, y, z and a radius in mm, e.g. centre (400, 0, 300) mm, "
+    "radius 100 mm",
+    ParamType.NUMBER: "a number, e.g. 2.5",
+    ParamType.DURATION: "seconds, e.g. 1.5",
+    ParamType.BOOL: "true or false",
+    ParamType.OBJECT: "an object's name, e.g. cup",
+}
+
+
+def _numbers(text: str) -> list[float]:
+    """The numbers in ``text``; the words and brackets around them ("mm", "rpy") are skipped,
+    but any other letter makes the text no list of numbers.
+    """
+    rest = _NUMBER.sub(" ", text)
+    for word in ("centre", "center", "radius", "rpy", "mm", "deg", "°", "s"):
+        rest = rest.replace(word, " ")
+    if any(c.isalnum() for c in rest):
+        raise ValueError(text)
+    return [float(n) for n in _NUMBER.findall(text)]
+
+
+def _parse(ptype: ParamType, text: str) -> Any:
+    if ptype in (ParamType.NUMBER, ParamType.DURATION):
+        (value,) = _numbers(text)
+        return value
+    if ptype is ParamType.BOOL:
+        if text.lower() in _TRUE | _FALSE:
+            return text.lower() in _TRUE
+        raise ValueError(text)
+    if ptype is ParamType.POSE:
+        x, y, z, roll, pitch, yaw = _numbers(text)
+        return pose_from_display((x, y, z, roll, pitch, yaw))
+    if ptype is ParamType.JOINTS:
+        angles = _numbers(text)
+        if not angles:
+            raise ValueError(text)
+        return JointConfig(tuple(a / _DEG for a in angles))
+    if ptype is ParamType.REGION:
+        x, y, z, radius = _numbers(text)
+        if radius <= 0:
+            raise ValueError(text)
+        return Region((x / 1000.0, y / 1000.0, z / 1000.0), radius / 1000.0)
+    if ptype is ParamType.OBJECT:
+        if not text or any(c.isspace() for c in text):
+            raise ValueError(text)
+        return ObjectModel(text)
+    raise AssertionError(ptype)
+
+
+def parse_shown(ptype: ParamType, text: str, name: str = "the value") -> Any:
+    """What a person typed, in the units :func:`format_value` shows (mm, degrees), as a value
+    of ``ptype`` in SI units.
+
+    ``ParamType.ANY`` takes a number, true or false, else the text. Raises
+    ShownValueError naming ``name`` and what its type takes; a Waypoint is not typed (it is
+    taught or picked in the Waypoints panel).
+    """
+    text = text.strip()
+    if ptype is ParamType.TEXT:
+        return text
+    if ptype is ParamType.ANY:
+        for guess in (ParamType.NUMBER, ParamType.BOOL):
+            try:
+                return _parse(guess, text)
+            except ValueError:
+                continue
+        return text
+    if ptype is ParamType.WAYPOINT:
+        raise ShownValueError(
+            f"{name} holds a Waypoint: pick or teach one in the Waypoints panel, it is not typed"
+        )
+    try:
+        return _parse(ptype, text)
+    except (ValueError, ZeroDivisionError) as exc:
+        raise ShownValueError(
+            f"{name} holds {with_article(ptype.value)}: type {_HOW[ptype]} (not {text!r})"
+        ) from exc

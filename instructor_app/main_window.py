@@ -13,7 +13,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
+from PySide6.QtGui import QAction, QCloseEvent, QKeySequence, QUndoGroup
 from PySide6.QtWidgets import (
     QLabel,
     QMainWindow,
@@ -38,6 +38,7 @@ from instructor_app.panels.operator import OperatorPanel
 from instructor_app.panels.scene_teach import SceneTeachLink
 from instructor_app.panels.start_page import StartPage, find_examples
 from instructor_app.plan_files import PlanFiles
+from instructor_app.runtime.blackboard_edits import BlackboardEdits
 from instructor_app.runtime.controller import RunController
 from instructor_app.runtime.robot_status import CellClearButton, RobotStatusLabel
 from instructor_app.runtime.run_view import (
@@ -253,10 +254,13 @@ class MainWindow(QMainWindow):
 
     def _build_edit_menus(self) -> None:
         edit = self.menuBar().addMenu("&Edit")
-        stack = self.document.undo_stack
+        # The plan's edits; while a run is paused, its named parameters' (BlackboardEdits).
+        self.undo_group = QUndoGroup(self)
+        self.undo_group.addStack(self.document.undo_stack)
+        self.undo_group.setActiveStack(self.document.undo_stack)
         undo, redo = (
-            stack.createUndoAction(self, "&Undo"),
-            stack.createRedoAction(self, "&Redo"),
+            self.undo_group.createUndoAction(self, "&Undo"),
+            self.undo_group.createRedoAction(self, "&Redo"),
         )
         undo.setShortcuts(QKeySequence.keyBindings(QKeySequence.StandardKey.Undo))
         redo.setShortcuts([QKeySequence("Ctrl+Shift+Z"), QKeySequence("Ctrl+Y")])
@@ -317,7 +321,9 @@ class MainWindow(QMainWindow):
         controller.failures_described.connect(views.canvas.set_failure_tips)
         views.canvas.commands.run_entries = self._run_entries
         controller.inner_statuses_changed.connect(views.inside.set_statuses)
-        controller.blackboard_written.connect(views.blackboard.set_value)
+        self.blackboard_edits = BlackboardEdits(
+            controller, views.blackboard, self.undo_group, self.document.undo_stack, self
+        )
         controller.log_message.connect(views.log.append)
         controller.running_nodes_changed.connect(self.running_panel.set_nodes)
         controller.hold_changed.connect(self.running_panel.set_held)

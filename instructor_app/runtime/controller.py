@@ -10,16 +10,18 @@ when its RunFinished event comes through the pump.
 from __future__ import annotations
 
 import copy
+import dataclasses
+import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from PySide6.QtCore import QObject, QTimer, Signal
 
 from capabilities.cell_features import ReportsStatus, lockstep_of
 from capabilities.faults import hold_check
 from capabilities.run_sampler import JointSampler
-from engine.blackboard import Blackboard, BlackboardError
+from engine.blackboard import OPERATOR, Blackboard, BlackboardEntry, BlackboardError
 from engine.build import BuildError, build_tree
 from engine.events import Listener, RunFinished
 from engine.executor import Executor, ExecutorState
@@ -81,6 +83,9 @@ class RunController(QObject):
     Signals:
         statuses_changed(dict): node id -> Status, only the nodes changed since last time.
         blackboard_written(str, object): a blackboard key and its newest value.
+        entries_written(list): the newest :class:`BlackboardEntry` of each key written since
+            the last drain (its ``time`` in seconds since the run started); when a run
+            starts, every entry it starts with (the plan's parameters, tick 0).
         log_message(str, str): text and level ("info", "warning", "error").
         run_state_changed(object): the run's ExecutorState (READY before the first run).
         run_starting(): Run or Step was asked for, before the cell is reset and the plan is
@@ -107,6 +112,7 @@ class RunController(QObject):
     # object, not dict: a dict signal goes through QVariantMap and turns Status into str.
     statuses_changed = Signal(object)
     blackboard_written = Signal(str, object)
+    entries_written = Signal(list)
     log_message = Signal(str, str)
     run_state_changed = Signal(object)
     run_starting = Signal()
@@ -145,6 +151,7 @@ class RunController(QObject):
         self._messages: dict[str, str] = {}
         self._said: dict[str, str] = {}  # node id -> "look for cup failed (not_found): no cup"
         self._last_board: Blackboard | None = None  # the last run's values, for a resume
+        self._started_at = 0.0  # time.monotonic() when the run started
         self._running: list[str] = []
         self._failure: tuple[str, str] = ("", "")
         self._stopping = False  # a stop was asked: the halt's IDLE resets are not shown
@@ -205,6 +212,23 @@ class RunController(QObject):
             self.pause()
         assert self._executor is not None
         self._executor.step()
+
+    def set_entry(self, key: str, value: Any) -> None:
+        """Set a named parameter of the paused run (the engine writes it between ticks, as
+        the operator's); it comes back through ``entries_written``.
+
+        Raises BlackboardError (naming the entry and its type) for a value of another type,
+        RuntimeError when no run is paused.
+        """
+        if self._executor is None or self._state != ExecutorState.PAUSED:
+            raise RuntimeError(f"{key} can be set only while a run is paused")
+        self._executor.set_entry(key, value, OPERATOR)
+
+    def label(self, node_id: str) -> str:
+        """What the Instructor calls a node of the current run (runtime ids inside instances
+        too: "greet > say"); the id itself when the plan has no such node.
+        """
+        return self._label(node_id)
 
     def stop(self) -> None:
         """Halt what runs (an arm in motion stops); the run ends via run_finished.
@@ -304,6 +328,7 @@ class RunController(QObject):
             return False
         self.run_starting.emit()
         plan = copy.deepcopy(self.document.plan)  # edits during the run do not reach it
+        self._started_at = time.monotonic()
         if plan.reset_cell and start_at is None:
             self.reset_cell(plan.scene)
         registry = self.session.registry
@@ -347,6 +372,7 @@ class RunController(QObject):
         # Every node starts the run grey (IDLE), also those the run never reaches; sent after
         # the state change, on which the views clear the last run's colours.
         self.statuses_changed.emit(dict(self._statuses))
+        self.entries_written.emit([self._since_start(e) for e in tree.blackboard.entries()])
         if start_at:
             self.log_message.emit(
                 f"Run of {plan.name or 'the plan'} resumed from {self._label(start_at)} "
@@ -425,11 +451,35 @@ class RunController(QObject):
             self._update_running()
         for key, value in batch.writes.items():
             self.blackboard_written.emit(key, value)
+        if batch.written:
+            self._emit_entries(batch)
         self._emit_logs(batch)
         if batch.failures:
             self._update_failure()
         if batch.finished is not None:
             self._finish(batch.finished)
+
+    def _since_start(self, entry: BlackboardEntry) -> BlackboardEntry:
+        """``entry`` with its time in seconds since the run started."""
+        return dataclasses.replace(entry, time=max(0.0, entry.time - self._started_at))
+
+    def _emit_entries(self, batch: Batch) -> None:
+        """The newest write of each key in ``batch``, as entries (at most one per key per
+        drain: a plan that writes at every tick costs the GUI one row update a frame).
+        """
+        board = self._last_board
+        entries = [
+            BlackboardEntry(
+                e.key,
+                e.value,
+                board.type_of(e.key) if board is not None else None,
+                e.node_id,
+                e.tick,
+                e.time,
+            )
+            for e in batch.written.values()
+        ]
+        self.entries_written.emit([self._since_start(e) for e in entries])
 
     def _keep_held_nodes(self, changed: dict[str, Status], batch: Batch) -> None:
         """A hold halts the running leaves (the engine resets them to IDLE) but the run is not

@@ -48,6 +48,7 @@ class Batch:
             order they did (a node that failed and was reset in the same batch is still
             here: its failure was real).
         writes: blackboard key -> newest value, in order of first write.
+        written: blackboard key -> its newest write (writer, tick, time), same order.
         logs: (node id, message) in order.
         finished: the RunFinished event, if the run ended.
         started: whether a RunStarted event arrived.
@@ -59,6 +60,7 @@ class Batch:
     messages: dict[str, str] = field(default_factory=dict)
     failures: list[tuple[str, str, str]] = field(default_factory=list)
     writes: dict[str, Any] = field(default_factory=dict)
+    written: dict[str, BlackboardWritten] = field(default_factory=dict)
     logs: list[tuple[str, str]] = field(default_factory=list)
     finished: RunFinished | None = None
     started: bool = False
@@ -108,6 +110,7 @@ def _merge(batch: Batch, event: Event) -> None:
             batch.failures.append((event.node_id, event.message, event.error))
     elif isinstance(event, BlackboardWritten):
         batch.writes[event.key] = event.value
+        batch.written[event.key] = event
     elif isinstance(event, LogMessage):
         batch.logs.append((event.node_id, event.message))
     elif isinstance(event, RunFinished):

@@ -19,14 +19,15 @@ def test_blackboard_rows_sorted_and_updated(qtbot: QtBot) -> None:
     panel.set_values(
         {"ALPHA": True, "CUP_POSE": Pose((0.1, 0.2, 0.3), rpy_to_quaternion(0, 0, math.pi))}
     )
-    names = [panel.table.item(r, 0).text() for r in range(panel.table.rowCount())]
-    assert names == ["ALPHA", "CUP_POSE", "ZETA"]
+    plan = panel.tree.topLevelItem(0)
+    names = [plan.child(r).text(0) for r in range(plan.childCount())]
+    assert panel.scopes() == ["Plan"] and names == ["ALPHA", "CUP_POSE", "ZETA"]
     assert panel.text_of("CUP_POSE") == "(100.0, 200.0, 300.0) mm, rpy (0.0, 0.0, 180.0)°"
     panel.set_value("ZETA", 2.0)
-    assert panel.table.rowCount() == 3 and panel.text_of("ZETA") == "2"
+    assert plan.childCount() == 3 and panel.text_of("ZETA") == "2"
     assert panel.values()["ALPHA"] is True
     panel.clear()
-    assert panel.table.rowCount() == 0 and panel.values() == {}
+    assert panel.tree.topLevelItemCount() == 0 and panel.values() == {}
 
 
 def test_log_lines_have_time_and_level_and_are_capped(qtbot: QtBot) -> None:
