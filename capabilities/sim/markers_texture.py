@@ -173,11 +173,16 @@ class MarkerTextures:
             physicsClientId=client,
         )
 
-    def apply(self, client: int, body_id: int, link_index: int, marker_id: int) -> None:
-        """Put the texture of ``marker_id`` on a link that carries a marker plane."""
+    def apply(
+        self, client: int, body_id: int, link_index: int, marker_id: int, shape_index: int = -1
+    ) -> None:
+        """Put the texture of ``marker_id`` on a marker plane: the link's only visual shape,
+        or its ``shape_index``-th one.
+        """
         p.changeVisualShape(
             body_id,
             link_index,
+            shapeIndex=shape_index,
             textureUniqueId=self.texture_id(client, marker_id),
             rgbaColor=[1, 1, 1, 1],
             physicsClientId=client,

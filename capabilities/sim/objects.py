@@ -19,7 +19,7 @@ from capabilities.object_library import (
     parse_model,
 )
 from capabilities.sim.errors import SimError
-from capabilities.sim.markers_texture import MarkerTextures
+from capabilities.sim.markers_texture import MarkerTextures, plane_side
 from engine.types import Pose
 
 __all__ = [
@@ -49,11 +49,13 @@ class SceneError(SimError):
 
 @dataclass(frozen=True)
 class SpawnedObject:
-    """A model instance in a pybullet client: its body and the link of each marker."""
+    """A model instance in a pybullet client: its body (markers are drawn on its base)."""
 
     body_id: int
     model: ObjectModelSpec
-    marker_links: dict[int, int]
+
+    def carries(self, marker_id: int) -> bool:
+        return any(m.marker_id == marker_id for m in self.model.markers)
 
 
 def _collision_shape(client: int, model: ObjectModelSpec) -> int:
@@ -78,6 +80,28 @@ def _collision_shape(client: int, model: ObjectModelSpec) -> int:
     )
 
 
+def _visual_shapes(client: int, model: ObjectModelSpec, textures: MarkerTextures) -> int:
+    """The base's visual shapes: the mesh, then one textured plane per marker.
+
+    The planes are shapes of the base, not links of their own: a link on a fixed joint costs
+    the physics as much as a moving part (a resting kit bin stepped 2.4 times slower with its
+    six marker links), and TinyRenderer textures each shape of a base on its own.
+    """
+    markers = model.markers
+    plane = str(textures.plane_file())
+    return p.createVisualShapeArray(
+        shapeTypes=[p.GEOM_MESH] * (1 + len(markers)),
+        fileNames=[str(model.mesh_file)] + [plane] * len(markers),
+        meshScales=[[1.0, 1.0, 1.0]]
+        + [[plane_side(m.size), plane_side(m.size), 1.0] for m in markers],
+        rgbaColors=[list(model.color)] + [[1.0, 1.0, 1.0, 1.0]] * len(markers),
+        visualFramePositions=[[0.0, 0.0, 0.0]] + [list(m.pose.position) for m in markers],
+        visualFrameOrientations=[[0.0, 0.0, 0.0, 1.0]]
+        + [list(m.pose.orientation) for m in markers],
+        physicsClientId=client,
+    )
+
+
 def spawn_object(
     client: int,
     model: ObjectModelSpec,
@@ -87,9 +111,8 @@ def spawn_object(
 ) -> SpawnedObject:
     """Create a body for ``model`` with its object frame at ``pose`` (world).
 
-    The body's base carries the mesh and the collision shape; each marker is a massless
-    link on a fixed joint carrying a textured plane, so the texture sits exactly at the
-    marker pose of model.json.
+    The body's base carries the collision shape, the mesh and a textured plane per marker,
+    placed at the marker pose of model.json.
 
     Args:
         client: pybullet client id.
@@ -98,30 +121,13 @@ def spawn_object(
         textures: the marker texture cache.
         fixed: a static body (mass 0), e.g. a fixture.
     """
-    visual = p.createVisualShape(
-        p.GEOM_MESH,
-        fileName=str(model.mesh_file),
-        rgbaColor=list(model.color),
-        physicsClientId=client,
-    )
-    markers = model.markers
     body = p.createMultiBody(
         baseMass=0.0 if fixed else model.mass,
         baseCollisionShapeIndex=_collision_shape(client, model),
-        baseVisualShapeIndex=visual,
+        baseVisualShapeIndex=_visual_shapes(client, model, textures),
         basePosition=list(pose.position),
         baseOrientation=list(pose.orientation),
         baseInertialFramePosition=list(model.center_of_mass),
-        linkMasses=[0.0] * len(markers),
-        linkCollisionShapeIndices=[-1] * len(markers),
-        linkVisualShapeIndices=[textures.plane_visual(client, m.size) for m in markers],
-        linkPositions=[list(m.pose.position) for m in markers],
-        linkOrientations=[list(m.pose.orientation) for m in markers],
-        linkInertialFramePositions=[[0, 0, 0]] * len(markers),
-        linkInertialFrameOrientations=[[0, 0, 0, 1]] * len(markers),
-        linkParentIndices=[0] * len(markers),
-        linkJointTypes=[p.JOINT_FIXED] * len(markers),
-        linkJointAxis=[[0, 0, 1]] * len(markers),
         physicsClientId=client,
     )
     p.changeDynamics(
@@ -132,11 +138,9 @@ def spawn_object(
         spinningFriction=1e-3,
         physicsClientId=client,
     )
-    links = {}
-    for index, marker in enumerate(markers):
-        textures.apply(client, body, index, marker.marker_id)
-        links[marker.marker_id] = index
-    return SpawnedObject(body, model, links)
+    for index, marker in enumerate(model.markers):
+        textures.apply(client, body, -1, marker.marker_id, shape_index=1 + index)
+    return SpawnedObject(body, model)
 
 
 def object_frame_pose(client: int, body_id: int, model: ObjectModelSpec) -> Pose:

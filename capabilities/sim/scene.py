@@ -111,7 +111,7 @@ class SceneState:
         if marker_id in self.fixed_markers:
             return "table"
         for name, obj in self.objects.items():
-            if marker_id in obj.marker_links:
+            if obj.carries(marker_id):
                 return name
         raise SceneError(f"scene {self.name!r} has no marker {marker_id}")
 
@@ -126,13 +126,8 @@ class SceneState:
         if owner == "table":
             return self.fixed_markers[marker_id].pose
         obj = self.objects[owner]
-        state = p.getLinkState(
-            obj.body_id,
-            obj.marker_links[marker_id],
-            computeForwardKinematics=True,
-            physicsClientId=client,
-        )
-        return Pose(state[4], state[5])
+        marker = next(m for m in obj.model.markers if m.marker_id == marker_id)
+        return object_frame_pose(client, obj.body_id, obj.model).compose(marker.pose)
 
     def spawn(self, client: int, name: str, model: str, pose: Pose, fixed: bool = False) -> int:
         """Add an object (e.g. a bin a worker hands over); returns its body id."""
