@@ -94,7 +94,7 @@ class MainWindow(QMainWindow):
         self.views: Views = make_views(self.document, session, self, self.autosaver.folder.parent)
         self.run_actions = RunActions(self.controller, self)
         self.debug_actions = DebugActions(
-            self.controller, self.views.canvas, self.show_message, self
+            self.controller, self.views.canvas, self.show_message, self, self.settings
         )
         self.running_panel = RunningNodesPanel(self._node_path, self)
         self.operator_panel = OperatorPanel(self)

@@ -24,7 +24,7 @@ __all__ = ["CanvasActions", "MenuEntry", "NodeFactory", "default_node_factory", 
 
 NodeFactory = Callable[[NodeKind, "str | None"], NodeSpec]
 # A context menu entry: (text, handler), or (text, [(text, handler), ...]) for a submenu.
-MenuEntry = tuple[str, "Callable[[], None] | list[tuple[str, Callable[[], None]]]"]
+MenuEntry = tuple[str, "Callable[[], object] | list[tuple[str, Callable[[], object]]]"]
 
 # What "Add child" offers first: every kind but operations (those follow, by capability) and
 # subtree instances (those come from the library).

@@ -22,6 +22,7 @@ from engine.status import FAILURE, SUCCESS
 from instructor_app.canvas.actions import MenuEntry
 from instructor_app.canvas.view import CanvasView
 from instructor_app.runtime.controller import RunController
+from instructor_app.settings import AppSettings
 
 __all__ = ["DebugActions"]
 
@@ -46,6 +47,7 @@ class DebugActions(QObject):
         canvas: where the nodes are selected and marked.
         say: shows a line in the status bar (text, for how many ms; 0: until replaced).
         parent: owner of the actions (the main window, so that shortcuts work everywhere).
+        settings: where the breakpoints of each plan are kept (None: nowhere).
     """
 
     def __init__(
@@ -54,9 +56,11 @@ class DebugActions(QObject):
         canvas: CanvasView,
         say: Callable[[str, int], None],
         parent: QWidget,
+        settings: AppSettings | None = None,
     ) -> None:
         super().__init__(parent)
         self.controller, self.canvas, self._say = controller, canvas, say
+        self._settings = settings
         self.debugging = controller.debugging
         self.paused_at = ""  # the plan node the run is paused at ("" when it is not)
         self.toggle = self._action(parent, "Toggle &Breakpoint", "F9", self.toggle_selected)
@@ -73,6 +77,7 @@ class DebugActions(QObject):
         controller.run_paused.connect(self._on_paused)
         controller.run_state_changed.connect(self._on_state)
         canvas.document.plan_changed.connect(self._on_plan_changed)
+        canvas.document.plan_reset.connect(self._on_plan_reset)
         self._on_state(controller.state)
 
     @staticmethod
@@ -99,7 +104,7 @@ class DebugActions(QObject):
         if not node_id:
             self._say("Select one node to set a breakpoint on", 8000)
             return
-        on = self.debugging.toggle_breakpoint(node_id)
+        on = self._toggle(node_id)
         label = self.canvas.document.node(node_id).label
         self._say(f"Breakpoint before {label} {'set' if on else 'cleared'}", 8000)
 
@@ -124,7 +129,7 @@ class DebugActions(QObject):
                 functools.partial(debugging.set_skipped, node_id, not skipped),
             ),
         ]
-        force: list[tuple[str, Callable[[], None]]] = [
+        force: list[tuple[str, Callable[[], object]]] = [
             ("Succeed", functools.partial(debugging.set_forced, node_id, Forced(SUCCESS)))
         ]
         for error in FAIL_TYPES:
@@ -135,8 +140,12 @@ class DebugActions(QObject):
         entries.append(("Force Result", force))
         return entries
 
-    def _toggle(self, node_id: str) -> None:
-        self.debugging.toggle_breakpoint(node_id)
+    def _toggle(self, node_id: str) -> bool:
+        on = self.debugging.toggle_breakpoint(node_id)
+        if self._settings is not None:
+            plan_id = self.canvas.document.plan.id
+            self._settings.set_breakpoints(plan_id, sorted(self.debugging.breakpoints))
+        return on
 
     def _force(self, node_id: str, forced: Forced | None) -> None:
         self.debugging.set_forced(node_id, forced)
@@ -149,6 +158,12 @@ class DebugActions(QObject):
         notes = {node.id: self.debugging.note(node.id) for _, node in plan.walk()}
         notes = {k: v for k, v in notes.items() if v}
         self.canvas.set_debug_marks(self.debugging.breakpoints, notes, self.paused_at)
+
+    def _on_plan_reset(self) -> None:
+        """Another plan (or the same, reloaded): its breakpoints as they were kept."""
+        plan = self.canvas.document.plan
+        kept = set(self._settings.breakpoints(plan.id)) if self._settings is not None else set()
+        self.debugging.load(kept & {node.id for _, node in plan.walk()})
 
     def _on_plan_changed(self) -> None:
         self.debugging.forget({node.id for _, node in self.canvas.document.plan.walk()})

@@ -1,8 +1,9 @@
 """The operator's breakpoints, skipped nodes and forced results, by plan node id.
 
 They belong to the Instructor's session, not to the plan file (a breakpoint is a look at a
-run, not part of the task): they stay while the application is open, across runs and plan
-edits, and are dropped with the nodes they were on. Each run gets an
+run, not part of the task): they stay across runs and plan edits and are dropped with the
+nodes they were on; the breakpoints are also kept in the settings by plan id, so that the
+plan opened again has them (skips and forced results are not kept). Each run gets an
 :class:`~engine.debugger.Debugger` made from them (:meth:`RunDebugging.debugger`); a change
 while a run goes reaches that run at once. A forced result is given once: to the run going
 on, else to the next run.
@@ -103,6 +104,13 @@ class RunDebugging(QObject):
             self._live.force(node_id, forced)
         elif forced is not None:
             self._forced[node_id] = forced
+        self.changed.emit()
+
+    def load(self, breakpoints: set[str]) -> None:
+        """Start afresh with these breakpoints (another plan was opened)."""
+        self._breakpoints = set(breakpoints)
+        self._skipped.clear()
+        self._forced.clear()
         self.changed.emit()
 
     def forget(self, known: set[str]) -> None:

@@ -96,7 +96,12 @@ def test_a_breakpoint_pauses_before_the_move_and_the_run_continues(
         actions["&Continue"].trigger()
     assert finished.args[0].status is Status.SUCCESS
     assert canvas.debug_marks(ids["move to GOAL"]) == (True, "", False)  # the dot stays
-    assert "breakpoint" not in dump_plan(window.document.plan)  # not in the plan file
+    saved = dump_plan(window.document.plan)
+    assert "breakpoint" not in saved  # not in the plan file
+    window.document.load_text(saved, None)  # the plan opened again: kept in the settings
+    assert canvas.debug_marks(ids["move to GOAL"]) == (True, "", False)
+    window.document.load_text(dump_plan(_move_plan()), None)  # another plan: none
+    assert window.controller.debugging.breakpoints == frozenset()
 
 
 def test_step_over_and_run_to_a_node(qtbot: Any, none_session: CellSession, tmp_path: Path) -> None:
