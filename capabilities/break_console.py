@@ -12,6 +12,9 @@ commands, one a line, until one lets the run go on:
   roll, pitch, yaw in degrees);
 - ``quit``: stop the run (the robot stops as with Ctrl-C).
 
+``--break-if NODE_PATH EXPR`` pauses before the node only when the script ``EXPR``
+(BehaviorTree.CPP's language, :mod:`engine.script`) is true in the node's scope.
+
 The end of the input continues the run. While paused the robot is held, as Pause holds it.
 """
 
@@ -118,17 +121,24 @@ class BreakConsole:
             "help": self._help,
         }
 
-    def add(self, text: str, before: bool = True) -> str:
-        """A breakpoint at the node ``text`` names (before or after it); its path.
+    def add(self, text: str, before: bool = True, condition: str = "") -> str:
+        """A breakpoint at the node ``text`` names (before or after it; only when the script
+        ``condition`` is true in the node's scope, if one is given); its path.
 
         Raises:
             BreakpointNotFound: no such node.
+            ScriptSyntaxError: the condition is not a script.
         """
         node_id = find_node(self._paths, text)
         old = self._executor.debugger.breakpoints.get(node_id)
         both = old is not None and old.before != before
         self._executor.debugger.set_breakpoint(
-            Breakpoint(node_id, before=before or both, after=not before or both)
+            Breakpoint(
+                node_id,
+                before=before or both,
+                after=not before or both,
+                condition=condition or (old.condition if old is not None else ""),
+            )
         )
         return self._paths.get(node_id, node_id)
 

@@ -47,6 +47,7 @@ from engine.run_records import (
     runs_folder,
 )
 from engine.run_report import FailureLog
+from engine.script import ScriptSyntaxError, parse_script
 from engine.spec import PlanSpec
 from engine.status import Status
 from engine.trace import TraceError, TraceRecorder, format_timeline, read_trace
@@ -327,10 +328,15 @@ def _groot2(
 def _breaks_found(args: argparse.Namespace, plan: PlanSpec, err: TextIO) -> bool:
     """Whether every ``--break`` names a node of the plan (else said on ``err``)."""
     try:
-        for text in [*args.breaks, *args.breaks_after]:
+        for text in [*args.breaks, *args.breaks_after, *(path for path, _ in args.breaks_if)]:
             find_node(runtime_paths(plan), text)
+        for _, condition in args.breaks_if:
+            parse_script(condition)
     except BreakpointNotFound as exc:
         print(f"error: --break: {exc}", file=err)
+        return False
+    except ScriptSyntaxError as exc:
+        print(f"error: --break-if: {exc}", file=err)
         return False
     return True
 
@@ -339,7 +345,7 @@ def _break_console(
     args: argparse.Namespace, executor: Executor, plan: PlanSpec, out: TextIO
 ) -> BreakConsole | None:
     """The console that serves the pauses at ``--break`` nodes (None without one)."""
-    if not (args.breaks or args.breaks_after):
+    if not (args.breaks or args.breaks_after or args.breaks_if):
         return None
     console = BreakConsole(executor, plan, args.stdin, out)
     executor.add_listener(console)
@@ -347,6 +353,8 @@ def _break_console(
         console.add(text)
     for text in args.breaks_after:
         console.add(text, before=False)
+    for text, condition in args.breaks_if:
+        console.add(text, condition=condition)
     return console
 
 
@@ -658,6 +666,16 @@ def _parser() -> argparse.ArgumentParser:
         help="pause before this node (its path as --verbose prints it, or its id; "
         "repeatable) and read commands from stdin: step, next, continue, print NAME, "
         "set NAME VALUE, quit",
+    )
+    run.add_argument(
+        "--break-if",
+        dest="breaks_if",
+        action="append",
+        nargs=2,
+        default=[],
+        metavar=("NODE_PATH", "EXPR"),
+        help="pause before this node when the script EXPR is true in its scope "
+        "(e.g. 'attempts >= 3'), as --break",
     )
     run.add_argument(
         "--break-after",

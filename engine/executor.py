@@ -207,8 +207,10 @@ class Executor:
         self._thread.start()
 
     def pause(self) -> None:
+        """Pause after the current tick (a step over from here is a step to the next event)."""
         with self._cond:
             if self._state is ExecutorState.RUNNING:
+                self.debugger.current = ""
                 self._paused = True
                 self._state = ExecutorState.PAUSED
 

@@ -12,15 +12,20 @@ import pytest
 
 from capabilities.break_console import BreakpointNotFound, find_node
 from capabilities.cli import main
+from engine.files import save_plan
+from engine.spec import Binding, NodeKind, NodeSpec, PlanSpec
+from engine.types import ParamType
 
 ROOT = Path(__file__).resolve().parents[2]
 FIGURE3 = ROOT / "resources" / "examples" / "figure3_debug.costar.json"
 MOVE = "cup to bin/transfer or wait[1]/transfer[0]/move to CUP_POSE[3]"
 
 
-def costar_run(stdin: str, *options: str) -> subprocess.CompletedProcess[str]:
-    """``costar run`` of Figure 3 on no cell, its commands fed on stdin."""
-    argv = [sys.executable, "-m", "capabilities.cli", "run", "--cell", "none", str(FIGURE3)]
+def costar_run(
+    stdin: str, *options: str, plan: str = str(FIGURE3)
+) -> subprocess.CompletedProcess[str]:
+    """``costar run`` of a plan (Figure 3) on no cell, its commands fed on stdin."""
+    argv = [sys.executable, "-m", "capabilities.cli", "run", "--cell", "none", plan]
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     return subprocess.run(
         [*argv, "--rate", "200", "--no-record", *options],
@@ -84,3 +89,36 @@ def test_find_node_by_id_path_or_bare_path() -> None:
     assert find_node(paths, "top/place") == "c"
     with pytest.raises(BreakpointNotFound, match="several nodes"):
         find_node(paths, "top/pick")
+
+
+def _counting_plan(tmp_path: Path) -> str:
+    """A plan that sets count to 0, then three times adds 1 to it and works."""
+    script = NodeKind.SCRIPT
+
+    def code(name: str, text: str) -> NodeSpec:
+        return NodeSpec(script, name=name, params={"code": Binding.fixed(text, ParamType.TEXT)})
+
+    work = NodeSpec(NodeKind.OPERATION, name="work", op="debug.succeed")
+    body = NodeSpec(NodeKind.SEQUENCE, name="once", children=[code("count", "count += 1"), work])
+    three = NodeSpec(
+        NodeKind.REPEAT,
+        name="three times",
+        params={"count": Binding.fixed(3.0, ParamType.NUMBER)},
+        children=[body],
+    )
+    top = NodeSpec(NodeKind.SEQUENCE, name="top", children=[code("start", "count := 0"), three])
+    path = tmp_path / "count.costar.json"
+    save_plan(PlanSpec(top, "count"), path)
+    return str(path)
+
+
+def test_break_if_stops_only_when_its_condition_is_true(tmp_path: Path) -> None:
+    plan = _counting_plan(tmp_path)
+    where = "top/three times/once/work"
+    proc = costar_run("print count\ncontinue\n", "--break-if", where, "count == 2", plan=plan)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.count("paused before") == 1
+    assert "breakpoint before work (count == 2 is true)" in proc.stdout
+    assert "count = 2" in proc.stdout
+    bad = costar_run("", "--break-if", where, "count ==", plan=plan)
+    assert bad.returncode == 2 and "--break-if" in bad.stderr
