@@ -15,14 +15,17 @@ commands, one a line, until one lets the run go on:
 ``--break-if NODE_PATH EXPR`` pauses before the node only when the script ``EXPR``
 (BehaviorTree.CPP's language, :mod:`engine.script`) is true in the node's scope.
 
-The end of the input continues the run. While paused the robot is held, as Pause holds it.
+The end of the input continues the run. While paused the robot is held, as Pause holds it;
+Ctrl-C stops the run there as anywhere.
 """
 
 from __future__ import annotations
 
 import collections
 import math
+import queue
 import re
+import threading
 from collections.abc import Callable
 from typing import Any, TextIO
 
@@ -110,6 +113,8 @@ class BreakConsole:
         self._paused: collections.deque[RunPaused] = collections.deque()
         self._eof = False
         self._helped = False
+        self._lines: queue.Queue[str] = queue.Queue()
+        self._reader: threading.Thread | None = None
         self._commands: dict[str, Callable[[str], bool]] = {
             "step": lambda _: self._go(executor.step_next),
             "next": lambda _: self._go(executor.step_over),
@@ -159,7 +164,9 @@ class BreakConsole:
             self._helped = True
             self._say(HELP)
         while True:
-            line = "" if self._eof else self._in.readline()
+            line = self._line()
+            if line is None:  # the run ended while paused (Ctrl-C)
+                return
             if not line:
                 self._eof = True
                 self._say("end of input: continuing")
@@ -170,6 +177,31 @@ class BreakConsole:
             if command is None:
                 self._say(f"unknown command {word!r}; {HELP}" if word else HELP)
             elif command(rest.strip()):
+                return
+
+    def _line(self) -> str | None:
+        """The next line typed ("" at the end of the input); None once the run has ended.
+
+        A reader thread reads the input, so that a run stopped while paused (Ctrl-C) ends
+        without waiting for a line.
+        """
+        if self._eof:
+            return ""
+        if self._reader is None:
+            self._reader = threading.Thread(target=self._read, name="costar-break", daemon=True)
+            self._reader.start()
+        while self._executor.result is None:
+            try:
+                return self._lines.get(timeout=0.1)
+            except queue.Empty:
+                continue
+        return None
+
+    def _read(self) -> None:
+        while True:
+            line = self._in.readline()
+            self._lines.put(line)
+            if not line:
                 return
 
     # ------------------------------------------------------------------ commands

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import os
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -122,3 +123,26 @@ def test_break_if_stops_only_when_its_condition_is_true(tmp_path: Path) -> None:
     assert "count = 2" in proc.stdout
     bad = costar_run("", "--break-if", where, "count ==", plan=plan)
     assert bad.returncode == 2 and "--break-if" in bad.stderr
+
+
+def test_ctrl_c_while_paused_stops_the_run_without_waiting_for_a_line() -> None:
+    argv = [sys.executable, "-m", "capabilities.cli", "run", "--cell", "none", str(FIGURE3)]
+    proc = subprocess.Popen(
+        [*argv, "--rate", "200", "--no-record", "--break", MOVE],
+        stdin=subprocess.PIPE,  # kept open: nothing is typed
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+        cwd=ROOT,
+    )
+    try:
+        assert proc.stdout is not None
+        assert proc.stdout.readline().startswith(f"paused before {MOVE}")
+        proc.send_signal(signal.SIGINT)
+        rest, err = proc.communicate(timeout=20)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 3, err
+    assert "stopped after" in rest
