@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple, TextIO
 
 from capabilities.base import CapabilityError, CapabilityRegistry
+from capabilities.break_console import BreakConsole, BreakpointNotFound, find_node
 from capabilities.cell_features import ClosableCell, lockstep_of
 from capabilities.cells import CellError, cell_argument, open_cell
 from capabilities.collaboration.answers import CONFIRM_MODES, PromptAnswerer
@@ -46,6 +47,7 @@ from engine.run_records import (
     runs_folder,
 )
 from engine.run_report import FailureLog
+from engine.script import ScriptSyntaxError, parse_script
 from engine.spec import PlanSpec
 from engine.status import Status
 from engine.trace import TraceError, TraceRecorder, format_timeline, read_trace
@@ -219,6 +221,8 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         except BuildError as exc:
             print(f"error: {exc}", file=err)
             return EXIT_INVALID
+        if not _breaks_found(args, plan, err):
+            return EXIT_INVALID
         # Before anything that must be undone (the trace file, the signals): it may refuse.
         publisher = _groot2(args, plan, registry, tree, out)  # Groot2Error: exit 2
         failures = FailureLog(plan)
@@ -244,12 +248,13 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             hold=hold_check(cell),
             lockstep=lockstep_of(cell),
         )
+        console = _break_console(args, executor, plan, out)
         restore = _install_interrupt(executor)
-        console = cell.interfaces().get("operator")
-        answerer = PromptAnswerer(console, args.confirm, args.stdin, out) if console else None
+        operator = cell.interfaces().get("operator")
+        answerer = PromptAnswerer(operator, args.confirm, args.stdin, out) if operator else None
         try:
             executor.start()
-            result = _wait(executor, args.timeout, holds, out)
+            result = _wait(executor, args.timeout, holds, out, console)
         finally:
             restore()
             if answerer is not None:
@@ -320,13 +325,55 @@ def _groot2(
     return publisher
 
 
-def _wait(executor: Executor, timeout: float | None, holds: HoldWatch, out: TextIO) -> RunFinished:
-    # Wait in short slices so that Ctrl-C is handled promptly in the main thread.
+def _breaks_found(args: argparse.Namespace, plan: PlanSpec, err: TextIO) -> bool:
+    """Whether every ``--break`` names a node of the plan (else said on ``err``)."""
+    try:
+        for text in [*args.breaks, *args.breaks_after, *(path for path, _ in args.breaks_if)]:
+            find_node(runtime_paths(plan), text)
+        for _, condition in args.breaks_if:
+            parse_script(condition)
+    except BreakpointNotFound as exc:
+        print(f"error: --break: {exc}", file=err)
+        return False
+    except ScriptSyntaxError as exc:
+        print(f"error: --break-if: {exc}", file=err)
+        return False
+    return True
+
+
+def _break_console(
+    args: argparse.Namespace, executor: Executor, plan: PlanSpec, out: TextIO
+) -> BreakConsole | None:
+    """The console that serves the pauses at ``--break`` nodes (None without one)."""
+    if not (args.breaks or args.breaks_after or args.breaks_if):
+        return None
+    console = BreakConsole(executor, plan, args.stdin, out)
+    executor.add_listener(console)
+    for text in args.breaks:
+        console.add(text)
+    for text in args.breaks_after:
+        console.add(text, before=False)
+    for text, condition in args.breaks_if:
+        console.add(text, condition=condition)
+    return console
+
+
+def _wait(
+    executor: Executor,
+    timeout: float | None,
+    holds: HoldWatch,
+    out: TextIO,
+    console: BreakConsole | None = None,
+) -> RunFinished:
+    # Wait in short slices so that Ctrl-C is handled promptly in the main thread; a pause
+    # at a breakpoint is served here, its time not counted.
     waited = 0.0
     while True:
         result = executor.wait(0.1)
         if result is not None:
             return result
+        if console is not None:
+            console.serve()
         waited += 0.1
         reason = ""
         if timeout is not None and waited >= timeout:
@@ -610,6 +657,34 @@ def _parser() -> argparse.ArgumentParser:
         "clears, a controller that is gone): exit 3 (default 600)",
     )
     run.add_argument("--verbose", "-v", action="store_true", help="print every status change")
+    run.add_argument(
+        "--break",
+        dest="breaks",
+        action="append",
+        default=[],
+        metavar="NODE_PATH",
+        help="pause before this node (its path as --verbose prints it, or its id; "
+        "repeatable) and read commands from stdin: step, next, continue, print NAME, "
+        "set NAME VALUE, quit",
+    )
+    run.add_argument(
+        "--break-if",
+        dest="breaks_if",
+        action="append",
+        nargs=2,
+        default=[],
+        metavar=("NODE_PATH", "EXPR"),
+        help="pause before this node when the script EXPR is true in its scope "
+        "(e.g. 'attempts >= 3'), as --break",
+    )
+    run.add_argument(
+        "--break-after",
+        dest="breaks_after",
+        action="append",
+        default=[],
+        metavar="NODE_PATH",
+        help="pause once this node succeeded or failed (as --break)",
+    )
     run.add_argument(
         "--confirm",
         choices=CONFIRM_MODES,

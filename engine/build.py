@@ -7,7 +7,7 @@ cannot build raises :class:`BuildError` naming the node's path.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from engine.blackboard import Blackboard, BlackboardError
@@ -162,6 +162,7 @@ class _Build:
     plan: PlanSpec
     ctx: TreeContext
     source: OperationSource
+    scopes: dict[str, Callable[[str], str]] = field(default_factory=dict)
 
 
 def _instance(spec: NodeSpec, build: _Build, path: str, scope: Scope) -> Node:
@@ -217,6 +218,8 @@ def _add_conditions(node: Node, spec: NodeSpec, ctx: TreeContext, path: str, sco
 
 
 def _build_node(spec: NodeSpec, build: _Build, path: str, scope: Scope) -> Node:
+    if scope.outer is not None:  # inside an instance: names in its scope (the debugger's)
+        build.scopes[scope.node_id(spec.id)] = scope.key
     try:
         if spec.kind is NodeKind.SUBTREE:
             return _instance(spec, build, path, scope)
@@ -268,7 +271,10 @@ def build_tree(
             except BlackboardError as exc:
                 raise BuildError(f"parameters/{decl.name}", str(exc)) from exc
     ctx = TreeContext(board, clock) if clock is not None else TreeContext(board)
-    top = _build_node(plan.tree, _Build(plan, ctx, source), plan.tree.label, ROOT_SCOPE)
+    build = _Build(plan, ctx, source)
+    top = _build_node(plan.tree, build, plan.tree.label, ROOT_SCOPE)
     root = Root(ctx, ROOT_ID, plan.name or "root", plan.run_policy, plan.give_up_after)
     root.set_children([top])
-    return BehaviorTree(root, ctx)
+    tree = BehaviorTree(root, ctx)
+    tree.scopes.update(build.scopes)
+    return tree

@@ -16,6 +16,7 @@ __all__ = [
     "LogMessage",
     "RunFinished",
     "RunHeld",
+    "RunPaused",
     "Listener",
 ]
 
@@ -86,5 +87,22 @@ class RunHeld:
     time: float
 
 
-Event = RunStarted | StatusChanged | BlackboardWritten | LogMessage | RunFinished | RunHeld
+@dataclass(frozen=True, slots=True)
+class RunPaused:
+    """The run paused by itself at a node: a breakpoint, a step or a run to the node.
+
+    ``where`` is "before" (the node is about to start) or "after" (its status just changed);
+    ``why`` says so in words. The run goes on when it is resumed or stepped.
+    """
+
+    tick: int
+    node_id: str
+    where: str
+    why: str
+    time: float
+
+
+Event = (
+    RunStarted | StatusChanged | BlackboardWritten | LogMessage | RunFinished | RunHeld | RunPaused
+)
 Listener = Callable[[Event], None]

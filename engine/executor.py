@@ -19,6 +19,11 @@ time) the world goes on only with the engine's clock: after each tick the execut
 run one period and waits until it has, and the next tick comes then, not earlier (a job that
 finishes does not bring it forward). The same plan, scene and seed then give the same ticks,
 however busy the machine is. While the run is paused the world runs free.
+
+A :class:`~engine.debugger.Debugger` says where the run pauses by itself (breakpoints,
+steps, a run to a node): the engine thread then waits inside the tick, exactly there, as a
+paused run waits between ticks (the world runs free, nothing is ticked), and a RunPaused
+event says where and why.
 """
 
 from __future__ import annotations
@@ -30,6 +35,8 @@ import time
 from typing import Any, Protocol
 
 from engine.blackboard import OPERATOR
+from engine.debugger import Debugger, Step
+from engine.dispatcher import Dispatcher
 from engine.error_types import ErrorType
 from engine.events import (
     BlackboardWritten,
@@ -38,6 +45,7 @@ from engine.events import (
     LogMessage,
     RunFinished,
     RunHeld,
+    RunPaused,
     RunStarted,
     StatusChanged,
 )
@@ -63,6 +71,10 @@ class Lockstep(Protocol):
         ...
 
 
+class _Stopped(Exception):
+    """Raised on the engine thread, out of a tick paused inside, when the run is stopped."""
+
+
 class ExecutorState(str, enum.Enum):
     """Where the executor is: ready to start, running, paused or finished."""
 
@@ -70,51 +82,6 @@ class ExecutorState(str, enum.Enum):
     RUNNING = "running"
     PAUSED = "paused"
     FINISHED = "finished"
-
-
-class _Dispatcher:
-    """Delivers queued events to listeners on its own thread."""
-
-    def __init__(self, listeners: list[Listener]) -> None:
-        self._listeners = listeners
-        self._queue: collections.deque[Event] = collections.deque()
-        self._ready = threading.Condition()
-        self._closed = False
-        self.errors: list[str] = []
-        self._thread = threading.Thread(target=self._loop, name="costar-events", daemon=True)
-
-    def start(self) -> None:
-        self._thread.start()
-
-    def put(self, event: Event) -> None:
-        self._queue.append(event)  # deque.append is atomic: no lock on the engine's path
-        if len(self._queue) == 1:
-            with self._ready:
-                self._ready.notify()
-
-    def close(self) -> None:
-        with self._ready:
-            self._closed = True
-            self._ready.notify()
-
-    def join(self, timeout: float | None = None) -> None:
-        if self._thread.is_alive():
-            self._thread.join(timeout)
-
-    def _loop(self) -> None:
-        while True:
-            with self._ready:
-                while not self._queue and not self._closed:
-                    self._ready.wait(0.1)
-                if not self._queue and self._closed:
-                    return
-            while self._queue:
-                event = self._queue.popleft()
-                for listener in self._listeners:
-                    try:
-                        listener(event)
-                    except Exception as exc:  # a listener's bug must not stop the others
-                        self.errors.append(f"{type(exc).__name__}: {exc}")
 
 
 class Executor:
@@ -132,6 +99,8 @@ class Executor:
         inline: listeners called on the engine thread as each event happens, before the
             other listeners hear it: for what must act at the tick itself (a simulated
             cell's actors, in lockstep), quickly and without waiting on the engine.
+        debugger: breakpoints, skipped nodes, forced results (default: a debugger with
+            none, which costs the run nothing).
     """
 
     def __init__(
@@ -143,6 +112,7 @@ class Executor:
         hold: HoldCheck | None = None,
         lockstep: Lockstep | None = None,
         inline: list[Listener] | None = None,
+        debugger: Debugger | None = None,
     ) -> None:
         if rate_hz <= 0:
             raise ValueError(f"rate must be above 0 Hz, not {rate_hz}")
@@ -165,7 +135,8 @@ class Executor:
         self._result: RunFinished | None = None
         self._done = threading.Event()
         self._inline: list[Listener] = list(inline or [])
-        self._dispatcher = _Dispatcher(self._listeners)
+        self.debugger = debugger if debugger is not None else Debugger()
+        self._dispatcher = Dispatcher(self._listeners)
         self._thread = threading.Thread(target=self._run, name="costar-engine", daemon=True)
 
     # ------------------------------------------------------------------ control (any thread)
@@ -194,14 +165,18 @@ class Executor:
         self._thread.start()
 
     def pause(self) -> None:
+        """Pause after the current tick (a step over from here is a step to the next event)."""
         with self._cond:
             if self._state is ExecutorState.RUNNING:
+                self.debugger.current = ""
                 self._paused = True
                 self._state = ExecutorState.PAUSED
 
     def resume(self) -> None:
+        """Go on (continue): a step or a run to a node armed before is forgotten."""
         with self._cond:
             if self._state is ExecutorState.PAUSED:
+                self.debugger.arm(None)
                 self._paused = False
                 self._steps = 0  # steps not taken yet are void once running again
                 self._state = ExecutorState.RUNNING
@@ -230,6 +205,30 @@ class Executor:
             if self._state is not ExecutorState.PAUSED:
                 raise RuntimeError(f"{key} can be set only while the run is paused")
             self._edits.append((key, value, writer))
+            self._cond.notify()
+
+    def step_next(self) -> None:
+        """While paused: run to the next status change of any node, and pause there."""
+        self._go(Step.NEXT)
+
+    def step_over(self) -> None:
+        """While paused: run the node paused at to its end, and pause there (see
+        :mod:`engine.debugger`).
+        """
+        self._go(Step.OVER)
+
+    def run_to(self, node_id: str) -> None:
+        """While paused: run on until ``node_id`` is about to start, and pause there."""
+        self._go(None, node_id)
+
+    def _go(self, step: Step | None, run_to: str = "") -> None:
+        with self._cond:
+            if self._state is not ExecutorState.PAUSED:
+                return
+            self.debugger.arm(step, run_to)
+            self._paused = False
+            self._steps = 0
+            self._state = ExecutorState.RUNNING
             self._cond.notify()
 
     def stop(self, reason: str = "stopped", timeout: float | None = 5.0) -> None:
@@ -261,11 +260,15 @@ class Executor:
         put = self._emit
         clock = time.monotonic
 
+        debugger = self.debugger
+
         def on_status(node: Node, old: Status, new: Status) -> None:
             error = node.error.value if new is FAILURE and node.error is not None else ""
             if error and not node.children and self._hold is not None:
                 self._failures.append(node.message)
             put(StatusChanged(ctx.tick_count, node.id, old, new, node.message, clock(), error))
+            if debugger.step is not None:
+                debugger.on_status(node, old, new)
 
         def on_log(node_id: str, message: str) -> None:
             put(LogMessage(ctx.tick_count, node_id, message, clock()))
@@ -277,6 +280,31 @@ class Executor:
         ctx.log_sink = on_log
         ctx.wake = self.wake
         self.tree.blackboard.add_write_listener(on_write)
+        debugger.attach(self.tree, self._break)
+
+    def _break(self, node: Node, where: str, why: str) -> None:
+        """Pause here, inside the tick, until resumed, stepped or stopped (engine thread).
+
+        Raises:
+            _Stopped: the run was stopped while paused here.
+        """
+        with self._cond:
+            if self._stop_reason is None:
+                self._paused = True
+                self._state = ExecutorState.PAUSED
+        self._emit(RunPaused(self.tree.ctx.tick_count, node.id, where, why, time.monotonic()))
+        if self._lockstep is not None:
+            self._release(self._lockstep)  # the world runs free, the robot held
+        with self._cond:
+            while self._paused and self._stop_reason is None:
+                self._apply_edits()  # values set at a breakpoint reach the node it paused
+                if self._steps:  # one tick: this one goes on, the run pauses after it
+                    self._steps -= 1
+                    break
+                self._cond.wait()
+            self._apply_edits()
+            if self._stop_reason is not None:
+                raise _Stopped(self._stop_reason)
 
     def _wait_for_turn(self, deadline: float) -> str | None:
         """Sleep until the next tick is due; returns a stop reason when stopping."""
@@ -332,6 +360,8 @@ class Executor:
                         break
                 if self._lockstep is not None:
                     self._lockstep.advance(self.period)
+        except _Stopped as stopped:  # stopped while paused inside a tick
+            reason = str(stopped)
         except Exception as exc:  # a bug in the engine itself: end the run, keep the app
             reason, message = "error", f"{type(exc).__name__}: {exc}"
         try:

@@ -107,6 +107,14 @@ class Node:
                     new = self.fail(str(exc), ErrorType.INVALID_INPUT)
         return self._settle(status, new)
 
+    def give(self, status: Status, message: str, error: ErrorType | None = None) -> Status:
+        """Take a result from outside instead of ticking (the operator skipped the node or
+        forced its result): the node is not evaluated, its listeners hear of the change.
+        """
+        self.message = message
+        self.error = error if status is FAILURE else None
+        return self._settle(self.status, status)
+
     def _given(self, status: Status, condition: Condition) -> None:
         """The message of a result a pre-condition gave."""
         script = self.conditions.scripts[condition] if self.conditions is not None else None

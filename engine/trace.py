@@ -24,6 +24,7 @@ from engine.events import (
     LogMessage,
     RunFinished,
     RunHeld,
+    RunPaused,
     StatusChanged,
 )
 from engine.json_reader import JsonFileError, errors_as, parse_json
@@ -67,6 +68,8 @@ def _event_record(event: Event) -> dict[str, Any]:
         )
     if isinstance(event, RunHeld):
         return _ticked("held", event, reason=event.reason)
+    if isinstance(event, RunPaused):
+        return _ticked("paused", event, node=event.node_id, where=event.where, why=event.why)
     return {"event": "started", "plan": event.plan, "time": event.time}
 
 
@@ -226,6 +229,13 @@ def read_trace(path: str | os.PathLike[str]) -> Trace:
     return Trace(header, [record for _, record in records[1:]])
 
 
+def _held_words(event: dict[str, Any]) -> str:
+    """What a record of a hold or a pause says: the run held, resumed or paused."""
+    if event["event"] == "paused":
+        return f"paused: {event.get('why', '')}"
+    return f"held: {event['reason']}" if event.get("reason") else "resumed"
+
+
 def format_timeline(trace: Trace) -> Iterable[str]:
     """Readable lines: time since start, tick, node, change, message."""
     labels = trace.labels()
@@ -248,9 +258,8 @@ def format_timeline(trace: Trace) -> Iterable[str]:
         elif kind == "finished":
             tail = f" ({event['message']})" if event.get("message") else ""
             yield f"{head} tick {event['tick']:>5}  run {event['reason']}: {event['status']}{tail}"
-        elif kind == "held":
-            what = f"held: {event['reason']}" if event.get("reason") else "resumed"
-            yield f"{head} tick {event['tick']:>5}  run {what}"
+        elif kind in ("held", "paused"):
+            yield f"{head} tick {event['tick']:>5}  run {_held_words(event)}"
         elif kind == "failures":
             tick = f"{head} tick {event['tick']:>5}  "
             if isinstance(event.get("cause"), dict):

@@ -13,7 +13,7 @@ starts it again.
 from __future__ import annotations
 
 import enum
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 from engine.blackboard import Blackboard
 from engine.context import TreeContext
@@ -131,12 +131,19 @@ _SKIPPED_AS: dict[str, Status] = {
 
 
 class BehaviorTree:
-    """A runnable tree: the root, its context, and its nodes by id."""
+    """A runnable tree: the root, its context, and its nodes by id.
+
+    Attributes:
+        scopes: node id -> how a name in that node's scope becomes a blackboard key (the
+            builder fills it for the nodes inside subtree instances; a node not in it is at
+            the top, where a name is its key).
+    """
 
     def __init__(self, root: Root, ctx: TreeContext) -> None:
         self.root = root
         self.ctx = ctx
         self.nodes: dict[str, Node] = {node.id: node for node in root.iterate()}
+        self.scopes: dict[str, Callable[[str], str]] = {}
 
     @property
     def status(self) -> Status:

@@ -9,7 +9,6 @@ that an API change of a panel is adjusted in one place.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +23,7 @@ from PySide6.QtWidgets import (
 from engine.executor import ExecutorState
 from engine.library import library_folder
 from engine.spec import NodeKind
+from instructor_app.canvas.actions import MenuEntry
 from instructor_app.cell_control import CellControl
 from instructor_app.dialogs import APP_TITLE, DISCARD, Dialogs
 from instructor_app.document.autosave import DEFAULT_INTERVAL_MS, Autosaver
@@ -40,6 +40,7 @@ from instructor_app.panels.start_page import StartPage, find_examples
 from instructor_app.plan_files import PlanFiles
 from instructor_app.runtime.blackboard_edits import BlackboardEdits
 from instructor_app.runtime.controller import RunController
+from instructor_app.runtime.debug_view import DebugActions
 from instructor_app.runtime.robot_status import CellClearButton, RobotStatusLabel
 from instructor_app.runtime.run_view import (
     FailureButton,
@@ -93,6 +94,9 @@ class MainWindow(QMainWindow):
         self.controller = RunController(self.document, session, rate_hz=rate_hz, parent=self)
         self.views: Views = make_views(self.document, session, self, self.autosaver.folder.parent)
         self.run_actions = RunActions(self.controller, self)
+        self.debug_actions = DebugActions(
+            self.controller, self.views.canvas, self.show_message, self, self.settings
+        )
         self.running_panel = RunningNodesPanel(self._node_path, self)
         self.operator_panel = OperatorPanel(self)
         self.failure_button = FailureButton(self)
@@ -220,6 +224,7 @@ class MainWindow(QMainWindow):
         run_menu.addAction(groot2)
         run_menu.addAction(self._action("groot2_port", "Groot2 &Port…", self._ask_groot2_port))
         self._apply_groot2()
+        self.debug_actions.fill_menu(bar.addMenu("&Debug"))
         self.library.fill_menu(bar.addMenu("&Library"))
         help_menu = bar.addMenu("&Help")
         help_menu.addAction(self._action("about", f"&About {APP_TITLE}", self._about))
@@ -498,15 +503,18 @@ class MainWindow(QMainWindow):
         self.cells.use_plan_scene()
         return True
 
-    def _run_entries(self, node_id: str) -> list[tuple[str, Callable[[], None]]]:
-        """The run commands of a node's context menu: resume from it after a run ended."""
+    def _run_entries(self, node_id: str) -> list[MenuEntry]:
+        """The run commands of a node's context menu: resume from it after a run ended;
+        its breakpoint, skip and forced result.
+        """
+        entries = self.debug_actions.node_entries(node_id)
         if self.controller.state != ExecutorState.FINISHED:
-            return []
+            return entries
 
         def resume() -> None:
             self.controller.resume_from(node_id)  # a refused plan shows its problems
 
-        return [("Resume from this node", resume)]
+        return [("Resume from this node", resume), *entries]
 
     def _about(self) -> None:
         self.dialogs.about(

@@ -41,6 +41,7 @@ _LAST_DIR = "files/last_dir"
 _LIBRARY = "library/folder"
 _GEOMETRY = "window/geometry"
 _STATE = "window/state"
+_BREAKPOINTS = "debug/breakpoints"  # + "/<plan id>": the node ids, kept out of the plan file
 _GROOT2 = "groot2/publish"
 _GROOT2_PORT = "groot2/port"
 GROOT2_PORT = 1667  # BehaviorTree.CPP's Groot2Publisher's default
@@ -128,6 +129,20 @@ class AppSettings:
     def set_groot2_port(self, port: int) -> None:
         self.qsettings.setValue(_GROOT2_PORT, int(port))
         self.qsettings.sync()
+
+    def breakpoints(self, plan_id: str) -> list[str]:
+        """The node ids the operator set breakpoints on in the plan ``plan_id``."""
+        value = self.qsettings.value(f"{_BREAKPOINTS}/{plan_id}", [])
+        if isinstance(value, str):  # QSettings gives a lone string for a one-item list
+            value = [value]
+        return [str(v) for v in (value or []) if v]
+
+    def set_breakpoints(self, plan_id: str, node_ids: list[str]) -> None:
+        key = f"{_BREAKPOINTS}/{plan_id}"
+        if node_ids:
+            self.qsettings.setValue(key, sorted(node_ids))
+        else:
+            self.qsettings.remove(key)
 
     def save_window(self, geometry: QByteArray, state: QByteArray) -> None:
         self.qsettings.setValue(_GEOMETRY, geometry)

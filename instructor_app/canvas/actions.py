@@ -20,9 +20,11 @@ from instructor_app.document.editing import PlanDocument
 from instructor_app.document.model import SUBTREE_MIME, DocumentError
 from instructor_app.document.tree_ops import can_have_child
 
-__all__ = ["CanvasActions", "NodeFactory", "default_node_factory", "LOGIC_KINDS"]
+__all__ = ["CanvasActions", "MenuEntry", "NodeFactory", "default_node_factory", "LOGIC_KINDS"]
 
 NodeFactory = Callable[[NodeKind, "str | None"], NodeSpec]
+# A context menu entry: (text, handler), or (text, [(text, handler), ...]) for a submenu.
+MenuEntry = tuple[str, "Callable[[], object] | list[tuple[str, Callable[[], object]]]"]
 
 # What "Add child" offers first: every kind but operations (those follow, by capability) and
 # subtree instances (those come from the library).
@@ -65,8 +67,9 @@ class CanvasActions(QObject):
         self.operations: dict[str, list[tuple[str, str]]] = {}
         self.node_factory: NodeFactory = default_node_factory
         # node id -> (text, handler) entries added by whoever runs the plan ("Resume from
-        # this node"): the canvas knows no runs; empty when none apply now
-        self.run_entries: Callable[[str], list[tuple[str, Callable[[], None]]]] = lambda _: []
+        # this node"; a list of entries for a submenu): the canvas knows no runs; empty when
+        # none apply now
+        self.run_entries: Callable[[str], list[MenuEntry]] = lambda _: []
         self.actions: dict[str, QAction] = {}
         handlers: dict[str, Callable[[], None]] = {
             "delete": self.delete,
@@ -215,7 +218,12 @@ class CanvasActions(QObject):
             if entries:
                 menu.addSeparator()
             for text, handler in entries:
-                menu.addAction(text).triggered.connect(handler)
+                if isinstance(handler, list):  # a submenu
+                    sub = menu.addMenu(text)
+                    for sub_text, sub_handler in handler:
+                        sub.addAction(sub_text).triggered.connect(sub_handler)
+                else:
+                    menu.addAction(text).triggered.connect(handler)
         else:
             menu.addAction(self.actions["paste"])
         menu.addSeparator()

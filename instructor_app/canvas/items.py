@@ -61,6 +61,8 @@ _BROKEN = QColor(200, 30, 30)
 _TEXT = QColor(20, 20, 20)
 _BADGE = QColor(60, 60, 60)
 _WHITE = QColor(255, 255, 255)
+_BREAKPOINT = QColor(200, 30, 30)  # a debugger's red dot
+_PAUSED_HERE = QColor(255, 140, 0)
 _SELECTED_CHANGE = QGraphicsItem.GraphicsItemChange.ItemSelectedChange
 _MOVED = QGraphicsItem.GraphicsItemChange.ItemScenePositionHasChanged
 _COLOURS: dict[RGB, QColor] = {}
@@ -81,6 +83,7 @@ class _Fonts:
     symbol: QFont
     small: QFont
     title_metrics: QFontMetricsF
+    small_metrics: QFontMetricsF
     ready = False
 
     @classmethod
@@ -94,6 +97,7 @@ class _Fonts:
         cls.symbol.setBold(True)
         cls.small.setPointSize(8)
         cls.title_metrics = QFontMetricsF(cls.title)
+        cls.small_metrics = QFontMetricsF(cls.small)
         cls.ready = True
 
 
@@ -168,6 +172,9 @@ class TreeNodeItem(NodeItem):
         self.halted = False  # it was running when the run was stopped
         self.index_badge = 0  # 1-based place among its parent's children; 0: none
         self.hidden_count = 0  # descendants hidden by collapsing; 0: expanded
+        self.breakpoint = False  # the run pauses before it
+        self.debug_note = ""  # "skipped", "forced: succeed" ...
+        self.paused_here = False  # the run is paused at it
         self._elided = ""
         self._bounds = _bounds(self._width, self._height)
 
@@ -195,7 +202,19 @@ class TreeNodeItem(NodeItem):
             tip = f"{look.title}\nFailed: {self.status_tip}"
         elif self.halted:
             tip = f"{look.title}\nHalted: it was running when the run was stopped"
+        marks = (["breakpoint"] if self.breakpoint else []) + (
+            [self.debug_note] if self.debug_note else []
+        )
+        if marks:
+            tip = f"{tip or look.title}\n{', '.join(marks)}"
         self.setToolTip(tip)
+
+    def set_debug(self, breakpoint: bool, note: str, paused_here: bool) -> None:
+        """Show a breakpoint (a red dot), a skip or forced result, the run paused here."""
+        if (breakpoint, note, paused_here) != (self.breakpoint, self.debug_note, self.paused_here):
+            self.breakpoint, self.debug_note, self.paused_here = breakpoint, note, paused_here
+            self._update_tip()
+            self.update()
 
     def set_status_tip(self, text: str) -> None:
         """Show why the node failed in its tooltip ("" clears it)."""
@@ -394,6 +413,8 @@ class TreeNodeItem(NodeItem):
         pen = QPen(_SELECTED, 3.0) if self.isSelected() else QPen(_BORDER, 1.0)
         if look is not None and look.broken and not self.isSelected():
             pen = QPen(_BROKEN, 2.5, Qt.PenStyle.DashLine)
+        if self.paused_here:
+            pen = QPen(_PAUSED_HERE, 5.0)
         painter.setPen(pen)
         painter.setBrush(QBrush(fill))
         painter.drawRoundedRect(rect, 6.0, 6.0)
@@ -456,6 +477,8 @@ class TreeNodeItem(NodeItem):
                 Qt.AlignmentFlag.AlignCenter,
                 str(self.index_badge),
             )
+        if self.breakpoint or self.debug_note:
+            self._paint_debug(painter)
         if self.hidden_count:
             box = QRectF(self._width - 40.0, self._height - 8.0, 40.0, 16.0)
             painter.setPen(QPen(_BORDER, 1.0))
@@ -463,6 +486,21 @@ class TreeNodeItem(NodeItem):
             painter.drawRoundedRect(box, 7.0, 7.0)
             painter.setPen(_TEXT)
             painter.drawText(box, Qt.AlignmentFlag.AlignCenter, f"+{self.hidden_count}")
+
+    def _paint_debug(self, painter: QPainter) -> None:
+        """The breakpoint's red dot on the top right corner, a skip or forced result below."""
+        if self.breakpoint:
+            painter.setPen(QPen(_WHITE, 1.5))
+            painter.setBrush(_BREAKPOINT)
+            painter.drawEllipse(QPointF(self._width - 14.0, -2.0), 8.0, 8.0)
+        if self.debug_note:
+            width = _Fonts.small_metrics.horizontalAdvance(self.debug_note) + 12.0
+            box = QRectF(10.0, self._height - 8.0, width, 16.0)
+            painter.setPen(QPen(_BORDER, 1.0))
+            painter.setBrush(_PAUSED_HERE)
+            painter.drawRoundedRect(box, 7.0, 7.0)
+            painter.setPen(_TEXT)
+            painter.drawText(box, Qt.AlignmentFlag.AlignCenter, self.debug_note)
 
 
 class TreeNode(BaseNode):

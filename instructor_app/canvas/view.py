@@ -144,6 +144,21 @@ class CanvasView(QWidget):
                 self._statused.add(node_id)
                 yield node_id, node.item
 
+    def set_debug_marks(
+        self, breakpoints: Iterable[str], notes: Mapping[str, str], paused_at: str = ""
+    ) -> None:
+        """Draw the breakpoints, the skips and forced results (``notes``: id -> "skipped"),
+        and the node the run is paused at (""); every other node loses its marks.
+        """
+        marked = set(breakpoints)
+        for node_id, node in self.mirror.nodes.items():
+            node.item.set_debug(node_id in marked, notes.get(node_id, ""), node_id == paused_at)
+
+    def debug_marks(self, node_id: str) -> tuple[bool, str, bool]:
+        """(breakpoint, note, paused here) as drawn on the node."""
+        item = self.item(node_id)
+        return item.breakpoint, item.debug_note, item.paused_here
+
     def is_halted(self, node_id: str) -> bool:
         """True when the node shows as halted by a stop."""
         return self.mirror.nodes[node_id].item.halted

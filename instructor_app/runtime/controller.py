@@ -12,6 +12,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -34,6 +35,7 @@ from engine.trace import TraceRecorder
 from engine.tree import BehaviorTree
 from engine.validation import ERROR, Problem, has_errors, validate_plan
 from instructor_app.document.editing import PlanDocument
+from instructor_app.runtime.debugging import RunDebugging
 from instructor_app.runtime.pump import Batch, EventPump, failure_text
 from instructor_app.runtime.session import CellSession
 
@@ -107,6 +109,11 @@ class RunController(QObject):
             instances; None when a new run starts.
         nodes_halted(list): ids of the nodes that were running when the run was stopped (or
             ended by an error): halted, they keep their last status.
+        run_paused(str, str): the run paused by itself (a breakpoint, a step, a run to a
+            node): the plan node it paused at (the instance, inside one) and why, in words.
+
+    Attributes:
+        debugging: the operator's breakpoints, skipped nodes and forced results.
     """
 
     # object, not dict: a dict signal goes through QVariantMap and turns Status into str.
@@ -125,6 +132,7 @@ class RunController(QObject):
     failures_described = Signal(object)
     hold_changed = Signal(str, str)
     nodes_halted = Signal(list)
+    run_paused = Signal(str, str)
 
     def __init__(
         self,
@@ -160,6 +168,7 @@ class RunController(QObject):
         self._idled: set[str] = set()  # nodes that went RUNNING -> IDLE at the last drain
         self._groot2_port: int | None = None  # publish runs for Groot2 on it (None: do not)
         self._groot2: Groot2Publisher | None = None  # serving, once a run was published
+        self.debugging = RunDebugging(self)
 
     # ------------------------------------------------------------------ state
 
@@ -229,6 +238,32 @@ class RunController(QObject):
         too: "greet > say"); the id itself when the plan has no such node.
         """
         return self._label(node_id)
+
+    def step_next(self) -> None:
+        """Run to the next status change of any node and pause there (starts a paused run
+        when idle).
+        """
+        self._debug_go(lambda executor: executor.step_next())
+
+    def step_over(self) -> None:
+        """Run the node the run paused at to its end, and pause there."""
+        self._debug_go(lambda executor: executor.step_over())
+
+    def run_to(self, node_id: str) -> None:
+        """Run on until ``node_id`` is about to start, and pause there (starts a run when
+        idle).
+        """
+        self._debug_go(lambda executor: executor.run_to(node_id))
+
+    def _debug_go(self, go: Callable[[Executor], None]) -> None:
+        if not self.is_running:
+            if not self._start(paused=True):
+                return
+        elif self._state == ExecutorState.RUNNING:
+            self.pause()
+        assert self._executor is not None
+        go(self._executor)
+        self._set_state(ExecutorState.RUNNING)
 
     def stop(self) -> None:
         """Halt what runs (an arm in motion stops); the run ends via run_finished.
@@ -365,6 +400,7 @@ class RunController(QObject):
             plan_name=plan.name,
             hold=hold,
             lockstep=lockstep_of(self.session.cell),
+            debugger=self.debugging.debugger(),
         )
         self._executor.start(paused=paused)
         self._timer.start()
@@ -458,6 +494,17 @@ class RunController(QObject):
             self._update_failure()
         if batch.finished is not None:
             self._finish(batch.finished)
+        elif batch.paused is not None:
+            self._paused(batch.paused.node_id, batch.paused.why)
+
+    def _paused(self, node_id: str, why: str) -> None:
+        """The run paused by itself: say where, on the node of the plan that shows it."""
+        executor = self._executor
+        if executor is None or executor.state is not ExecutorState.PAUSED:
+            return  # resumed (or stepped) since: the pause is over
+        self._set_state(ExecutorState.PAUSED)
+        self.log_message.emit(f"Paused at {self._label(node_id)}: {why}", "info")
+        self.run_paused.emit(node_id.split("/")[0], why)
 
     def _since_start(self, entry: BlackboardEntry) -> BlackboardEntry:
         """``entry`` with its time in seconds since the run started."""
@@ -597,6 +644,7 @@ class RunController(QObject):
             self.log_message.emit(f"On the way: {other.describe()}", "info")
         level = "info" if event.status in (Status.SUCCESS, Status.SKIPPED) else "warning"
         self.log_message.emit(self._summary(event, self._failure[1] if failed else ""), level)
+        self.debugging.run_ended()
         self._set_state(ExecutorState.FINISHED)
         outcome = RunOutcome(event, failed, message, dict(self._statuses), cause, others)
         self.run_finished.emit(outcome)

@@ -20,6 +20,7 @@ from engine.events import (
     LogMessage,
     RunFinished,
     RunHeld,
+    RunPaused,
     RunStarted,
     StatusChanged,
 )
@@ -54,6 +55,7 @@ class Batch:
         started: whether a RunStarted event arrived.
         holds: why the cell held the run, in order ("" when it went on again).
         idled: nodes that went from RUNNING to IDLE (halted: by a hold, a stop, a parent).
+        paused: where the run paused by itself last (a breakpoint, a step), if it did.
     """
 
     statuses: dict[str, Status] = field(default_factory=dict)
@@ -66,11 +68,18 @@ class Batch:
     started: bool = False
     holds: list[str] = field(default_factory=list)
     idled: set[str] = field(default_factory=set)
+    paused: RunPaused | None = None
 
     @property
     def empty(self) -> bool:
         return not (
-            self.statuses or self.writes or self.logs or self.finished or self.started or self.holds
+            self.statuses
+            or self.writes
+            or self.logs
+            or self.finished
+            or self.started
+            or self.holds
+            or self.paused
         )
 
 
@@ -119,3 +128,5 @@ def _merge(batch: Batch, event: Event) -> None:
         batch.started = True
     elif isinstance(event, RunHeld):
         batch.holds.append(event.reason)
+    elif isinstance(event, RunPaused):
+        batch.paused = event

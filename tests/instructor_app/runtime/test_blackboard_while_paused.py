@@ -27,7 +27,7 @@ from engine.types import ParamType, Pose
 from instructor_app.main_window import MainWindow
 from instructor_app.panels.blackboard import TICK, VALUE, WRITER
 from instructor_app.runtime.session import CellSession
-from tests.instructor_app.gui_driver import make_window, show_tab
+from tests.instructor_app.gui_driver import click_node, make_window, show_tab
 from tests.instructor_app.runtime.plans import number, op
 
 FOUND = Pose((0.4, 0.0, 0.3), (1.0, 0.0, 0.0, 0.0))
@@ -179,3 +179,30 @@ def test_each_scope_shows_its_names_and_the_nodes_that_wrote_them(
     assert panel.text_of("SEEN", WRITER) == "Pick cup > count"
     assert panel.text_of("GOT", WRITER) == "Pick cup"  # copied out by the instance
     assert not panel.editable  # the run is over
+
+
+def test_at_a_breakpoint_before_the_move_a_changed_target_is_where_it_goes(
+    qtbot: Any, none_session: CellSession, tmp_path: Path
+) -> None:
+    """The issue's check: F9 on the move, Run; paused there, the worker types a new target
+    in the Blackboard panel; Continue, and the move goes to the new target.
+    """
+    window = _window(qtbot, none_session, tmp_path)
+    panel, controller = window.views.blackboard, window.controller
+    move = next(n.id for _, n in window.document.plan.walk() if n.name == "move")
+    window.activateWindow()  # the shortcuts are the window's
+    qtbot.waitUntil(window.isActiveWindow)
+    click_node(qtbot, window, move)
+    qtbot.keyClick(window.views.canvas.viewer, Qt.Key.Key_F9)
+    with qtbot.waitSignal(controller.run_paused, timeout=10000) as paused:
+        window.run_actions.run.trigger()
+    assert paused.args[0] == move
+    qtbot.waitUntil(lambda: panel.values().get("TARGET") == FOUND and panel.editable, timeout=5000)
+
+    _edit(qtbot, window, "TARGET", TYPED)
+    qtbot.waitUntil(lambda: panel.text_of("TARGET", WRITER) == "you (while paused)", timeout=5000)
+    with qtbot.waitSignal(controller.run_finished, timeout=10000) as finished:
+        window.run_actions.run.trigger()  # continue
+    assert finished.args[0].status is Status.SUCCESS
+    moves = [line for line in window.views.log.lines() if "moving to" in line]
+    assert len(moves) == 1 and "position=(0.5, 0.1, 0.25)" in moves[0]
