@@ -557,16 +557,31 @@ class URConnection:
         )
 
     def _disconnect(self) -> None:
+        """Disconnect the three clients side by side: ur_rtde's control and receive
+        interfaces each wait about half a second for their threads on disconnect.
+        """
         self._watchdog = False
+        closing = []
         for name in ("control", "receive", "dashboard"):
             obj = getattr(self, name)
             setattr(self, name, None)
-            if obj is None:
-                continue
-            try:
-                obj.disconnect()
-            except Exception:  # a dead controller: nothing more to close
-                _log.debug("disconnecting %s failed", name, exc_info=True)
+            if obj is not None:
+                closing.append(
+                    threading.Thread(
+                        target=_disconnect_one, args=(name, obj), name=f"ur-close-{name}"
+                    )
+                )
+        for thread in closing:
+            thread.start()
+        for thread in closing:
+            thread.join(timeout=10.0)
+
+
+def _disconnect_one(name: str, client: Any) -> None:
+    try:
+        client.disconnect()
+    except Exception:  # a dead controller: nothing more to close
+        _log.debug("disconnecting %s failed", name, exc_info=True)
 
 
 def _control_interface(module: Any, host: str, attempts: int = 3) -> Any:
