@@ -11,9 +11,12 @@ Every decorator passes a SKIPPED child up (BehaviorTree.CPP's do): it is SKIPPED
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from engine.context import TreeContext
 from engine.error_types import ErrorType
 from engine.node import Node
+from engine.script import ScriptEnv, ScriptRunError, parse_script
 from engine.status import FAILURE, RUNNING, SKIPPED, SUCCESS, Status
 
 __all__ = [
@@ -26,6 +29,10 @@ __all__ = [
     "Repeat",
     "Retry",
     "Timeout",
+    "KeepRunningUntilFailure",
+    "Delay",
+    "RunOnce",
+    "Precondition",
 ]
 
 
@@ -230,4 +237,124 @@ class Timeout(_Clocked):
         if status is RUNNING and self._elapsed() >= self.seconds:
             child.reset()
             return self.fail(f"timed out after {self.seconds:g} s", ErrorType.TIMEOUT)
+        return status
+
+
+class KeepRunningUntilFailure(Decorator):
+    """RUNNING while the child succeeds (it starts again on the next tick); FAILURE when it
+    fails. A skipped child is checked again on the next tick (BehaviorTree.CPP's).
+    """
+
+    kind = "keep_running_until_failure"
+
+    def update(self) -> Status:
+        child = self.children[0]
+        status = child.tick()
+        if status is FAILURE:
+            return self.fail(f"{child.name} failed")
+        if status is not RUNNING:
+            child.reset()
+        return RUNNING
+
+
+class Delay(_Clocked):
+    """BehaviorTree.CPP's Delay: RUNNING for ``seconds``, then ticks the child and gives its
+    result. The first tick always answers RUNNING (BehaviorTree.CPP's timer fires on another
+    thread, after the tick that started it).
+    """
+
+    kind = "delay"
+
+    def __init__(
+        self, ctx: TreeContext, node_id: str, name: str = "", seconds: float = 0.0
+    ) -> None:
+        super().__init__(ctx, node_id, name)
+        if seconds < 0:
+            raise ValueError(f"a delay of at least 0 s, not {seconds}")
+        self.seconds = seconds
+
+    def update(self) -> Status:
+        if self._started is None:
+            self._started = self.ctx.clock()
+            return RUNNING
+        if self._elapsed() < self.seconds:
+            return RUNNING
+        return self.children[0].tick()
+
+
+class RunOnce(Decorator):
+    """Runs its child to the end once; afterwards, even after a reset, it is SKIPPED
+    (``then_skip``) or gives the child's result again without ticking it.
+    """
+
+    kind = "run_once"
+
+    def __init__(
+        self, ctx: TreeContext, node_id: str, name: str = "", then_skip: bool = True
+    ) -> None:
+        super().__init__(ctx, node_id, name)
+        self.then_skip = then_skip
+        self._result: Status | None = None
+
+    def update(self) -> Status:
+        result = self._result
+        if result is not None:
+            if self.then_skip:
+                self.message = "skipped: it has run once"
+                return SKIPPED
+            if result is FAILURE:
+                return self.fail("it ran once and failed")
+            return result
+        status = self.children[0].tick()
+        if status is SUCCESS or status is FAILURE:
+            self._result = status
+        return status
+
+    # on_reset keeps the result: BehaviorTree.CPP's halt does not forget it either.
+
+
+class Precondition(Decorator):
+    """BehaviorTree.CPP's Precondition: ticks the child when the script ``if`` is true, else
+    gives ``otherwise`` (its ``else``: FAILURE unless told). Once the child has started, the
+    script is not checked again until the child finishes; as in BehaviorTree.CPP, a halt does
+    not change that.
+
+    Args:
+        code: the script (a syntax error raises ScriptSyntaxError).
+        otherwise: the status when the script is false.
+        key: a name in the script -> its blackboard key (the node's scope).
+    """
+
+    kind = "precondition"
+
+    def __init__(
+        self,
+        ctx: TreeContext,
+        node_id: str,
+        name: str,
+        code: str,
+        otherwise: Status = FAILURE,
+        *,
+        key: Callable[[str], str] | None = None,
+    ) -> None:
+        super().__init__(ctx, node_id, name)
+        self.script = parse_script(code)
+        self.otherwise = otherwise
+        self._env = ScriptEnv(ctx.blackboard, key=key, writer=node_id)
+        self._child_started = False
+
+    def update(self) -> Status:
+        if not self._child_started:
+            try:
+                holds = self.script.check(self._env)
+            except ScriptRunError as exc:
+                return self.fail(f"script {exc}", ErrorType.INVALID_INPUT)
+            if not holds:
+                if self.otherwise is FAILURE:
+                    return self.fail(f"its condition ({self.script.text.strip()}) is false")
+                return self.otherwise
+            self._child_started = True
+        status = self.children[0].tick()
+        if status is SUCCESS or status is FAILURE:
+            self._child_started = False
         return status
