@@ -258,7 +258,7 @@ class _Reader(ReaderBase):
                 self.problem(element.line, f"a port of {logic.model} ({known})", repr(port))
                 continue
             name, mapping = by_port[port]
-            if text.startswith("{") and text.endswith("}"):
+            if not mapping.raw and text.startswith("{") and text.endswith("}"):
                 node.params[name] = Binding.reference(text[1:-1])
                 continue
             exact = element.attrs.get(f"_{name}")
@@ -266,8 +266,9 @@ class _Reader(ReaderBase):
                 value = mapping.read(text) if exact is None else _setting_text(exact)
                 node.params[name] = kind_setting(logic.kind, name, value)
             except ValueError:
+                expected = "true or false" if port in _BOOL_PORTS else "a number"
                 self.problem(
-                    element.line, f"{port} a number", repr(text if exact is None else exact)
+                    element.line, f"{port} {expected}", repr(text if exact is None else exact)
                 )
         return node
 
@@ -298,6 +299,9 @@ class _Reader(ReaderBase):
             if binding is not None:
                 node.params[port] = binding
         return node
+
+
+_BOOL_PORTS = ("catch_on_halt", "then_skip")
 
 
 def _setting_text(text: str) -> str | float:

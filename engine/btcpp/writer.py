@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from engine.btcpp.errors import XmlExportError
-from engine.btcpp.logic import BUILTIN_MODELS, LOGIC, LOGIC_BY_MODEL
+from engine.btcpp.logic import BUILTIN_MODELS, LOGIC, LOGIC_BY_MODEL, model_of
 from engine.btcpp.names import encode_id, encode_port, readable_tree_id
 from engine.btcpp.values import MODEL_TYPE, value_text
 from engine.conditions import Condition
@@ -293,7 +293,7 @@ class _Writer:
                 attrs[f"_{name}"] = value if isinstance(value, str) else repr(exact)
         if not logic.builtin and logic.model not in self.models:
             self.models[logic.model] = self._logic_model(node.kind)
-        return logic.model
+        return model_of(node.kind, len(node.children))
 
     def _logic_model(self, kind: NodeKind) -> _Model:
 
