@@ -189,8 +189,9 @@ def _threshold(count: int, n_children: int) -> int:
 
 
 class Parallel(Node):
-    """Ticks every unfinished child each tick; finishes by its policy and then halts the
-    children still running.
+    """Ticks every unfinished child each tick, in order, and finishes as soon as its policy
+    is met (the children after that one are not ticked); then halts the children still
+    running.
 
     A skipped child is checked afresh each tick. As in BehaviorTree.CPP (a success count of
     -1), a skipped child counts as a success for the policy "all"; when every child is
@@ -216,33 +217,44 @@ class Parallel(Node):
         self._need, self._fail = self.policy.thresholds(len(self.children))
 
     def update(self) -> Status:
-        succeeded = failed = skipped = 0
-        for child in self.children:
+        children = self.children
+        succeeded = sum(child.status is SUCCESS for child in children)
+        failed = sum(child.status is FAILURE for child in children)
+        skipped = 0
+        finished = self._finished(succeeded, failed, skipped)  # no children, or too few
+        if finished is not None:
+            return finished
+        for child in children:
             status = child.status
-            if status is SKIPPED:
-                status = child.recheck()
-            elif status is not SUCCESS and status is not FAILURE:
-                status = child.tick()
-            if status is SUCCESS:
-                succeeded += 1
-            elif status is FAILURE:
-                failed += 1
-            elif status is SKIPPED:
-                skipped += 1
-        if failed >= self._fail:
-            self._halt_running()
-            self.message = f"{failed} of {len(self.children)} failed"
-            return FAILURE
+            if status is not SUCCESS and status is not FAILURE:
+                status = child.recheck() if status is SKIPPED else child.tick()
+                if status is SUCCESS:
+                    succeeded += 1
+                elif status is FAILURE:
+                    failed += 1
+                elif status is SKIPPED:
+                    skipped += 1
+            # As BehaviorTree.CPP's: the policy is checked after each child, so a Parallel
+            # that has its answer does not start the children after it.
+            finished = self._finished(succeeded, failed, skipped)
+            if finished is not None:
+                self._halt_running()
+                return finished
+        return SKIPPED if skipped and skipped == len(children) else RUNNING
+
+    def _finished(self, succeeded: int, failed: int, skipped: int) -> Status | None:
+        """SUCCESS or FAILURE when the policy is met by these counts, else None."""
         if succeeded >= self._need or (
             self.policy.counts_skipped and succeeded + skipped >= self._need
         ):
-            self._halt_running()
             return SUCCESS
+        if failed >= self._fail:
+            self.message = f"{failed} of {len(self.children)} failed"
+            return FAILURE
         if len(self.children) - failed < self._need:
-            self._halt_running()
             self.message = "too many children failed to reach the success policy"
             return FAILURE
-        return SKIPPED if skipped and skipped == len(self.children) else RUNNING
+        return None
 
     def _halt_running(self) -> None:
         for child in self.children:

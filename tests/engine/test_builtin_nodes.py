@@ -232,11 +232,20 @@ def test_switch_string_equality_rejects_trailing_characters() -> None:
 def test_parallel_negative_counts_count_back_from_all_children(ctx: Any) -> None:
     children = leaves(ctx, (SUCCESS,), (SUCCESS,), (RUNNING,))
     node = with_children(Parallel(ctx, "p", policy=ParallelPolicy(-2, -3)), children)
-    assert node.tick() is SUCCESS  # -2 of 3: two successes
-    assert children[2].status is IDLE and children[2].halts == 1
+    assert node.tick() is SUCCESS  # -2 of 3: two successes, and the third is not started
+    assert children[2].status is IDLE and children[2].updates == 0
     failing = leaves(ctx, (FAILURE,), (FAILURE,), (RUNNING,))
     node = with_children(Parallel(ctx, "q", policy=ParallelPolicy("all", -2)), failing)
     assert node.tick() is FAILURE  # -2 of 3: two failures
+
+
+def test_parallel_checks_its_policy_after_each_child_counting_earlier_results(ctx: Any) -> None:
+    first, second, third = leaves(ctx, (RUNNING, SUCCESS), (SUCCESS,), (RUNNING,))
+    node = with_children(Parallel(ctx, "p", policy=ParallelPolicy(2)), [first, second, third])
+    assert node.tick() is RUNNING and third.status is RUNNING
+    # first's success with second's from the last tick meets the policy: third is halted
+    # and not ticked again (BehaviorTree.CPP keeps the count of earlier successes)
+    assert node.tick() is SUCCESS and (third.updates, third.halts) == (1, 1)
 
 
 def test_parallel_all_waits_for_every_child_then_counts_failures(ctx: Any) -> None:

@@ -193,3 +193,47 @@ def test_precondition_else_runs_from_a_plan(
     config = {"if": "false", "else": otherwise}
     spec = plan(logic(NodeKind.PRECONDITION, logic(NodeKind.ALWAYS_FAILURE), **config))
     assert build_tree(spec, registry).tick_until_done(max_ticks=5) is expected
+
+
+def run_again(tree: Any, times: int) -> list[Any]:
+    """The tree ticked ``times`` times, reset after each finish (BehaviorTree.CPP's tickOnce
+    on a tree that finished).
+    """
+    results = []
+    for _ in range(times):
+        if tree.status in (SUCCESS, FAILURE):
+            tree.reset()
+        results.append(tree.tick())
+    return results
+
+
+def test_sequence_with_memory_resumes_at_the_failed_condition_issue_636(
+    registry: CapabilityRegistry,
+) -> None:
+    spec = plan(
+        logic(
+            NodeKind.SEQUENCE_WITH_MEMORY,
+            logic(NodeKind.SCRIPT, code="var := 0"),
+            logic(NodeKind.ALWAYS_SUCCESS, name="A"),
+            logic(NodeKind.SCRIPT_CONDITION, code="var += 1; var >= 5"),
+            logic(NodeKind.ALWAYS_SUCCESS, name="B"),
+        )
+    )
+    tree = build_tree(spec, registry)
+    assert run_again(tree, 5) == [FAILURE] * 4 + [SUCCESS]
+    assert tree.blackboard.get("var") == 5  # the Script ran once: the sequence kept its place
+
+
+def test_run_once_runs_its_child_in_the_first_run_only(registry: CapabilityRegistry) -> None:
+    spec = plan(
+        logic(
+            NodeKind.SEQUENCE,
+            logic(NodeKind.RUN_ONCE, logic(NodeKind.SCRIPT, code="a += 1")),
+            logic(NodeKind.SCRIPT, code="b += 1"),
+        )
+    )
+    tree = build_tree(spec, registry)
+    tree.blackboard.set("a", 0)
+    tree.blackboard.set("b", 0)
+    assert run_again(tree, 5) == [SUCCESS] * 5
+    assert (tree.blackboard.get("a"), tree.blackboard.get("b")) == (1, 5)
