@@ -53,6 +53,7 @@ from engine.kinds import settings_of
 from engine.leaves import OperationLeaf, ScriptLeaf, Wait
 from engine.node import Node
 from engine.operations import Direction, OperationNotFound, OperationSource
+from engine.queue_loop import Loop
 from engine.script import ScriptSyntaxError, parse_script
 from engine.spec import KIND_CATEGORY, Category, NodeKind, NodeSpec, PlanSpec
 from engine.status import Status
@@ -154,6 +155,16 @@ def _builtin_factories(
         NodeKind.RUN_ONCE: lambda: RunOnce(ctx, node_id, label, cfg["then_skip"] == "true"),
         NodeKind.PRECONDITION: lambda: Precondition(
             ctx, node_id, label, cfg["if"], Status(cfg["else"]), key=scope.key
+        ),
+        NodeKind.LOOP: lambda: Loop(
+            ctx,
+            node_id,
+            label,
+            cfg["queue"],
+            cfg["value"],
+            cfg["type"],
+            Status(cfg["if_empty"]),
+            key=scope.key,
         ),
         NodeKind.SET_BLACKBOARD: lambda: SetBlackboard(
             ctx, node_id, label, cfg["value"], cfg["output_key"], key=scope.key

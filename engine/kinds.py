@@ -144,6 +144,19 @@ KIND_PORTS: dict[NodeKind, tuple[PortSpec, ...]] = {
             "RUNNING",
         ),
     ),
+    NodeKind.LOOP: (
+        _text("queue", "the values, separated by ; (or {key}: an entry holding them)"),
+        _text("value", "{key}: the entry each value is written to before the child runs"),
+        _words("type", "string", "the type of the values", "int", "double", "bool", "string"),
+        _words(
+            "if_empty",
+            "SUCCESS",
+            "the status when no value is left",
+            "SUCCESS",
+            "FAILURE",
+            "SKIPPED",
+        ),
+    ),
     NodeKind.SET_BLACKBOARD: (
         _text("value", "the value written; {key} copies the entry key"),
         _text("output_key", "the name of the entry written" + _ENTRY),
@@ -218,6 +231,8 @@ KIND_DOC: dict[NodeKind, str] = {
     NodeKind.RUN_ONCE: "Runs its child only the first time (BehaviorTree.CPP's RunOnce).",
     NodeKind.PRECONDITION: "Runs its child when a script is true (BehaviorTree.CPP's "
     "Precondition).",
+    NodeKind.LOOP: "Runs its child once for each value of a queue, the value in a named "
+    "parameter (BehaviorTree.CPP's LoopInt, LoopDouble, LoopBool, LoopString).",
     NodeKind.ALWAYS_SUCCESS: "Succeeds.",
     NodeKind.ALWAYS_FAILURE: "Fails.",
     NodeKind.SET_BLACKBOARD: "Sets a named parameter to a value (BehaviorTree.CPP's "

@@ -86,6 +86,8 @@ class NodeKind(str, enum.Enum):
     DELAY = "delay"
     RUN_ONCE = "run_once"
     PRECONDITION = "precondition"
+    # LoopInt, LoopDouble, LoopBool, LoopString: the element type is a setting.
+    LOOP = "loop"
     ALWAYS_SUCCESS = "always_success"
     ALWAYS_FAILURE = "always_failure"
     SET_BLACKBOARD = "set_blackboard"
@@ -125,6 +127,7 @@ KIND_CATEGORY: dict[NodeKind, Category] = {
     NodeKind.DELAY: Category.DECORATOR,
     NodeKind.RUN_ONCE: Category.DECORATOR,
     NodeKind.PRECONDITION: Category.DECORATOR,
+    NodeKind.LOOP: Category.DECORATOR,
     NodeKind.ALWAYS_SUCCESS: Category.LEAF,
     NodeKind.ALWAYS_FAILURE: Category.LEAF,
     NodeKind.SET_BLACKBOARD: Category.LEAF,

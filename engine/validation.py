@@ -33,6 +33,7 @@ from engine.operations import (
     OperationSource,
 )
 from engine.port_text import braced
+from engine.queue_loop import LOOP_TYPES, parse_queue
 from engine.script import ScriptError, ScriptNames, parse_script, script_names
 from engine.spec import (
     KIND_CATEGORY,
@@ -349,6 +350,8 @@ def _check_kind_rules(check: Check, node: NodeSpec) -> None:
         _check_parallel_all(check, node)
     elif node.kind is NodeKind.SWITCH:
         _check_switch_cases(check, node)
+    elif node.kind is NodeKind.LOOP:
+        _check_loop(check, node)
 
 
 # How many children some composites take: (the counts allowed, what to say).
@@ -378,6 +381,47 @@ def _check_switch_cases(check: Check, node: NodeSpec) -> None:
                 f"{node.label!r} has {cases} cases (one node each, and a default last), so "
                 f"{name!r} has no node to run.",
                 name,
+            )
+
+
+_LOOP_VALUE_TYPES = {
+    "int": ParamType.NUMBER,
+    "double": ParamType.NUMBER,
+    "bool": ParamType.BOOL,
+    "string": ParamType.TEXT,
+}
+
+
+def _loop_value_key(node: NodeSpec) -> str | None:
+    """The entry a Loop writes its values to (``{key}``), or None."""
+    value = _setting(node, "value")
+    return braced(value) or None if isinstance(value, str) else None
+
+
+def _check_loop(check: Check, node: NodeSpec) -> None:
+    """A Loop writes to ``{key}``; a queue written out must hold values of its type."""
+    of = _setting(node, "type")
+    key = _loop_value_key(node)
+    if key is None:
+        value = _setting(node, "value")
+        if value is not None:
+            check.add(
+                ERROR,
+                node,
+                f"'value' of {node.label!r} names the entry the values go to, as {{key}}, "
+                f"not {value!r}.",
+                "value",
+            )
+    elif of in _LOOP_VALUE_TYPES:
+        writer = Writer(repr(node.label), (_LOOP_VALUE_TYPES[of],), node)
+        check.writers.setdefault(key, []).append(writer)
+    queue = _setting(node, "queue")
+    if isinstance(queue, str) and braced(queue) is None and of in LOOP_TYPES:
+        try:
+            parse_queue(queue, of)
+        except ValueError as exc:
+            check.add(
+                ERROR, node, f"'queue' of {node.label!r} must hold {of} values: {exc}.", "queue"
             )
 
 
@@ -521,6 +565,8 @@ def _check_reads_of(check: Check, node: NodeSpec, available: frozenset[str]) -> 
         return written
     if node.kind is NodeKind.CATCH and len(children) == 2:
         return _catch_reads(check, node, available)
+    if node.kind is NodeKind.LOOP and (key := _loop_value_key(node)):
+        available = available | {key}  # written before the child runs
     results = [_check_reads(check, child, available) for child in children]
     if node.kind is NodeKind.PARALLEL:
         return _parallel_guarantee(node, results)

@@ -13,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from engine.spec import NodeKind
+from engine.spec import NodeKind, NodeSpec
 
 __all__ = [
     "BUILTIN_MODELS",
@@ -104,6 +104,7 @@ class LogicModel:
         element: its model type: Control, Decorator or Action.
         builtin: True when BehaviorTree.CPP has it; False: declared in the TreeNodesModel.
         settings: our setting name -> how it is written.
+        implied: settings the model's id gives, not written as ports (LoopInt: type int).
     """
 
     kind: NodeKind
@@ -111,6 +112,7 @@ class LogicModel:
     element: str
     builtin: bool = True
     settings: dict[str, SettingMap] = field(default_factory=dict)
+    implied: dict[str, str] = field(default_factory=dict)
 
 
 _SUCCESS = _words({"all": "-1", "any": "1"})
@@ -124,6 +126,25 @@ _CODE_IF = SettingMap("if", _word_text, _word_read)
 def _text(port: str) -> SettingMap:
     """A text port kept as written, ``{key}`` included."""
     return SettingMap(port, _word_text, _word_read, raw=True)
+
+
+_LOOP_TYPES = ("int", "double", "bool", "string")
+
+
+def _loop(of: str) -> LogicModel:
+    """LoopInt, LoopDouble, LoopBool or LoopString: our Loop with that ``type``."""
+    settings = {
+        "queue": _text("queue"),
+        "value": _text("value"),
+        "if_empty": SettingMap("if_empty", _word_text, _word_read),
+    }
+    return LogicModel(
+        NodeKind.LOOP,
+        f"Loop{of.capitalize()}",
+        "Decorator",
+        settings=settings,
+        implied={"type": of},
+    )
 
 
 def _switch_settings() -> dict[str, SettingMap]:
@@ -227,6 +248,7 @@ LOGIC: dict[NodeKind, LogicModel] = {
             "Decorator",
             settings={"if": _CODE_IF, "else": SettingMap("else", _word_text, _word_read)},
         ),
+        _loop("string"),
         LogicModel(NodeKind.ALWAYS_SUCCESS, "AlwaysSuccess", "Action"),
         LogicModel(NodeKind.ALWAYS_FAILURE, "AlwaysFailure", "Action"),
         LogicModel(
@@ -241,19 +263,25 @@ LOGIC: dict[NodeKind, LogicModel] = {
     )
 }
 SWITCH_MODELS = tuple(f"Switch{n}" for n in range(2, 7))
+_LOOPS = {m.model: m for m in map(_loop, ("int", "double", "bool", "string"))}
 LOGIC_BY_MODEL: dict[str, LogicModel] = {
-    **{m.model: m for m in LOGIC.values() if m.kind is not NodeKind.SWITCH},
+    **{m.model: m for m in LOGIC.values() if m.kind not in (NodeKind.SWITCH, NodeKind.LOOP)},
     **{model: LOGIC[NodeKind.SWITCH] for model in SWITCH_MODELS},
+    **_LOOPS,
 }
 
 
-def model_of(kind: NodeKind, children: int) -> str:
-    """BehaviorTree.CPP's id of a node of ``kind`` with that many children (a Switch's
-    number is its number of cases: the children less the default).
+def model_of(node: NodeSpec) -> str:
+    """BehaviorTree.CPP's id of a node: its kind's, a Switch's by its number of cases (its
+    children less the default), a Loop's by its type (LoopInt ...).
     """
-    if kind is NodeKind.SWITCH:
-        return f"Switch{children - 1}"
-    return LOGIC[kind].model
+    if node.kind is NodeKind.SWITCH:
+        return f"Switch{len(node.children) - 1}"
+    if node.kind is NodeKind.LOOP:
+        binding = node.params.get("type")
+        of = binding.value if binding is not None and isinstance(binding.value, str) else ""
+        return _loop(of if of in _LOOP_TYPES else "string").model
+    return LOGIC[node.kind].model
 
 
 # Every built-in id of BehaviorTree.CPP 4.10 (an operation's model id must not be one).

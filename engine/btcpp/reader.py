@@ -14,6 +14,7 @@ from engine.btcpp.read_parts import Model, ReaderBase, read_models
 from engine.btcpp.writer import UNUSED_OUTPUT
 from engine.btcpp.xmltree import Element, XmlSyntaxError, XmlTooLarge, parse, parse_file
 from engine.conditions import Condition
+from engine.kinds import kind_port
 from engine.kinds import setting as kind_setting
 from engine.operations import Direction, OperationManifest
 from engine.spec import (
@@ -251,6 +252,10 @@ class _Reader(ReaderBase):
 
     def _logic(self, element: Element, logic: LogicModel) -> NodeSpec:
         node = NodeSpec(logic.kind)
+        for name, given in logic.implied.items():
+            spec = kind_port(logic.kind, name)
+            if spec is None or given != spec.default:  # a default stays unbound, as made
+                node.params[name] = kind_setting(logic.kind, name, given)
         by_port = {m.port: (name, m) for name, m in logic.settings.items()}
         for port, text in self._ports(element).items():
             if port not in by_port:

@@ -103,14 +103,15 @@ def builtin_examples(one: One) -> dict[str, PlanSpec]:
         ),
         "btcpp_decorators": one(
             "btcpp_decorators",
-            "Delay, RunOnce, Precondition, KeepRunningUntilFailure",
+            "Delay, RunOnce, Precondition, KeepRunningUntilFailure, LoopInt",
             "BehaviorTree.CPP's decorators: a Delay of 0.1 s, a RunOnce that counts one try, a "
-            "Precondition on that count, and a KeepRunningUntilFailure that counts on until "
-            "the count reaches 3 (inverted: its failure is the success). Runs to SUCCESS.",
+            "Precondition on that count, a KeepRunningUntilFailure that counts on until "
+            "the count reaches 3 (inverted: its failure is the success), and a LoopInt that "
+            "adds up the sizes 1, 2 and 3. Runs to SUCCESS.",
             lambda m: m.node(
                 N.SEQUENCE,
                 "tries",
-                m.node(N.SCRIPT, "none yet", code="TRIES := 0"),
+                m.node(N.SCRIPT, "none yet", code="TRIES := 0; SUM := 0"),
                 m.node(N.DELAY, "settle", m.debug("succeed", "start"), seconds=0.1),
                 m.node(N.RUN_ONCE, "once", m.node(N.SCRIPT, "one try", code="TRIES += 1")),
                 m.node(
@@ -133,6 +134,15 @@ def builtin_examples(one: One) -> dict[str, PlanSpec]:
                         ),
                     ),
                 ),
+                m.node(
+                    N.LOOP,
+                    "each size",
+                    m.node(N.SCRIPT, "add it", code="SUM += SIZE"),
+                    queue="1;2;3",
+                    value="{SIZE}",
+                    type="int",
+                ),
+                m.node(N.SCRIPT_CONDITION, "all added", code="SUM == 6"),
             ),
         ),
     }
