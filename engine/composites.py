@@ -83,6 +83,7 @@ class _Resuming(_InOrder):
                 index += 1
                 if self.yields and status is next_on and before is IDLE and index < count:
                     self._index = index
+                    self.ctx.wake()  # BehaviorTree.CPP's emitWakeUpSignal: tick again soon
                     return RUNNING
                 continue
             self._index = index

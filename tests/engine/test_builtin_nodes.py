@@ -104,7 +104,10 @@ def test_sequence_with_memory_keeps_its_place_through_a_halt(ctx: Any) -> None:
 def test_async_sequence_gives_the_tick_back_after_each_immediate_success(ctx: Any) -> None:
     first, second, third = leaves(ctx, (SUCCESS,), (RUNNING, SUCCESS), (SUCCESS,))
     node = with_children(AsyncSequence(ctx, "a"), [first, second, third])
+    wakes: list[int] = []
+    ctx.wake = lambda: wakes.append(1)
     assert node.tick() is RUNNING and statuses([first, second, third]) == [SUCCESS, IDLE, IDLE]
+    assert wakes == [1]  # BehaviorTree.CPP's wake-up signal: the next tick comes at once
     assert node.tick() is RUNNING and second.status is RUNNING
     # second finishes after running: no tick is given back, third runs in the same tick
     assert node.tick() is SUCCESS and third.status is SUCCESS
