@@ -375,3 +375,13 @@ def test_precondition_of_a_missing_entry_fails_as_invalid_input(ctx: Any) -> Non
     (child,) = leaves(ctx, (SUCCESS,))
     node = with_children(Precondition(ctx, "p", "", "missing == 1"), [child])
     assert node.tick() is FAILURE and node.error is ErrorType.INVALID_INPUT
+
+
+def test_precondition_halted_while_its_child_runs_does_not_check_again(ctx: Any) -> None:
+    ctx.blackboard.set("a", 1)
+    (child,) = leaves(ctx, (RUNNING, SUCCESS))
+    node = with_children(Precondition(ctx, "p", "", "a == 1"), [child])
+    assert node.tick() is RUNNING
+    node.reset()
+    ctx.blackboard.set("a", 2)
+    assert node.tick() is SUCCESS  # BehaviorTree.CPP's halt keeps _children_running too
