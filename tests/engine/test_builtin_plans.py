@@ -22,8 +22,7 @@ EVERY_BUILTIN = """<root BTCPP_format="4" main_tree_to_execute="Main">
   <BehaviorTree ID="Main">
     <Sequence>
       <SetBlackboard value="2" output_key="mode"/>
-      <SetBlackboard value="{mode}" output_key="copy"/>
-      <Switch3 variable="{copy}" case_1="1" case_2="2" case_3="3">
+      <Switch3 variable="{mode}" case_1="1" case_2="2" case_3="3">
         <AlwaysFailure/>
         <Script code="picked := 'two'"/>
         <AlwaysFailure/>
@@ -59,6 +58,7 @@ EVERY_BUILTIN = """<root BTCPP_format="4" main_tree_to_execute="Main">
       </Inverter>
       <RunOnce then_skip="false"><AlwaysSuccess/></RunOnce>
       <Precondition if="picked == 'two'" else="FAILURE"><AlwaysSuccess/></Precondition>
+      <SetBlackboard value="{picked}" output_key="copy"/>
       <UnsetBlackboard key="copy"/>
     </Sequence>
   </BehaviorTree>
