@@ -104,10 +104,13 @@ class Sequence(_Resuming):
 class SequenceWithMemory(Sequence):
     """BehaviorTree.CPP's SequenceWithMemory: a Sequence that keeps its place through a
     failure and a halt, so that, ticked again, it resumes at the child that failed or was
-    running; it starts from the first child only after it has succeeded.
+    running; it starts from the first child only after it has succeeded. Like an
+    AsyncSequence (and as its source does), it gives the tick back after each child that
+    succeeded at once.
     """
 
     kind = "sequence_with_memory"
+    yields = True
 
     def update(self) -> Status:
         status = super().update()

@@ -83,19 +83,20 @@ def test_unset_blackboard_removes_an_entry_and_succeeds_without_one(ctx: Any) ->
 def test_sequence_with_memory_resumes_at_the_child_that_failed(ctx: Any) -> None:
     first, second, third = leaves(ctx, (SUCCESS,), (FAILURE, SUCCESS), (SUCCESS,))
     node = with_children(SequenceWithMemory(ctx, "s"), [first, second, third])
+    assert node.tick() is RUNNING  # like an AsyncSequence: the tick back after first
     assert node.tick() is FAILURE
     assert statuses([first, second, third]) == [SUCCESS, FAILURE, IDLE]
     node.reset()  # a retry: BehaviorTree.CPP's halt keeps the place
-    assert node.tick() is SUCCESS
+    assert [node.tick(), node.tick()] == [RUNNING, SUCCESS]
     assert (first.updates, second.updates, third.updates) == (1, 2, 1)
     node.reset()  # after a success it starts from the first child again
-    assert node.tick() is SUCCESS and first.updates == 2
+    assert node.tick() is RUNNING and first.updates == 2
 
 
 def test_sequence_with_memory_keeps_its_place_through_a_halt(ctx: Any) -> None:
     first, second = leaves(ctx, (SUCCESS,), (RUNNING, SUCCESS))
     node = with_children(SequenceWithMemory(ctx, "s"), [first, second])
-    assert node.tick() is RUNNING
+    assert [node.tick(), node.tick()] == [RUNNING, RUNNING] and second.status is RUNNING
     node.reset()
     assert second.halts == 1
     assert node.tick() is SUCCESS and first.updates == 1
