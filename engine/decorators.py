@@ -3,10 +3,13 @@
 Iterator and Enforce are the paper's (section III-B): Iterator resets its child on SUCCESS
 (repeat while it succeeds), Enforce resets it on FAILURE (retry until it succeeds); both take
 an optional count and timeout. Repeat(n) and Retry(n) are their counted forms under the
-names BehaviorTree.CPP and py_trees users know. A repeated child runs at most once per tick,
-so a child that succeeds at once cannot spin the engine.
+names BehaviorTree.CPP and py_trees users know, ticked as BehaviorTree.CPP ticks them. A
+child that finishes at once gives the tick back before its next round (Iterator and Enforce:
+any child), so a child that succeeds at once cannot spin the engine.
 
-Every decorator passes a SKIPPED child up (BehaviorTree.CPP's do): it is SKIPPED itself.
+Every decorator passes a SKIPPED child up (BehaviorTree.CPP's do): it is SKIPPED itself,
+except KeepRunningUntilFailure, which checks the child again on the next tick. Delay, RunOnce
+and Precondition are BehaviorTree.CPP's.
 """
 
 from __future__ import annotations
@@ -17,7 +20,7 @@ from engine.context import TreeContext
 from engine.error_types import ErrorType
 from engine.node import Node
 from engine.script import ScriptEnv, ScriptRunError, parse_script
-from engine.status import FAILURE, RUNNING, SKIPPED, SUCCESS, Status
+from engine.status import FAILURE, IDLE, RUNNING, SKIPPED, SUCCESS, Status
 
 __all__ = [
     "Decorator",
@@ -148,7 +151,14 @@ class _Looping(_Clocked):
         self.timeout = timeout
         self.done = 0
 
+    # BehaviorTree.CPP's Repeat and RetryUntilSuccessful: a child that finished after it had
+    # been running starts again in the same tick; one that finished at once gives the tick
+    # back (the next round on the next tick).
+    again_in_tick = False
+
     def update(self) -> Status:
+        if self.again_in_tick:
+            return self._btcpp_round()
         child, status = self._tick_child()
         if status is not RUNNING and status is not self.repeat_on:
             return status
@@ -164,6 +174,21 @@ class _Looping(_Clocked):
                 self.error = ErrorType.TIMEOUT
             return self.on_timeout
         return RUNNING
+
+    def _btcpp_round(self) -> Status:
+        child = self.children[0]
+        while True:
+            before = child.status
+            status = child.tick()
+            if status is not self.repeat_on:
+                return status
+            self.done += 1
+            if self.count is not None and self.done >= self.count:
+                return self._finish_count()
+            child.reset()
+            if before is IDLE:
+                self.ctx.wake()  # BehaviorTree.CPP's emitWakeUpSignal: tick again soon
+                return RUNNING
 
     def _finish_count(self) -> Status:
         if self.on_count is FAILURE:
@@ -205,6 +230,7 @@ class Repeat(Iterator):
     """Run the child ``count`` times while it succeeds (BehaviorTree.CPP's Repeat)."""
 
     kind = "repeat"
+    again_in_tick = True
 
     def __init__(self, ctx: TreeContext, node_id: str, name: str = "", count: int = 1) -> None:
         super().__init__(ctx, node_id, name, count=count)
@@ -214,6 +240,7 @@ class Retry(Enforce):
     """Try the child up to ``count`` times until it succeeds (RetryUntilSuccessful)."""
 
     kind = "retry"
+    again_in_tick = True
 
     def __init__(self, ctx: TreeContext, node_id: str, name: str = "", count: int = 1) -> None:
         super().__init__(ctx, node_id, name, count=count)

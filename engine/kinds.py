@@ -211,7 +211,8 @@ KIND_DOC: dict[NodeKind, str] = {
     NodeKind.SCRIPT_CONDITION: "Succeeds when a script's value is true, fails when it is false "
     "(BehaviorTree.CPP's ScriptCondition).",
     NodeKind.SEQUENCE_WITH_MEMORY: "A sequence that, run again after a failure, goes on from "
-    "the child that failed (BehaviorTree.CPP's SequenceWithMemory).",
+    "the child that failed, and lets a tick pass after each child that succeeded at once "
+    "(BehaviorTree.CPP's SequenceWithMemory).",
     NodeKind.ASYNC_SEQUENCE: "A sequence that lets a tick pass after each child that succeeded "
     "at once (BehaviorTree.CPP's AsyncSequence).",
     NodeKind.ASYNC_FALLBACK: "A selector that lets a tick pass after each child that failed at "
