@@ -11,25 +11,39 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from engine.blackboard import Blackboard, BlackboardError
+from engine.blackboard_leaves import (
+    AlwaysFailure,
+    AlwaysSuccess,
+    SetBlackboard,
+    UnsetBlackboard,
+)
 from engine.catch import Catch
 from engine.composites import (
+    AsyncFallback,
+    AsyncSequence,
     Parallel,
     ParallelPolicy,
     ReactiveSelector,
     ReactiveSequence,
     Selector,
     Sequence,
+    SequenceWithMemory,
 )
 from engine.conditions import Condition, NodeConditions
 from engine.context import TreeContext
+from engine.controls import IfThenElse, ParallelAll, Switch, TryCatch, WhileDoElse
 from engine.decorators import (
+    Delay,
     Enforce,
     ForceFailure,
     ForceSuccess,
     Inverter,
     Iterator,
+    KeepRunningUntilFailure,
+    Precondition,
     Repeat,
     Retry,
+    RunOnce,
     Timeout,
 )
 from engine.error_types import parse_error_types
@@ -39,8 +53,10 @@ from engine.kinds import settings_of
 from engine.leaves import OperationLeaf, ScriptLeaf, Wait
 from engine.node import Node
 from engine.operations import Direction, OperationNotFound, OperationSource
+from engine.queue_loop import Loop
 from engine.script import ScriptSyntaxError, parse_script
-from engine.spec import NodeKind, NodeSpec, PlanSpec
+from engine.spec import KIND_CATEGORY, Category, NodeKind, NodeSpec, PlanSpec
+from engine.status import Status
 from engine.tree import BehaviorTree, Root
 from engine.types import with_article
 
@@ -56,6 +72,14 @@ _SIMPLE: dict[NodeKind, type[Node]] = {
     NodeKind.INVERTER: Inverter,
     NodeKind.FORCE_SUCCESS: ForceSuccess,
     NodeKind.FORCE_FAILURE: ForceFailure,
+    NodeKind.SEQUENCE_WITH_MEMORY: SequenceWithMemory,
+    NodeKind.ASYNC_SEQUENCE: AsyncSequence,
+    NodeKind.ASYNC_FALLBACK: AsyncFallback,
+    NodeKind.IF_THEN_ELSE: IfThenElse,
+    NodeKind.WHILE_DO_ELSE: WhileDoElse,
+    NodeKind.KEEP_RUNNING_UNTIL_FAILURE: KeepRunningUntilFailure,
+    NodeKind.ALWAYS_SUCCESS: AlwaysSuccess,
+    NodeKind.ALWAYS_FAILURE: AlwaysFailure,
 }
 
 
@@ -107,8 +131,48 @@ def _logic_node(spec: NodeSpec, ctx: TreeContext, node_id: str, scope: Scope) ->
         NodeKind.SCRIPT_CONDITION: lambda: ScriptLeaf(
             ctx, node_id, label, cfg["code"], condition=True, key=scope.key
         ),
+        **_builtin_factories(cfg, ctx, node_id, label, scope),
     }
     return factories[spec.kind]()
+
+
+def _builtin_factories(
+    cfg: dict[str, Any], ctx: TreeContext, node_id: str, label: str, scope: Scope
+) -> dict[NodeKind, Callable[[], Node]]:
+    """The BehaviorTree.CPP built-ins that take settings."""
+    return {
+        NodeKind.PARALLEL_ALL: lambda: ParallelAll(ctx, node_id, label, int(cfg["max_failures"])),
+        NodeKind.SWITCH: lambda: Switch(
+            ctx,
+            node_id,
+            label,
+            cfg["variable"],
+            tuple(cfg[name] for name in sorted(cfg) if name.startswith("case_")),
+            key=scope.key,
+        ),
+        NodeKind.TRY_CATCH: lambda: TryCatch(ctx, node_id, label, cfg["catch_on_halt"] == "true"),
+        NodeKind.DELAY: lambda: Delay(ctx, node_id, label, float(cfg["seconds"])),
+        NodeKind.RUN_ONCE: lambda: RunOnce(ctx, node_id, label, cfg["then_skip"] == "true"),
+        NodeKind.PRECONDITION: lambda: Precondition(
+            ctx, node_id, label, cfg["if"], Status(cfg["else"]), key=scope.key
+        ),
+        NodeKind.LOOP: lambda: Loop(
+            ctx,
+            node_id,
+            label,
+            cfg["queue"],
+            cfg["value"],
+            cfg["type"],
+            Status(cfg["if_empty"]),
+            key=scope.key,
+        ),
+        NodeKind.SET_BLACKBOARD: lambda: SetBlackboard(
+            ctx, node_id, label, cfg["value"], cfg["output_key"], key=scope.key
+        ),
+        NodeKind.UNSET_BLACKBOARD: lambda: UnsetBlackboard(
+            ctx, node_id, label, cfg["key"], key=scope.key
+        ),
+    }
 
 
 def _operation_leaf(spec: NodeSpec, build: _Build, path: str, scope: Scope) -> Node:
@@ -232,7 +296,7 @@ def _build_node(spec: NodeSpec, build: _Build, path: str, scope: Scope) -> Node:
             _build_node(child, build, f"{path}/{child.label}[{index}]", scope)
             for index, child in enumerate(spec.children)
         ]
-        if isinstance(node, (OperationLeaf, Wait, ScriptLeaf)):
+        if KIND_CATEGORY[spec.kind] is Category.LEAF:
             if children:
                 raise BuildError(path, f"{with_article(spec.kind.value)} node cannot have children")
         else:

@@ -14,10 +14,13 @@ from __future__ import annotations
 
 from engine.context import TreeContext
 from engine.node import Node
-from engine.status import FAILURE, RUNNING, SKIPPED, SUCCESS, Status
+from engine.status import FAILURE, IDLE, RUNNING, SKIPPED, SUCCESS, Status
 
 __all__ = [
     "Sequence",
+    "SequenceWithMemory",
+    "AsyncSequence",
+    "AsyncFallback",
     "Selector",
     "Parallel",
     "ParallelPolicy",
@@ -54,7 +57,14 @@ class _InOrder(Node):
 
 
 class _Resuming(_InOrder):
-    """An in-order walk that keeps its place: a RUNNING child is resumed next tick."""
+    """An in-order walk that keeps its place: a RUNNING child is resumed next tick.
+
+    With ``yields`` (BehaviorTree.CPP's AsyncSequence and AsyncFallback), a child that gave
+    ``next_on`` on its first tick hands the tick back: the node is RUNNING and the next child
+    starts on the next tick.
+    """
+
+    yields = False
 
     def __init__(self, ctx: TreeContext, node_id: str, name: str = "") -> None:
         super().__init__(ctx, node_id, name)
@@ -67,9 +77,14 @@ class _Resuming(_InOrder):
         count = len(children)
         while index < count:
             child = children[index]
+            before = child.status
             status = child.tick()
             if status is next_on or status is SKIPPED:
                 index += 1
+                if self.yields and status is next_on and before is IDLE and index < count:
+                    self._index = index
+                    self.ctx.wake()  # BehaviorTree.CPP's emitWakeUpSignal: tick again soon
+                    return RUNNING
                 continue
             self._index = index
             return self._stopped(child, status)
@@ -86,6 +101,36 @@ class Sequence(_Resuming):
     kind = "sequence"
 
 
+class SequenceWithMemory(Sequence):
+    """BehaviorTree.CPP's SequenceWithMemory: a Sequence that keeps its place through a
+    failure and a halt, so that, ticked again, it resumes at the child that failed or was
+    running; it starts from the first child only after it has succeeded. Like an
+    AsyncSequence (and as its source does), it gives the tick back after each child that
+    succeeded at once.
+    """
+
+    kind = "sequence_with_memory"
+    yields = True
+
+    def update(self) -> Status:
+        status = super().update()
+        if self._index >= len(self.children):
+            self._index = 0
+        return status
+
+    def on_reset(self) -> None:
+        """Keeps its place: a reset is BehaviorTree.CPP's halt, which keeps it too."""
+
+
+class AsyncSequence(Sequence):
+    """BehaviorTree.CPP's AsyncSequence: a Sequence that gives the tick back after each child
+    that succeeded at once.
+    """
+
+    kind = "async_sequence"
+    yields = True
+
+
 class Selector(_Resuming):
     """Children in order until one succeeds; FAILURE when all failed (a fallback)."""
 
@@ -94,22 +139,36 @@ class Selector(_Resuming):
     exhausted_message = "every option failed"
 
 
+class AsyncFallback(Selector):
+    """BehaviorTree.CPP's AsyncFallback: a Selector that gives the tick back after each child
+    that failed at once.
+    """
+
+    kind = "async_fallback"
+    yields = True
+
+
 class ParallelPolicy:
     """When a Parallel finishes: ``success`` is "all", "any" or a count M; ``failure`` is
-    "any" (= 1) or a count N.
+    "any" (= 1) or a count N. A negative count is BehaviorTree.CPP's: -1 is every child,
+    -2 all but one, and so on (never below 0). A count of 0, which BehaviorTree.CPP takes,
+    is refused.
     """
 
     __slots__ = ("failure", "success")
 
     def __init__(self, success: str | int = "all", failure: str | int = "any") -> None:
-        if not (success in ("all", "any") or (isinstance(success, int) and success >= 1)):
-            raise ValueError(
-                f"success policy must be 'all', 'any' or a count >= 1, not {success!r}"
-            )
-        if not (failure == "any" or (isinstance(failure, int) and failure >= 1)):
-            raise ValueError(f"failure policy must be 'any' or a count >= 1, not {failure!r}")
+        if not (success in ("all", "any") or _is_count(success)):
+            raise ValueError(f"success policy must be 'all', 'any' or a count, not {success!r}")
+        if not (failure == "any" or _is_count(failure)):
+            raise ValueError(f"failure policy must be 'any' or a count, not {failure!r}")
         self.success = success
         self.failure = failure
+
+    @property
+    def counts_skipped(self) -> bool:
+        """A skipped child counts as a success (BehaviorTree.CPP: a negative success count)."""
+        return self.success == "all" or (isinstance(self.success, int) and self.success < 0)
 
     def thresholds(self, n_children: int) -> tuple[int, int]:
         """(successes needed, failures that end it) for ``n_children`` children."""
@@ -118,14 +177,25 @@ class ParallelPolicy:
         elif self.success == "any":
             need = 1
         else:
-            need = int(self.success)
-        fail = 1 if self.failure == "any" else int(self.failure)
-        return max(need, 0), fail
+            need = _threshold(int(self.success), n_children)
+        fail = 1 if self.failure == "any" else _threshold(int(self.failure), n_children)
+        return need, fail
+
+
+def _is_count(value: object) -> bool:
+    """A whole number other than 0 (a count of 0 would end the Parallel before it starts)."""
+    return isinstance(value, int) and not isinstance(value, bool) and value != 0
+
+
+def _threshold(count: int, n_children: int) -> int:
+    """A count of children; a negative one counts back from all of them."""
+    return max(n_children + count + 1, 0) if count < 0 else count
 
 
 class Parallel(Node):
-    """Ticks every unfinished child each tick; finishes by its policy and then halts the
-    children still running.
+    """Ticks every unfinished child each tick, in order, and finishes as soon as its policy
+    is met (the children after that one are not ticked); then halts the children still
+    running.
 
     A skipped child is checked afresh each tick. As in BehaviorTree.CPP (a success count of
     -1), a skipped child counts as a success for the policy "all"; when every child is
@@ -151,33 +221,44 @@ class Parallel(Node):
         self._need, self._fail = self.policy.thresholds(len(self.children))
 
     def update(self) -> Status:
-        succeeded = failed = skipped = 0
-        for child in self.children:
+        children = self.children
+        succeeded = sum(child.status is SUCCESS for child in children)
+        failed = sum(child.status is FAILURE for child in children)
+        skipped = 0
+        finished = self._finished(succeeded, failed, skipped)  # no children, or too few
+        if finished is not None:
+            return finished
+        for child in children:
             status = child.status
-            if status is SKIPPED:
-                status = child.recheck()
-            elif status is not SUCCESS and status is not FAILURE:
-                status = child.tick()
-            if status is SUCCESS:
-                succeeded += 1
-            elif status is FAILURE:
-                failed += 1
-            elif status is SKIPPED:
-                skipped += 1
+            if status is not SUCCESS and status is not FAILURE:
+                status = child.recheck() if status is SKIPPED else child.tick()
+                if status is SUCCESS:
+                    succeeded += 1
+                elif status is FAILURE:
+                    failed += 1
+                elif status is SKIPPED:
+                    skipped += 1
+            # As BehaviorTree.CPP's: the policy is checked after each child, so a Parallel
+            # that has its answer does not start the children after it.
+            finished = self._finished(succeeded, failed, skipped)
+            if finished is not None:
+                self._halt_running()
+                return finished
+        return SKIPPED if skipped and skipped == len(children) else RUNNING
+
+    def _finished(self, succeeded: int, failed: int, skipped: int) -> Status | None:
+        """SUCCESS or FAILURE when the policy is met by these counts, else None."""
+        if succeeded >= self._need or (
+            self.policy.counts_skipped and succeeded + skipped >= self._need
+        ):
+            return SUCCESS
         if failed >= self._fail:
-            self._halt_running()
             self.message = f"{failed} of {len(self.children)} failed"
             return FAILURE
-        if succeeded >= self._need or (
-            self.policy.success == "all" and succeeded + skipped >= self._need
-        ):
-            self._halt_running()
-            return SUCCESS
         if len(self.children) - failed < self._need:
-            self._halt_running()
             self.message = "too many children failed to reach the success policy"
             return FAILURE
-        return SKIPPED if skipped and skipped == len(self.children) else RUNNING
+        return None
 
     def _halt_running(self) -> None:
         for child in self.children:

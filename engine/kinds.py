@@ -11,6 +11,7 @@ reference would be read at no defined moment. Validation says so when a file bin
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from typing import Any
 
@@ -41,6 +42,20 @@ def _count(name: str, doc: str, default: float | None = None) -> PortSpec:
 
 def _seconds(name: str, doc: str, default: float | None = None) -> PortSpec:
     return PortSpec(name, (_D,), default=default, unit="s", doc=doc)
+
+
+def _words(name: str, default: str, doc: str, *words: str) -> PortSpec:
+    """A port that takes one of a few words (BehaviorTree.CPP's bool or NodeStatus)."""
+    return PortSpec(name, (_T,), default=default, doc=doc, choices=words)
+
+
+def _text(name: str, doc: str, default: str | None = None) -> PortSpec:
+    return PortSpec(name, (_T,), default=default, doc=doc)
+
+
+_ENTRY = " ({key} reads the entry key)"
+_BOOL_WORDS = ("true", "false")
+_SWITCH_CASES = 6  # Switch2 .. Switch6
 
 
 def _policy(name: str, default: str, doc: str) -> PortSpec:
@@ -86,8 +101,74 @@ KIND_PORTS: dict[NodeKind, tuple[PortSpec, ...]] = {
     NodeKind.SCRIPT_CONDITION: (
         PortSpec("code", (_T,), doc="the script; its last value, true or false, is the answer"),
     ),
+    NodeKind.PARALLEL_ALL: (
+        _count(
+            "max_failures",
+            "fail when at least this many children failed (negative: counted back from all)",
+            1.0,
+        ),
+    ),
+    NodeKind.SWITCH: (
+        _text("variable", "the text compared with the cases" + _ENTRY),
+        *(
+            _text(f"case_{n}", f"the child {n} runs when the variable equals this" + _ENTRY, "")
+            for n in range(1, _SWITCH_CASES + 1)
+        ),
+    ),
+    NodeKind.TRY_CATCH: (
+        _words(
+            "catch_on_halt",
+            "false",
+            "run the catch child when the node is halted during the try block",
+            *_BOOL_WORDS,
+        ),
+    ),
+    NodeKind.DELAY: (_seconds("seconds", "how long to wait before the child starts"),),
+    NodeKind.RUN_ONCE: (
+        _words(
+            "then_skip",
+            "true",
+            "after the first run, skip (true) or give the first result again (false)",
+            *_BOOL_WORDS,
+        ),
+    ),
+    NodeKind.PRECONDITION: (
+        _text("if", "the script; the child runs when its value is true"),
+        _words(
+            "else",
+            "FAILURE",
+            "the status when the script is false",
+            "FAILURE",
+            "SUCCESS",
+            "SKIPPED",
+            "RUNNING",
+        ),
+    ),
+    NodeKind.LOOP: (
+        _text("queue", "the values, separated by ; (or {key}: an entry holding them)"),
+        _text("value", "{key}: the entry each value is written to before the child runs"),
+        _words("type", "string", "the type of the values", "int", "double", "bool", "string"),
+        _words(
+            "if_empty",
+            "SUCCESS",
+            "the status when no value is left",
+            "SUCCESS",
+            "FAILURE",
+            "SKIPPED",
+        ),
+    ),
+    NodeKind.SET_BLACKBOARD: (
+        _text("value", "the value written; {key} copies the entry key"),
+        _text("output_key", "the name of the entry written" + _ENTRY),
+    ),
+    NodeKind.UNSET_BLACKBOARD: (_text("key", "the name of the entry removed" + _ENTRY),),
 }
-_SCRIPT_KINDS = (NodeKind.SCRIPT, NodeKind.SCRIPT_CONDITION)
+# The ports that hold a script.
+_SCRIPT_PORTS = {
+    (NodeKind.SCRIPT, "code"),
+    (NodeKind.SCRIPT_CONDITION, "code"),
+    (NodeKind.PRECONDITION, "if"),
+}
 
 # What a fixed value of each port must be beyond its type: (minimum, whole number).
 _LIMITS: dict[tuple[NodeKind, str], tuple[float, bool]] = {
@@ -99,9 +180,13 @@ _LIMITS: dict[tuple[NodeKind, str], tuple[float, bool]] = {
     (NodeKind.RETRY, "count"): (1, True),
     (NodeKind.WAIT, "seconds"): (0, False),
     (NodeKind.TIMEOUT, "seconds"): (0, False),
-    (NodeKind.PARALLEL, "success"): (1, True),
-    (NodeKind.PARALLEL, "failure"): (1, True),
+    (NodeKind.PARALLEL, "success"): (-math.inf, True),
+    (NodeKind.PARALLEL, "failure"): (-math.inf, True),
+    (NodeKind.PARALLEL_ALL, "max_failures"): (-math.inf, True),
+    (NodeKind.DELAY, "seconds"): (0, False),
 }
+# Counts that may be negative (counted back from the number of children) but not 0.
+_NONZERO = {(NodeKind.PARALLEL, "success"), (NodeKind.PARALLEL, "failure")}
 
 KIND_DOC: dict[NodeKind, str] = {
     NodeKind.SEQUENCE: "Runs children in order; fails at the first failure.",
@@ -125,6 +210,35 @@ KIND_DOC: dict[NodeKind, str] = {
     NodeKind.SCRIPT: "Runs a script that sets named parameters (BehaviorTree.CPP's Script).",
     NodeKind.SCRIPT_CONDITION: "Succeeds when a script's value is true, fails when it is false "
     "(BehaviorTree.CPP's ScriptCondition).",
+    NodeKind.SEQUENCE_WITH_MEMORY: "A sequence that, run again after a failure, goes on from "
+    "the child that failed, and lets a tick pass after each child that succeeded at once "
+    "(BehaviorTree.CPP's SequenceWithMemory).",
+    NodeKind.ASYNC_SEQUENCE: "A sequence that lets a tick pass after each child that succeeded "
+    "at once (BehaviorTree.CPP's AsyncSequence).",
+    NodeKind.ASYNC_FALLBACK: "A selector that lets a tick pass after each child that failed at "
+    "once (BehaviorTree.CPP's AsyncFallback).",
+    NodeKind.PARALLEL_ALL: "Runs all children to the end at the same time; fails when too many "
+    "failed (BehaviorTree.CPP's ParallelAll).",
+    NodeKind.IF_THEN_ELSE: "Runs its second node when its first succeeds, else its third "
+    "(BehaviorTree.CPP's IfThenElse).",
+    NodeKind.WHILE_DO_ELSE: "Checks its first node every tick: runs the second while it "
+    "succeeds, the third when it fails (BehaviorTree.CPP's WhileDoElse).",
+    NodeKind.SWITCH: "Runs the node of the case that equals the variable, else the last node "
+    "(BehaviorTree.CPP's Switch2 to Switch6).",
+    NodeKind.TRY_CATCH: "Runs its nodes in order; when one fails, runs the last node, then "
+    "fails (BehaviorTree.CPP's TryCatch).",
+    NodeKind.KEEP_RUNNING_UNTIL_FAILURE: "Runs its child again and again until it fails.",
+    NodeKind.DELAY: "Waits a number of seconds, then runs its child.",
+    NodeKind.RUN_ONCE: "Runs its child only the first time (BehaviorTree.CPP's RunOnce).",
+    NodeKind.PRECONDITION: "Runs its child when a script is true (BehaviorTree.CPP's "
+    "Precondition).",
+    NodeKind.LOOP: "Runs its child once for each value of a queue, the value in a named "
+    "parameter (BehaviorTree.CPP's LoopInt, LoopDouble, LoopBool, LoopString).",
+    NodeKind.ALWAYS_SUCCESS: "Succeeds.",
+    NodeKind.ALWAYS_FAILURE: "Fails.",
+    NodeKind.SET_BLACKBOARD: "Sets a named parameter to a value (BehaviorTree.CPP's "
+    "SetBlackboard).",
+    NodeKind.UNSET_BLACKBOARD: "Removes a named parameter (BehaviorTree.CPP's UnsetBlackboard).",
     NodeKind.OPERATION: "Runs a capability operation.",
 }
 
@@ -153,20 +267,26 @@ def check_setting(kind: NodeKind, name: str, value: Any) -> str | None:
     if isinstance(value, str):
         if kind is NodeKind.CATCH and name == "errors":
             return _error_list_problem(value)
-        if kind in _SCRIPT_KINDS and name == "code":
+        if (kind, name) in _SCRIPT_PORTS:
             return _script_problem(value)
         return None  # a word: checked against the port's choices
     minimum, whole = _LIMITS.get((kind, name), (0.0, False))
     strict = kind is NodeKind.TIMEOUT  # a time limit of 0 would fail at once
     is_number = isinstance(value, (int, float)) and not isinstance(value, bool)
+    nonzero = (kind, name) in _NONZERO
     if (
         is_number
         and (value > minimum if strict else value >= minimum)
         and (not whole or float(value).is_integer())
+        and not (nonzero and value == 0)
     ):
         return None
+    if nonzero:
+        return "a whole number other than 0"
     if whole:
-        return f"a whole number of at least {minimum:g}"
+        return (
+            "a whole number" if minimum == -math.inf else f"a whole number of at least {minimum:g}"
+        )
     return "a number of seconds above 0" if strict else "a number of seconds, 0 or more"
 
 
@@ -219,7 +339,8 @@ def settings_of(kind: NodeKind, params: Mapping[str, Binding]) -> dict[str, Any]
             and port.choices
             and value not in port.choices
         ):
-            expected = f"one of {', '.join(port.choices)} or a count"
+            counts = " or a count" if ParamType.NUMBER in port.types else ""
+            expected = f"one of {', '.join(port.choices)}{counts}"
         if expected is not None:
             shown = f"{value:g}" if isinstance(value, float) else repr(value)
             raise ValueError(f"{port.name!r} must be {expected}, not {shown}")

@@ -72,6 +72,26 @@ class NodeKind(str, enum.Enum):
     # run on the blackboard; the condition succeeds when the script's value is true.
     SCRIPT = "script"
     SCRIPT_CONDITION = "script_condition"
+    # More of BehaviorTree.CPP 4.10's built-in nodes, under its semantics (engine.builtins).
+    SEQUENCE_WITH_MEMORY = "sequence_with_memory"
+    ASYNC_SEQUENCE = "async_sequence"
+    ASYNC_FALLBACK = "async_fallback"
+    PARALLEL_ALL = "parallel_all"
+    IF_THEN_ELSE = "if_then_else"
+    WHILE_DO_ELSE = "while_do_else"
+    # Switch2 .. Switch6: the number of cases is the number of children less the default.
+    SWITCH = "switch"
+    TRY_CATCH = "try_catch"
+    KEEP_RUNNING_UNTIL_FAILURE = "keep_running_until_failure"
+    DELAY = "delay"
+    RUN_ONCE = "run_once"
+    PRECONDITION = "precondition"
+    # LoopInt, LoopDouble, LoopBool, LoopString: the element type is a setting.
+    LOOP = "loop"
+    ALWAYS_SUCCESS = "always_success"
+    ALWAYS_FAILURE = "always_failure"
+    SET_BLACKBOARD = "set_blackboard"
+    UNSET_BLACKBOARD = "unset_blackboard"
     OPERATION = "operation"
     # An instance of a library subtree: one leaf in the plan's tree, expanded when built.
     SUBTREE = "subtree"
@@ -95,6 +115,23 @@ KIND_CATEGORY: dict[NodeKind, Category] = {
     NodeKind.WAIT: Category.LEAF,
     NodeKind.SCRIPT: Category.LEAF,
     NodeKind.SCRIPT_CONDITION: Category.LEAF,
+    NodeKind.SEQUENCE_WITH_MEMORY: Category.COMPOSITE,
+    NodeKind.ASYNC_SEQUENCE: Category.COMPOSITE,
+    NodeKind.ASYNC_FALLBACK: Category.COMPOSITE,
+    NodeKind.PARALLEL_ALL: Category.COMPOSITE,
+    NodeKind.IF_THEN_ELSE: Category.COMPOSITE,
+    NodeKind.WHILE_DO_ELSE: Category.COMPOSITE,
+    NodeKind.SWITCH: Category.COMPOSITE,
+    NodeKind.TRY_CATCH: Category.COMPOSITE,
+    NodeKind.KEEP_RUNNING_UNTIL_FAILURE: Category.DECORATOR,
+    NodeKind.DELAY: Category.DECORATOR,
+    NodeKind.RUN_ONCE: Category.DECORATOR,
+    NodeKind.PRECONDITION: Category.DECORATOR,
+    NodeKind.LOOP: Category.DECORATOR,
+    NodeKind.ALWAYS_SUCCESS: Category.LEAF,
+    NodeKind.ALWAYS_FAILURE: Category.LEAF,
+    NodeKind.SET_BLACKBOARD: Category.LEAF,
+    NodeKind.UNSET_BLACKBOARD: Category.LEAF,
     NodeKind.OPERATION: Category.LEAF,
     NodeKind.SUBTREE: Category.LEAF,
 }

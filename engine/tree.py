@@ -127,6 +127,9 @@ _SKIPPED_AS: dict[str, Status] = {
     "reactive_sequence": SUCCESS,
     "selector": FAILURE,
     "reactive_selector": FAILURE,
+    "sequence_with_memory": SUCCESS,
+    "async_sequence": SUCCESS,
+    "async_fallback": FAILURE,
 }
 
 

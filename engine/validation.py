@@ -32,6 +32,8 @@ from engine.operations import (
     OperationNotFound,
     OperationSource,
 )
+from engine.port_text import braced
+from engine.queue_loop import LOOP_TYPES, parse_queue
 from engine.script import ScriptError, ScriptNames, parse_script, script_names
 from engine.spec import (
     KIND_CATEGORY,
@@ -144,6 +146,13 @@ def validate_plan(
 
 
 _SCRIPTS = (NodeKind.SCRIPT, NodeKind.SCRIPT_CONDITION)
+# Composites whose children run one after the other, each after the one before succeeded.
+_SEQUENCES = (
+    NodeKind.SEQUENCE,
+    NodeKind.REACTIVE_SEQUENCE,
+    NodeKind.SEQUENCE_WITH_MEMORY,
+    NodeKind.ASYNC_SEQUENCE,
+)
 
 
 def _names_of_script(node: NodeSpec) -> ScriptNames | None:
@@ -296,10 +305,30 @@ def _check_structure(check: Check, node: NodeSpec) -> None:
     if not isinstance(node.kind, NodeKind):
         check.add(ERROR, node, f"Unknown kind of node {node.kind!r}; it cannot run.")
         return
+    _check_children(check, node)
+    count, label = len(node.children), node.label
+    if node.kind not in (NodeKind.OPERATION, NodeKind.SUBTREE):
+        _check_kind_ports(check, node)
+    if count:
+        _check_kind_rules(check, node)
+    if node.kind is NodeKind.SET_BLACKBOARD and (key := _written_key(node)):
+        check.writers.setdefault(key, []).append(Writer(repr(label), (ParamType.ANY,), node))
+    if node.kind is NodeKind.CATCH:
+        key = _setting(node, "error")
+        if isinstance(key, str) and key:  # it writes the caught error there, as Text
+            check.writers.setdefault(key, []).append(Writer(repr(label), (ParamType.TEXT,), node))
+    if node.kind is not NodeKind.OPERATION and node.op:
+        check.add(WARNING, node, f"{label!r} is not an operation; its operation is ignored.")
+
+
+def _check_children(check: Check, node: NodeSpec) -> None:
+    """The number of children the node's kind takes."""
     category, count, label = KIND_CATEGORY[node.kind], len(node.children), node.label
     if category is Category.DECORATOR and count != 1:
         need = "needs one node below it" if count == 0 else f"can hold only one node, not {count}"
         check.add(ERROR, node, f"{label!r} {need}.")
+    elif node.kind in _CHILD_COUNTS and count not in _CHILD_COUNTS[node.kind][0]:
+        check.add(ERROR, node, f"{label!r} needs {_CHILD_COUNTS[node.kind][1]}; it has {count}.")
     elif node.kind is NodeKind.CATCH and count != 2:
         check.add(
             ERROR,
@@ -311,16 +340,101 @@ def _check_structure(check: Check, node: NodeSpec) -> None:
         check.add(ERROR, node, f"{label!r} has no nodes below it: add some or remove it.")
     elif category is Category.LEAF and count:
         check.add(ERROR, node, f"{label!r} cannot have nodes below it; it has {count}.")
-    if node.kind not in (NodeKind.OPERATION, NodeKind.SUBTREE):
-        _check_kind_ports(check, node)
-    if node.kind is NodeKind.PARALLEL and count:
+
+
+def _check_kind_rules(check: Check, node: NodeSpec) -> None:
+    """Settings checked against the number of children."""
+    if node.kind is NodeKind.PARALLEL:
         _check_parallel_policy(check, node)
-    if node.kind is NodeKind.CATCH:
-        key = _setting(node, "error")
-        if isinstance(key, str) and key:  # it writes the caught error there, as Text
-            check.writers.setdefault(key, []).append(Writer(repr(label), (ParamType.TEXT,), node))
-    if node.kind is not NodeKind.OPERATION and node.op:
-        check.add(WARNING, node, f"{label!r} is not an operation; its operation is ignored.")
+    elif node.kind is NodeKind.PARALLEL_ALL:
+        _check_parallel_all(check, node)
+    elif node.kind is NodeKind.SWITCH:
+        _check_switch_cases(check, node)
+    elif node.kind is NodeKind.LOOP:
+        _check_loop(check, node)
+
+
+# How many children some composites take: (the counts allowed, what to say).
+_CHILD_COUNTS: dict[NodeKind, tuple[range, str]] = {
+    NodeKind.IF_THEN_ELSE: (range(2, 4), "two or three nodes below it: if, then, else"),
+    NodeKind.WHILE_DO_ELSE: (range(2, 4), "two or three nodes below it: while, do, else"),
+    NodeKind.SWITCH: (range(3, 8), "from three to seven nodes below it: 2 to 6 cases, a default"),
+    NodeKind.TRY_CATCH: (range(2, 1 << 16), "two or more nodes below it: try, then catch"),
+}
+
+
+def _written_key(node: NodeSpec) -> str | None:
+    """The entry a SetBlackboard writes when its output_key names it (not ``{key}``)."""
+    key = _setting(node, "output_key")
+    if not isinstance(key, str) or not key.strip() or braced(key) is not None:
+        return None
+    return key.strip()
+
+
+def _check_switch_cases(check: Check, node: NodeSpec) -> None:
+    cases = len(node.children) - 1
+    for name, binding in node.params.items():
+        if name.startswith("case_") and int(name[5:]) > cases and binding.value not in ("", None):
+            check.add(
+                ERROR,
+                node,
+                f"{node.label!r} has {cases} cases (one node each, and a default last), so "
+                f"{name!r} has no node to run.",
+                name,
+            )
+
+
+_LOOP_VALUE_TYPES = {
+    "int": ParamType.NUMBER,
+    "double": ParamType.NUMBER,
+    "bool": ParamType.BOOL,
+    "string": ParamType.TEXT,
+}
+
+
+def _loop_value_key(node: NodeSpec) -> str | None:
+    """The entry a Loop writes its values to (``{key}``), or None."""
+    value = _setting(node, "value")
+    return braced(value) or None if isinstance(value, str) else None
+
+
+def _check_loop(check: Check, node: NodeSpec) -> None:
+    """A Loop writes to ``{key}``; a queue written out must hold values of its type."""
+    of = _setting(node, "type")
+    key = _loop_value_key(node)
+    if key is None:
+        value = _setting(node, "value")
+        if value is not None:
+            check.add(
+                ERROR,
+                node,
+                f"'value' of {node.label!r} names the entry the values go to, as {{key}}, "
+                f"not {value!r}.",
+                "value",
+            )
+    elif of in _LOOP_VALUE_TYPES:
+        writer = Writer(repr(node.label), (_LOOP_VALUE_TYPES[of],), node)
+        check.writers.setdefault(key, []).append(writer)
+    queue = _setting(node, "queue")
+    if isinstance(queue, str) and braced(queue) is None and of in LOOP_TYPES:
+        try:
+            parse_queue(queue, of)
+        except ValueError as exc:
+            check.add(
+                ERROR, node, f"'queue' of {node.label!r} must hold {of} values: {exc}.", "queue"
+            )
+
+
+def _check_parallel_all(check: Check, node: NodeSpec) -> None:
+    count = len(node.children)
+    wanted = _setting(node, "max_failures")
+    if isinstance(wanted, (int, float)) and wanted > count:
+        check.add(
+            ERROR,
+            node,
+            f"{node.label!r} fails after {wanted:g} failures but has only {count} children.",
+            "max_failures",
+        )
 
 
 def _setting(node: NodeSpec, name: str) -> Any:
@@ -441,6 +555,32 @@ def _check_writer_types(check: Check) -> None:
 
 def _check_reads_of(check: Check, node: NodeSpec, available: frozenset[str]) -> frozenset[str]:
     """:func:`_check_reads` of the node itself (its kind), without its conditions."""
+    if KIND_CATEGORY.get(node.kind) is Category.LEAF:
+        return _leaf_reads(check, node, available)
+    children = node.children
+    if node.kind in _SEQUENCES:
+        written: frozenset[str] = frozenset()
+        for child in children:
+            written |= _check_reads(check, child, available | written)
+        return written
+    if node.kind is NodeKind.CATCH and len(children) == 2:
+        return _catch_reads(check, node, available)
+    if node.kind is NodeKind.LOOP and (key := _loop_value_key(node)):
+        available = available | {key}  # written before the child runs
+    results = [_check_reads(check, child, available) for child in children]
+    if node.kind is NodeKind.PARALLEL:
+        return _parallel_guarantee(node, results)
+    if node.kind in (NodeKind.SELECTOR, NodeKind.REACTIVE_SELECTOR, NodeKind.ASYNC_FALLBACK):
+        return frozenset.intersection(*results) if results else frozenset()
+    if node.kind is NodeKind.ITERATOR and _setting(node, "timeout"):
+        return frozenset()
+    if node.kind in _PASS_CHILD and len(results) == 1:
+        return results[0]
+    return frozenset()
+
+
+def _leaf_reads(check: Check, node: NodeSpec, available: frozenset[str]) -> frozenset[str]:
+    """:func:`_check_reads_of` of a leaf."""
     if node.kind is NodeKind.OPERATION:
         return _operation_reads(check, node, available)
     if node.kind in _SCRIPTS:
@@ -449,23 +589,9 @@ def _check_reads_of(check: Check, node: NodeSpec, available: frozenset[str]) -> 
         for name in check.crossing_reads.get(id(node), ()):
             _check_reference(check, node, name, name, (ParamType.ANY,), available)
         return _operation_reads(check, node, available)
-    children = node.children
-    if node.kind in (NodeKind.SEQUENCE, NodeKind.REACTIVE_SEQUENCE):
-        written: frozenset[str] = frozenset()
-        for child in children:
-            written |= _check_reads(check, child, available | written)
-        return written
-    if node.kind is NodeKind.CATCH and len(children) == 2:
-        return _catch_reads(check, node, available)
-    results = [_check_reads(check, child, available) for child in children]
-    if node.kind is NodeKind.PARALLEL:
-        return _parallel_guarantee(node, results)
-    if node.kind in (NodeKind.SELECTOR, NodeKind.REACTIVE_SELECTOR):
-        return frozenset.intersection(*results) if results else frozenset()
-    if node.kind is NodeKind.ITERATOR and _setting(node, "timeout"):
-        return frozenset()
-    if node.kind in _PASS_CHILD and len(results) == 1:
-        return results[0]
+    if node.kind is NodeKind.SET_BLACKBOARD:
+        key = _written_key(node)
+        return frozenset({key}) if key else frozenset()
     return frozenset()
 
 
@@ -487,6 +613,8 @@ def _parallel_guarantee(node: NodeSpec, results: list[frozenset[str]]) -> frozen
     need = len(results) if policy == "all" else 1 if policy == "any" else policy
     if not isinstance(need, (int, float)) or isinstance(need, bool):
         return frozenset()
+    if need < 0:  # counted back from all children
+        need = max(len(results) + need + 1, 0)
     every = frozenset().union(*results)
     return frozenset(n for n in every if sum(n not in r for r in results) < need)
 

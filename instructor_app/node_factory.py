@@ -50,6 +50,7 @@ _START_VALUES: dict[NodeKind, float] = {
     NodeKind.RETRY: 2,
     NodeKind.TIMEOUT: 5.0,
     NodeKind.WAIT: 1.0,
+    NodeKind.DELAY: 1.0,
 }
 
 

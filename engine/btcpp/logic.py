@@ -13,9 +13,17 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from engine.spec import NodeKind
+from engine.spec import NodeKind, NodeSpec
 
-__all__ = ["BUILTIN_MODELS", "LOGIC", "LOGIC_BY_MODEL", "LogicModel", "SettingMap"]
+__all__ = [
+    "BUILTIN_MODELS",
+    "LOGIC",
+    "LOGIC_BY_MODEL",
+    "LogicModel",
+    "SWITCH_MODELS",
+    "SettingMap",
+    "model_of",
+]
 
 Setting = str | float
 
@@ -62,13 +70,28 @@ def _msec_read(text: str) -> Setting:
     return int(text) / 1000.0
 
 
+_BOOL_WORDS = {"true": "true", "True": "true", "TRUE": "true", "1": "true"}
+_BOOL_WORDS |= {"false": "false", "False": "false", "FALSE": "false", "0": "false"}
+
+
+def _bool_read(text: str) -> Setting:
+    """A bool port's text as our word, true or false (BehaviorTree.CPP's spellings)."""
+    if text.strip() not in _BOOL_WORDS:
+        raise ValueError(f"true or false, not {text!r}")
+    return _BOOL_WORDS[text.strip()]
+
+
 @dataclass(frozen=True)
 class SettingMap:
-    """One setting of a kind: its port in BehaviorTree.CPP and the text both ways."""
+    """One setting of a kind: its port in BehaviorTree.CPP and the text both ways.
+
+    ``raw``: the text is kept as it is, ``{key}`` too (the node reads the entry itself).
+    """
 
     port: str
     write: Callable[[Setting], str] = _count_text
     read: Callable[[str], Setting] = _number
+    raw: bool = False
 
 
 @dataclass(frozen=True)
@@ -81,6 +104,7 @@ class LogicModel:
         element: its model type: Control, Decorator or Action.
         builtin: True when BehaviorTree.CPP has it; False: declared in the TreeNodesModel.
         settings: our setting name -> how it is written.
+        implied: settings the model's id gives, not written as ports (LoopInt: type int).
     """
 
     kind: NodeKind
@@ -88,12 +112,45 @@ class LogicModel:
     element: str
     builtin: bool = True
     settings: dict[str, SettingMap] = field(default_factory=dict)
+    implied: dict[str, str] = field(default_factory=dict)
 
 
 _SUCCESS = _words({"all": "-1", "any": "1"})
 _FAILURE = _words({"any": "1"})
 _MSEC = SettingMap("msec", _msec_text, _msec_read)
 _CODE = SettingMap("code", _word_text, _word_read)  # a script, as it is
+_BOOL = (_word_text, _bool_read)
+_CODE_IF = SettingMap("if", _word_text, _word_read)
+
+
+def _text(port: str) -> SettingMap:
+    """A text port kept as written, ``{key}`` included."""
+    return SettingMap(port, _word_text, _word_read, raw=True)
+
+
+_LOOP_TYPES = ("int", "double", "bool", "string")
+
+
+def _loop(of: str) -> LogicModel:
+    """LoopInt, LoopDouble, LoopBool or LoopString: our Loop with that ``type``."""
+    settings = {
+        "queue": _text("queue"),
+        "value": _text("value"),
+        "if_empty": SettingMap("if_empty", _word_text, _word_read),
+    }
+    return LogicModel(
+        NodeKind.LOOP,
+        f"Loop{of.capitalize()}",
+        "Decorator",
+        settings=settings,
+        implied={"type": of},
+    )
+
+
+def _switch_settings() -> dict[str, SettingMap]:
+    cases = {f"case_{n}": _text(f"case_{n}") for n in range(1, 7)}
+    return {"variable": _text("variable"), **cases}
+
 
 LOGIC: dict[NodeKind, LogicModel] = {
     m.kind: m
@@ -153,9 +210,79 @@ LOGIC: dict[NodeKind, LogicModel] = {
         LogicModel(
             NodeKind.SCRIPT_CONDITION, "ScriptCondition", "Condition", settings={"code": _CODE}
         ),
+        LogicModel(NodeKind.SEQUENCE_WITH_MEMORY, "SequenceWithMemory", "Control"),
+        LogicModel(NodeKind.ASYNC_SEQUENCE, "AsyncSequence", "Control"),
+        LogicModel(NodeKind.ASYNC_FALLBACK, "AsyncFallback", "Control"),
+        LogicModel(
+            NodeKind.PARALLEL_ALL,
+            "ParallelAll",
+            "Control",
+            settings={"max_failures": SettingMap("max_failures")},
+        ),
+        LogicModel(NodeKind.IF_THEN_ELSE, "IfThenElse", "Control"),
+        LogicModel(NodeKind.WHILE_DO_ELSE, "WhileDoElse", "Control"),
+        # Written Switch2 .. Switch6 by its number of children (switch_model).
+        LogicModel(NodeKind.SWITCH, "Switch", "Control", settings=_switch_settings()),
+        LogicModel(
+            NodeKind.TRY_CATCH,
+            "TryCatch",
+            "Control",
+            settings={"catch_on_halt": SettingMap("catch_on_halt", *_BOOL)},
+        ),
+        LogicModel(NodeKind.KEEP_RUNNING_UNTIL_FAILURE, "KeepRunningUntilFailure", "Decorator"),
+        LogicModel(
+            NodeKind.DELAY,
+            "Delay",
+            "Decorator",
+            settings={"seconds": SettingMap("delay_msec", _msec_text, _msec_read)},
+        ),
+        LogicModel(
+            NodeKind.RUN_ONCE,
+            "RunOnce",
+            "Decorator",
+            settings={"then_skip": SettingMap("then_skip", *_BOOL)},
+        ),
+        LogicModel(
+            NodeKind.PRECONDITION,
+            "Precondition",
+            "Decorator",
+            settings={"if": _CODE_IF, "else": SettingMap("else", _word_text, _word_read)},
+        ),
+        _loop("string"),
+        LogicModel(NodeKind.ALWAYS_SUCCESS, "AlwaysSuccess", "Action"),
+        LogicModel(NodeKind.ALWAYS_FAILURE, "AlwaysFailure", "Action"),
+        LogicModel(
+            NodeKind.SET_BLACKBOARD,
+            "SetBlackboard",
+            "Action",
+            settings={"value": _text("value"), "output_key": _text("output_key")},
+        ),
+        LogicModel(
+            NodeKind.UNSET_BLACKBOARD, "UnsetBlackboard", "Action", settings={"key": _text("key")}
+        ),
     )
 }
-LOGIC_BY_MODEL: dict[str, LogicModel] = {m.model: m for m in LOGIC.values()}
+SWITCH_MODELS = tuple(f"Switch{n}" for n in range(2, 7))
+_LOOPS = {m.model: m for m in map(_loop, ("int", "double", "bool", "string"))}
+LOGIC_BY_MODEL: dict[str, LogicModel] = {
+    **{m.model: m for m in LOGIC.values() if m.kind not in (NodeKind.SWITCH, NodeKind.LOOP)},
+    **{model: LOGIC[NodeKind.SWITCH] for model in SWITCH_MODELS},
+    **_LOOPS,
+}
+
+
+def model_of(node: NodeSpec) -> str:
+    """BehaviorTree.CPP's id of a node: its kind's, a Switch's by its number of cases (its
+    children less the default), a Loop's by its type (LoopInt ...).
+    """
+    if node.kind is NodeKind.SWITCH:
+        return f"Switch{len(node.children) - 1}"
+    if node.kind is NodeKind.LOOP:
+        binding = node.params.get("type")
+        of = binding.value if binding is not None and isinstance(binding.value, str) else ""
+        return _loop(of if of in _LOOP_TYPES else "string").model
+    return LOGIC[node.kind].model
+
 
 # Every built-in id of BehaviorTree.CPP 4.10 (an operation's model id must not be one).
 BUILTIN_MODELS: frozenset[str] = frozenset(

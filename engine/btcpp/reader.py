@@ -14,6 +14,7 @@ from engine.btcpp.read_parts import Model, ReaderBase, read_models
 from engine.btcpp.writer import UNUSED_OUTPUT
 from engine.btcpp.xmltree import Element, XmlSyntaxError, XmlTooLarge, parse, parse_file
 from engine.conditions import Condition
+from engine.kinds import kind_port
 from engine.kinds import setting as kind_setting
 from engine.operations import Direction, OperationManifest
 from engine.spec import (
@@ -251,6 +252,10 @@ class _Reader(ReaderBase):
 
     def _logic(self, element: Element, logic: LogicModel) -> NodeSpec:
         node = NodeSpec(logic.kind)
+        for name, given in logic.implied.items():
+            spec = kind_port(logic.kind, name)
+            if spec is None or given != spec.default:  # a default stays unbound, as made
+                node.params[name] = kind_setting(logic.kind, name, given)
         by_port = {m.port: (name, m) for name, m in logic.settings.items()}
         for port, text in self._ports(element).items():
             if port not in by_port:
@@ -258,7 +263,7 @@ class _Reader(ReaderBase):
                 self.problem(element.line, f"a port of {logic.model} ({known})", repr(port))
                 continue
             name, mapping = by_port[port]
-            if text.startswith("{") and text.endswith("}"):
+            if not mapping.raw and text.startswith("{") and text.endswith("}"):
                 node.params[name] = Binding.reference(text[1:-1])
                 continue
             exact = element.attrs.get(f"_{name}")
@@ -266,8 +271,9 @@ class _Reader(ReaderBase):
                 value = mapping.read(text) if exact is None else _setting_text(exact)
                 node.params[name] = kind_setting(logic.kind, name, value)
             except ValueError:
+                expected = "true or false" if port in _BOOL_PORTS else "a number"
                 self.problem(
-                    element.line, f"{port} a number", repr(text if exact is None else exact)
+                    element.line, f"{port} {expected}", repr(text if exact is None else exact)
                 )
         return node
 
@@ -298,6 +304,9 @@ class _Reader(ReaderBase):
             if binding is not None:
                 node.params[port] = binding
         return node
+
+
+_BOOL_PORTS = ("catch_on_halt", "then_skip")
 
 
 def _setting_text(text: str) -> str | float:

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from engine.btcpp.errors import XmlExportError
-from engine.btcpp.logic import BUILTIN_MODELS, LOGIC, LOGIC_BY_MODEL
+from engine.btcpp.logic import BUILTIN_MODELS, LOGIC, LOGIC_BY_MODEL, model_of
 from engine.btcpp.names import encode_id, encode_port, readable_tree_id
 from engine.btcpp.values import MODEL_TYPE, value_text
 from engine.conditions import Condition
@@ -273,6 +273,8 @@ class _Writer:
     def _logic(self, node: NodeSpec, attrs: dict[str, str], path: str) -> str:
         logic = LOGIC[node.kind]
         for name, binding in sorted(node.params.items()):
+            if name in logic.implied:
+                continue  # the model's id says it (LoopInt: type int)
             mapping = logic.settings.get(name)
             if mapping is None:
                 raise self.fail(path, f"settings of {node.kind.value}", repr(name))
@@ -293,7 +295,7 @@ class _Writer:
                 attrs[f"_{name}"] = value if isinstance(value, str) else repr(exact)
         if not logic.builtin and logic.model not in self.models:
             self.models[logic.model] = self._logic_model(node.kind)
-        return logic.model
+        return model_of(node)
 
     def _logic_model(self, kind: NodeKind) -> _Model:
 

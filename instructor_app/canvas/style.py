@@ -57,6 +57,14 @@ _SYMBOLS: dict[NodeKind, str] = {
     NodeKind.REACTIVE_SEQUENCE: "R->",
     NodeKind.REACTIVE_SELECTOR: "R?",
     NodeKind.CATCH: "!?",  # try the first child; on a caught error, the second
+    NodeKind.SEQUENCE_WITH_MEMORY: "M->",
+    NodeKind.ASYNC_SEQUENCE: "A->",
+    NodeKind.ASYNC_FALLBACK: "A?",
+    NodeKind.PARALLEL_ALL: "|all|",
+    NodeKind.IF_THEN_ELSE: "if?",
+    NodeKind.WHILE_DO_ELSE: "while?",
+    NodeKind.SWITCH: "=?",
+    NodeKind.TRY_CATCH: "try!",
 }
 
 _MAX_PARAM_LINES = 4

@@ -65,6 +65,20 @@ def test_import_lists_every_unknown_node_with_its_line(tmp_path: Path) -> None:
     ]
 
 
+def test_the_smallest_v4_file_imports_and_runs_to_success(tmp_path: Path) -> None:
+    xml, plan_file = tmp_path / "smallest.xml", tmp_path / "smallest.costar.json"
+    xml.write_text(
+        '<root BTCPP_format="4">\n<BehaviorTree ID="MainTree">\n'
+        "<Sequence><AlwaysSuccess/></Sequence>\n</BehaviorTree>\n</root>\n",
+        encoding="utf-8",
+    )
+    code, out, err = run_cli("import-xml", str(xml), str(plan_file))
+    assert (code, err) == (0, "") and "wrote" in out
+    code, out, err = run_cli("run", "--cell", "none", "--no-record", str(plan_file))
+    assert (code, err) == (0, "")
+    assert out.strip().endswith("SUCCESS after 1 ticks")
+
+
 def test_export_errors_name_the_file(tmp_path: Path) -> None:
     broken = tmp_path / "broken.costar.json"
     broken.write_text("{", encoding="utf-8")

@@ -192,11 +192,11 @@ def test_unknown_node_types_are_all_reported_with_their_lines() -> None:
   <BehaviorTree ID="Main">
     <Sequence>
       <OpenDoor speed="1"/>
-      <Switch2 variable="{x}">
+      <SkipUnlessUpdated entry="{x}">
         <FlyAway/>
-        <AlwaysSuccess/>
-        <AlwaysFailure/>
-      </Switch2>
+        <WasEntryUpdated entry="{x}"/>
+        <Hover/>
+      </SkipUnlessUpdated>
       <Sleep msec="soon"/>
       <Inverter _skipIf="x == 1"><Action ID="Teleport"/></Inverter>
     </Sequence>
@@ -209,10 +209,10 @@ def test_unknown_node_types_are_all_reported_with_their_lines() -> None:
     unknown = [(p.line, p.got) for p in problems if p.got.startswith("unknown node type")]
     assert unknown == [
         (4, "unknown node type 'OpenDoor'"),
-        (5, "unknown node type 'Switch2'"),
+        (5, "unknown node type 'SkipUnlessUpdated'"),
         (6, "unknown node type 'FlyAway'"),
-        (7, "unknown node type 'AlwaysSuccess'"),
-        (8, "unknown node type 'AlwaysFailure'"),
+        (7, "unknown node type 'WasEntryUpdated'"),
+        (8, "unknown node type 'Hover'"),
         (11, "unknown node type 'Teleport'"),
     ]
     message = str(caught.value)

@@ -163,8 +163,18 @@ def test_repeat_runs_the_child_n_times(ctx: Any) -> None:
     child = ScriptedLeaf(ctx, "c", RUNNING, SUCCESS)
     node = deco(Repeat(ctx, "rep", count=2), child)
     child.script = [RUNNING, SUCCESS, RUNNING, SUCCESS]
-    assert [node.tick() for _ in range(4)] == [RUNNING] * 3 + [SUCCESS]
+    # BehaviorTree.CPP's Repeat: a child that finished after running starts again in the
+    # same tick
+    assert [node.tick() for _ in range(3)] == [RUNNING, RUNNING, SUCCESS]
     assert child.updates == 4
+
+
+def test_repeat_gives_the_tick_back_after_a_child_that_succeeded_at_once(ctx: Any) -> None:
+    node = deco(Repeat(ctx, "rep", count=3), ScriptedLeaf(ctx, "c", SUCCESS))
+    wakes: list[int] = []
+    ctx.wake = lambda: wakes.append(1)
+    assert [node.tick() for _ in range(3)] == [RUNNING, RUNNING, SUCCESS]
+    assert len(wakes) == 2
 
 
 def test_repeat_stops_at_a_failure(ctx: Any) -> None:

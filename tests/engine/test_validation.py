@@ -347,7 +347,7 @@ def test_ports_of_logic_nodes_take_typed_fixed_values() -> None:
         ),
         ("seconds", "'seconds' of 'pause' needs a Duration, but it is set to a Text."),
         ("success", "'success' of 'parallel' must be one of all, any, not 'most'."),
-        ("failure", "'failure' of 'parallel' must be a whole number of at least 1, not 1.5."),
+        ("failure", "'failure' of 'parallel' must be a whole number other than 0, not 1.5."),
     ]
 
 

@@ -482,6 +482,8 @@ def _leaves() -> dict[str, PlanSpec]:
 
 def node_examples() -> dict[str, PlanSpec]:
     """One plan per node kind (a subtree instance included), by file name."""
+    from tools.generators.builtin_examples import builtin_examples  # it builds with _one
+
     return {
         **_composites(),
         **_reactive(),
@@ -490,6 +492,7 @@ def node_examples() -> dict[str, PlanSpec]:
         **_leaves(),
         "subtree": _subtree_example(),
         "conditions": _conditions_example(),
+        **builtin_examples(_one),
     }
 
 

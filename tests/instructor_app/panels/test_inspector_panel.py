@@ -334,3 +334,23 @@ def test_an_unset_waypoint_asks_for_a_choice_and_the_first_one_chosen_binds_it(
     assert committed.args == [first]
     editor.set_context(EditorContext(waypoints=(first, second)))  # bound: shown as chosen
     assert editor.combo.currentText().startswith("above_cup")
+
+
+def test_settings_of_btcpp_builtins_edit_as_their_words(
+    panel: InspectorPanel, document: PlanDocument
+) -> None:
+    before = document.serialized()
+    once = document.add_node(NodeSpec(NodeKind.RUN_ONCE, id="once"), "root")
+    panel.show_node(once)
+    row = panel.port_row("then_skip")
+    assert row.mode == MODE_UNSET and isinstance(row.editor, ChoiceEditor)
+    assert row.editor.value() == "true"
+    _choose(row.editor.combo, row.editor.combo.findText("false"))
+    assert document.node("once").params["then_skip"] == Binding.fixed("false", ParamType.TEXT)
+    guard = document.add_node(NodeSpec(NodeKind.PRECONDITION, id="guard"), "root")
+    panel.show_node(guard)
+    otherwise = panel.port_row("else")
+    assert isinstance(otherwise.editor, ChoiceEditor) and otherwise.editor.value() == "FAILURE"
+    _choose(otherwise.editor.combo, otherwise.editor.combo.findText("SKIPPED"))
+    assert document.node("guard").params["else"] == Binding.fixed("SKIPPED", ParamType.TEXT)
+    _undo_all_restores(document, before)
