@@ -10,11 +10,14 @@ from __future__ import annotations
 import time
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from capabilities.cell_features import ClosableCell, ClosesOnExit
 from capabilities.collaboration.console import OperatorConsole
 from capabilities.errors import CapabilityError
+
+if TYPE_CHECKING:
+    from capabilities.robot.cell_file import CellConfig
 
 __all__ = [
     "CELL_NAMES",
@@ -90,23 +93,7 @@ def open_cell(
     if is_cell_file(name):
         return _open_cell_file(Path(name), seed, scene, speed, still_until_run)
     if name == "sim":
-        try:
-            from capabilities.sim.session import PERCEPTION_S, SimCellSession
-        except ImportError as exc:
-            raise CellError(f"the simulated cell cannot load: {exc}") from exc
-        try:
-            # Always in lockstep, paced or not: each look costs a fixed simulated time while
-            # the world stands still and a run's engine drives the world, so what a plan sees
-            # does not depend on how busy the machine is.
-            return SimCellSession(
-                scene or DEFAULT_SCENE,
-                seed,
-                speed,
-                lockstep=PERCEPTION_S,
-                still_until_run=still_until_run,
-            )
-        except Exception as exc:  # scene or model errors: say which, do not crash the CLI/GUI
-            raise CellError(f"the simulated cell did not start: {exc}") from exc
+        return _open_sim(seed, scene, speed, still_until_run)
     raise CellError(
         f"unknown cell {name!r}; cells: {', '.join(CELL_NAMES)}, or a cell file (*.cell.json)"
     )
@@ -151,11 +138,28 @@ def _open_cell_file(
             raise CellError(f"{path}: the UR cell needs ur_rtde: {exc}") from exc
         except CapabilityError as exc:
             raise CellError(f"{path}: {exc}") from exc
+    return _open_sim(seed, scene, speed, still_until_run, config, f"{path}: ")
+
+
+def _open_sim(
+    seed: int,
+    scene: str | None,
+    speed: float | None,
+    still_until_run: bool,
+    config: CellConfig | None = None,
+    where: str = "",
+) -> ClosableCell:
+    """The simulated cell (of ``config``, a cell file's, when given); ``where`` starts its
+    error messages.
+    """
     try:
         from capabilities.sim.session import PERCEPTION_S, SimCellSession
     except ImportError as exc:
         raise CellError(f"the simulated cell cannot load: {exc}") from exc
     try:
+        # Always in lockstep, paced or not: each look costs a fixed simulated time while
+        # the world stands still and a run's engine drives the world, so what a plan sees
+        # does not depend on how busy the machine is.
         return SimCellSession(
             scene or DEFAULT_SCENE,
             seed,
@@ -164,5 +168,5 @@ def _open_cell_file(
             lockstep=PERCEPTION_S,
             still_until_run=still_until_run,
         )
-    except Exception as exc:
-        raise CellError(f"{path}: the simulated cell did not start: {exc}") from exc
+    except Exception as exc:  # scene or model errors: say which, do not crash the CLI/GUI
+        raise CellError(f"{where}the simulated cell did not start: {exc}") from exc

@@ -214,13 +214,21 @@ class RunController(QObject):
 
     def step(self) -> None:
         """One tick: starts a paused run when idle, pauses a running one first."""
+        executor = self._paused_run()
+        if executor is not None:
+            executor.step()
+
+    def _paused_run(self) -> Executor | None:
+        """The run, paused: a paused run started when idle, a running one paused first
+        (None when none can start).
+        """
         if not self.is_running:
             if not self._start(paused=True):
-                return
+                return None
         elif self._state == ExecutorState.RUNNING:
             self.pause()
         assert self._executor is not None
-        self._executor.step()
+        return self._executor
 
     def set_entry(self, key: str, value: Any) -> None:
         """Set a named parameter of the paused run (the engine writes it between ticks, as
@@ -256,14 +264,10 @@ class RunController(QObject):
         self._debug_go(lambda executor: executor.run_to(node_id))
 
     def _debug_go(self, go: Callable[[Executor], None]) -> None:
-        if not self.is_running:
-            if not self._start(paused=True):
-                return
-        elif self._state == ExecutorState.RUNNING:
-            self.pause()
-        assert self._executor is not None
-        go(self._executor)
-        self._set_state(ExecutorState.RUNNING)
+        executor = self._paused_run()
+        if executor is not None:
+            go(executor)
+            self._set_state(ExecutorState.RUNNING)
 
     def stop(self) -> None:
         """Halt what runs (an arm in motion stops); the run ends via run_finished.
