@@ -227,23 +227,27 @@ class Enforce(_Looping):
 
 
 class Repeat(Iterator):
-    """Run the child ``count`` times while it succeeds (BehaviorTree.CPP's Repeat)."""
+    """Run the child ``count`` times while it succeeds (BehaviorTree.CPP's Repeat); a
+    ``count`` of -1 has no limit, as its ``num_cycles="-1"``.
+    """
 
     kind = "repeat"
     again_in_tick = True
 
     def __init__(self, ctx: TreeContext, node_id: str, name: str = "", count: int = 1) -> None:
-        super().__init__(ctx, node_id, name, count=count)
+        super().__init__(ctx, node_id, name, count=None if count == -1 else count)
 
 
 class Retry(Enforce):
-    """Try the child up to ``count`` times until it succeeds (RetryUntilSuccessful)."""
+    """Try the child up to ``count`` times until it succeeds (RetryUntilSuccessful); a
+    ``count`` of -1 has no limit, as its ``num_attempts="-1"``.
+    """
 
     kind = "retry"
     again_in_tick = True
 
     def __init__(self, ctx: TreeContext, node_id: str, name: str = "", count: int = 1) -> None:
-        super().__init__(ctx, node_id, name, count=count)
+        super().__init__(ctx, node_id, name, count=None if count == -1 else count)
 
 
 class Timeout(_Clocked):

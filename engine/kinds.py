@@ -91,8 +91,8 @@ KIND_PORTS: dict[NodeKind, tuple[PortSpec, ...]] = {
         _count("count", "give up with FAILURE after this many failures (0: no limit)", 0.0),
         _seconds("timeout", "give up with FAILURE after this many seconds (0: no limit)", 0.0),
     ),
-    NodeKind.REPEAT: (_count("count", "how many times"),),
-    NodeKind.RETRY: (_count("count", "how many attempts"),),
+    NodeKind.REPEAT: (_count("count", "how many times (-1: with no limit)"),),
+    NodeKind.RETRY: (_count("count", "how many attempts (-1: with no limit)"),),
     NodeKind.TIMEOUT: (_seconds("seconds", "time limit"),),
     NodeKind.WAIT: (_seconds("seconds", "how long to wait"),),
     NodeKind.SCRIPT: (
@@ -187,6 +187,8 @@ _LIMITS: dict[tuple[NodeKind, str], tuple[float, bool]] = {
 }
 # Counts that may be negative (counted back from the number of children) but not 0.
 _NONZERO = {(NodeKind.PARALLEL, "success"), (NodeKind.PARALLEL, "failure")}
+# Counts whose -1 means no limit, as BehaviorTree.CPP's num_cycles and num_attempts.
+_UNLIMITED = {(NodeKind.REPEAT, "count"), (NodeKind.RETRY, "count")}
 
 KIND_DOC: dict[NodeKind, str] = {
     NodeKind.SEQUENCE: "Runs children in order; fails at the first failure.",
@@ -274,6 +276,8 @@ def check_setting(kind: NodeKind, name: str, value: Any) -> str | None:
     strict = kind is NodeKind.TIMEOUT  # a time limit of 0 would fail at once
     is_number = isinstance(value, (int, float)) and not isinstance(value, bool)
     nonzero = (kind, name) in _NONZERO
+    if (kind, name) in _UNLIMITED and value == -1:
+        return None
     if (
         is_number
         and (value > minimum if strict else value >= minimum)
@@ -283,6 +287,8 @@ def check_setting(kind: NodeKind, name: str, value: Any) -> str | None:
         return None
     if nonzero:
         return "a whole number other than 0"
+    if (kind, name) in _UNLIMITED:
+        return f"a whole number of at least {minimum:g}, or -1 for no limit"
     if whole:
         return (
             "a whole number" if minimum == -math.inf else f"a whole number of at least {minimum:g}"

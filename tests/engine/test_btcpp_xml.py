@@ -415,3 +415,15 @@ def test_a_tree_never_takes_the_id_of_a_node_model(name: str) -> None:
     xml = export_xml(plan, {})
     assert f'<BehaviorTree ID="{name}"' not in xml
     assert import_xml(xml, "t.xml", {}).name == name
+
+
+def test_repeat_and_retry_of_minus_1_import_and_come_back() -> None:
+    # BehaviorTree.CPP's num_cycles="-1" / num_attempts="-1": no limit (found by the random
+    # trees of test_btcpp_random_trees.py, which our import refused)
+    text = (
+        '<root BTCPP_format="4" main_tree_to_execute="Main"><BehaviorTree ID="Main">'
+        '<RetryUntilSuccessful num_attempts="-1"><Repeat num_cycles="-1"><AlwaysSuccess/>'
+        "</Repeat></RetryUntilSuccessful></BehaviorTree></root>"
+    )
+    written = export_xml(import_xml(text, "forever.xml"), {})
+    assert 'num_attempts="-1"' in written and 'num_cycles="-1"' in written

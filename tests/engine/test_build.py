@@ -193,7 +193,12 @@ def test_a_decorator_with_two_children(registry: CapabilityRegistry) -> None:
 @pytest.mark.parametrize(
     ("kind", "config", "match"),
     [
-        (NodeKind.REPEAT, {"count": 0}, "'count' must be a whole number of at least 1, not 0"),
+        (
+            NodeKind.REPEAT,
+            {"count": 0},
+            "'count' must be a whole number of at least 1, or -1 for no limit, not 0",
+        ),
+        (NodeKind.RETRY, {"count": -2}, "'count' must be a whole number of at least 1, or -1"),
         (NodeKind.TIMEOUT, {"seconds": -1}, "must be a number of seconds above 0, not -1"),
         (
             NodeKind.PARALLEL,

@@ -194,6 +194,15 @@ def test_retry_succeeds_at_the_first_success(ctx: Any) -> None:
     assert [node.tick(), node.tick()] == [RUNNING, SUCCESS]
 
 
+def test_repeat_and_retry_with_a_count_of_minus_1_have_no_limit(ctx: Any) -> None:
+    # BehaviorTree.CPP's num_cycles="-1" and num_attempts="-1"
+    repeat = deco(Repeat(ctx, "rep", count=-1), ScriptedLeaf(ctx, "c", SUCCESS))
+    assert {repeat.tick() for _ in range(20)} == {RUNNING}
+    child = ScriptedLeaf(ctx, "d", *[FAILURE] * 20, SUCCESS)
+    retry = deco(Retry(ctx, "retry", count=-1), child)
+    assert [retry.tick() for _ in range(21)] == [RUNNING] * 20 + [SUCCESS]
+
+
 # ---------------------------------------------------------------------- Timeout
 
 
