@@ -41,8 +41,10 @@ ARUCO_DICTIONARY = cv2.aruco.DICT_4X4_50
 # and the mirrored one to 0.08 px, which must count as clearly different.
 AMBIGUITY_RATIO = 1.5
 AMBIGUITY_FLOOR_PX = 0.01
-# Images up to this size (longest side, px) are searched at twice the resolution: a 4 cm
-# marker at 0.9 m is only ~12 px wide at 320x240, with 2 px cells the decoder can miss.
+# Images up to this size (longest side, px) are searched at twice the resolution too: a 4 cm
+# marker at 0.9 m is only ~12 px wide at 320x240, with 2 px cells the decoder can miss. The
+# upscaled search misses others the plain one decodes (a cup's 3 cm top marker at a slant,
+# 14 px wide at 640x480): both are searched, a marker found by either is kept.
 _UPSCALE_BELOW_PX = 800
 
 
@@ -143,7 +145,16 @@ def _detector() -> cv2.aruco.ArucoDetector:
 
 def _find(grey: NDArray[np.uint8]) -> list[tuple[int, NDArray[np.float64], float]]:
     """(id, refined 4x2 corners, detector confidence) of every marker in a grey image."""
-    scale = 2 if max(grey.shape) <= _UPSCALE_BELOW_PX else 1
+    scales = (2, 1) if max(grey.shape) <= _UPSCALE_BELOW_PX else (1,)
+    found: list[tuple[int, NDArray[np.float64], float]] = []
+    for scale in scales:
+        known = {marker_id for marker_id, _, _ in found}
+        found += [hit for hit in _search(grey, scale) if hit[0] not in known]
+    return found
+
+
+def _search(grey: NDArray[np.uint8], scale: int) -> list[tuple[int, NDArray[np.float64], float]]:
+    """The markers the detector decodes in ``grey`` resized by ``scale``, refined at 1:1."""
     search = grey if scale == 1 else cv2.resize(grey, None, fx=scale, fy=scale)
     corners_list, ids, confidences, _ = _detector().detectMarkersWithConfidence(search)
     if ids is None or len(ids) == 0:

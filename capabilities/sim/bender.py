@@ -31,7 +31,7 @@ from capabilities.sim.bender_spec import (
     parse_bender,
     plan_parts,
 )
-from capabilities.sim.objects import ObjectModelSpec, SceneError, set_object_frame_pose
+from capabilities.sim.objects import ObjectModelSpec, SceneError, set_object_frame_pose, wake
 from capabilities.sim.scene import SceneState
 from capabilities.sim.scene_spec import read_scene_json
 from capabilities.sim.schedule import ScheduledActor
@@ -199,6 +199,11 @@ class WireBender(ScheduledActor[PlannedPart, BenderEvent]):
         set_object_frame_pose(
             self._client, arm.body_id, arm.model, _pitch_pose(self._pivot(), pitch)
         )
+        # A moved fixture pushes nothing that sleeps: wake what the arm's box now touches.
+        lo, hi = p.getAABB(arm.body_id, physicsClientId=self._client)
+        for body, _link in p.getOverlappingObjects(lo, hi, physicsClientId=self._client) or ():
+            if body != arm.body_id:
+                wake(self._client, body)
 
     def _watch(self, name: str, live: _Live, now: float) -> None:
         """Break a bad part's weld, or let a bad grasp slip, once it is lifted."""

@@ -27,6 +27,7 @@ from capabilities.sim.objects import (
     SpawnedObject,
     object_frame_pose,
     spawn_object,
+    wake,
 )
 from capabilities.sim.placement import Placement, sample_placements
 from capabilities.sim.scene_spec import SceneSpec, read_scene
@@ -141,6 +142,8 @@ class SceneState:
         """Take an object out of the world."""
         p.removeBody(self._get(name).body_id, physicsClientId=client)
         del self.objects[name]
+        for obj in self.objects.values():  # what rested on it falls
+            wake(client, obj.body_id)
 
     def _get(self, name: str) -> SpawnedObject:
         if name not in self.objects:

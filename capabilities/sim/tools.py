@@ -75,6 +75,9 @@ def attach(client: int, parent: int, parent_link: int, child: int) -> int:
         physicsClientId=client,
     )
     pybullet.changeConstraint(cid, maxForce=_ATTACH_FORCE, physicsClientId=client)
+    pybullet.changeDynamics(  # a part asleep on the table moves with the tool from now on
+        child, -1, activationState=pybullet.ACTIVATION_STATE_WAKE_UP, physicsClientId=client
+    )
     return int(cid)
 
 

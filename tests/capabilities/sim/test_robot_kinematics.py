@@ -139,17 +139,32 @@ def _render(urdf: str) -> tuple[np.ndarray, np.ndarray]:
 def test_the_robot_draws_its_collada_meshes_converted_to_obj_pixel_for_pixel(
     tmp_path: Path,
 ) -> None:
-    """The physics cell loads the visual meshes as OBJ files (a tenth of the COLLADA files'
-    load time); what a camera sees of the arm is the same to the pixel.
+    """The visual meshes converted to OBJ files (a tenth of the COLLADA files' load time)
+    draw the arm the same to the pixel; the physics cell draws them thinned to a tenth of
+    their triangles, and a camera sees the same arm but for a few pixels at its edges.
     """
     converted = robot_urdf_path(tmp_path)
     assert ".dae" not in converted.read_text()
-    assert len(list((tmp_path / "ur5_visual_meshes").glob("*.obj"))) == 7
-    collada = tmp_path / "collada.urdf"
+    thinned = sorted((tmp_path / "ur5_visual_meshes").glob("*_thinned*.obj"))
+    assert len(thinned) == 7 and all(str(obj) in converted.read_text() for obj in thinned)
     fragment = (ROBOTS_DIR / "parallel_gripper.urdf.xml").read_text(encoding="utf-8")
+    full = {
+        obj.stem.split("_")[0]: obj
+        for obj in (tmp_path / "ur5_visual_meshes").glob("*.obj")
+        if "_thinned" not in obj.name
+    }
+    assert len(full) == 7
+    whole, collada = tmp_path / "whole.urdf", tmp_path / "collada.urdf"
+    whole.write_text(build_robot_urdf(find_ur5_urdf(), fragment, visual_objs=full), "utf-8")
     collada.write_text(build_robot_urdf(find_ur5_urdf(), fragment), encoding="utf-8")
-    (rgb, depth), (rgb_collada, depth_collada) = _render(str(converted)), _render(str(collada))
+    rgb, depth = _render(str(whole))
+    rgb_collada, depth_collada = _render(str(collada))
     assert (depth < 1.0).mean() > 0.05  # the arm is in view
     assert np.array_equal(rgb, rgb_collada)
     assert np.allclose(depth, depth_collada, atol=1e-6)
+
+    rgb_thin, depth_thin = _render(str(converted))
+    differ = np.abs(rgb_thin[:, :, :3].astype(int) - rgb[:, :, :3].astype(int)).max(axis=2) > 30
+    assert differ.mean() < 0.005, differ.mean()  # a few pixels at the silhouette
+    assert ((depth_thin < 1.0) != (depth < 1.0)).mean() < 0.005
     assert robot_urdf_path(tmp_path) == converted  # converted once
