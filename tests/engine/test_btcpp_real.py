@@ -1,7 +1,8 @@
 """Our export loaded by BehaviorTree.CPP's own factory (4.10, strict about ids and attributes).
 
-Needs a checker program built against a local BehaviorTree.CPP (not part of this
-repository); set ``COSTAR_BTCPP_CHECK`` to it. Its contract:
+Needs a checker program built against a local BehaviorTree.CPP (its source is
+``tools/btcpp/check_load.cpp``, with how to build it); set ``COSTAR_BTCPP_CHECK`` to it. Its
+contract:
 
 - ``CHECK MODELS.txt load TREE.xml``: registers every model of MODELS.txt as a simple
   action, condition, control or decorator with its typed ports (``BT::InputPort<double>`` ...), loads
