@@ -36,9 +36,14 @@ A plan is written as::
   queries as ``<Action>`` with output ports.
 - Import knows: the mapped built-ins, Iterator and Enforce, ``<SubTree>`` of a tree in the
   file, and operations (those of the given manifests; without manifests, the Actions and
-  Conditions the file's TreeNodesModel declares). Any other node type,
-  ``_autoremap="true"``, unknown ports and values not in their port's form are problems, all
-  of them reported with their lines (:class:`XmlFileError`).
+  Conditions the file's TreeNodesModel declares). ``<include path=...>`` brings in another
+  file's trees (:mod:`engine.btcpp.includes`). A ``<SubTree _autoremap="true">`` of a tree
+  without a model shares every name its tree uses (but ``_private`` ones) with the instance's
+  scope, as BehaviorTree.CPP's autoremap does. The tree run is the one
+  ``main_tree_to_execute`` names, else the file's only tree (not an included one), else its
+  first (as BehaviorTree.CPP writes a loaded tree: the main one first). Any other node
+  type, unknown ports and values not in their port's form are problems, all of them reported
+  with their lines (:class:`XmlFileError`).
 - The pre- and post-conditions of any node as BehaviorTree.CPP's own attributes
   (``_failureIf``, ``_successIf``, ``_skipIf``, ``_while``, ``_onSuccess``, ``_onFailure``,
   ``_post``, ``_onHalted``), read and written as they are and run by

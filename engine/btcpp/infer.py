@@ -5,15 +5,17 @@ by the operations inside.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 
 from engine.btcpp.names import decode_port
 from engine.btcpp.xmltree import Element
+from engine.conditions import Condition
 from engine.operations import Direction
+from engine.script import ScriptSyntaxError, parse_script, script_names
 from engine.spec import SubtreePort
 from engine.types import ParamType
 
-__all__ = ["PortOf", "infer_subtree_ports", "instances_of"]
+__all__ = ["PortOf", "autoremapped", "infer_subtree_ports", "instances_of", "names_used"]
 
 # (element, attribute) -> the direction and type of that port of the element's node, if known
 PortOf = Callable[[Element, str], tuple[Direction, ParamType] | None]
@@ -68,3 +70,44 @@ def infer_subtree_ports(
     inputs = [SubtreePort(n, read.get(n, ParamType.TEXT)) for n in names if n not in written]
     outputs = [SubtreePort(n, written[n]) for n in names if n in written]
     return inputs, outputs
+
+
+_SCRIPT_PORTS = {("Script", "code"), ("ScriptCondition", "code")}
+_CONDITION_ATTRS = frozenset(c.attribute for c in Condition)
+
+
+def autoremapped(instance: Element) -> bool:
+    """True for a ``<SubTree _autoremap="true">`` (BehaviorTree.CPP reads it as a bool)."""
+    return instance.attrs.get("_autoremap", "false").strip().lower() in ("true", "1")
+
+
+def names_used(tree_id: str, trees: Mapping[str, Element]) -> list[str]:
+    """The blackboard names a tree uses (``{key}`` ports, scripts, pre- and post-conditions),
+    with those of the subtrees it runs with ``_autoremap``, as BehaviorTree.CPP's autoremap
+    shares them: every name but those starting with ``_`` (private to the subtree).
+    """
+    found: dict[str, None] = {}
+    stack, seen = [tree_id], {tree_id}
+    while stack:
+        tree = trees.get(stack.pop())
+        for element in _walk(tree) if tree is not None else ():
+            for attr, value in element.attrs.items():
+                for name in _names_in(element.tag, attr, value):
+                    found.setdefault(name.lstrip("@"), None)
+            inner = element.attrs.get("ID", "")
+            if element.tag == "SubTree" and autoremapped(element) and inner not in seen:
+                seen.add(inner)
+                stack.append(inner)
+    return [name for name in found if name and not name.startswith("_")]
+
+
+def _names_in(tag: str, attr: str, value: str) -> list[str]:
+    if value.startswith("{") and value.endswith("}") and value != "{=}":
+        return [value[1:-1].strip()]
+    if (tag, attr) in _SCRIPT_PORTS or attr in _CONDITION_ATTRS:
+        try:
+            names = script_names(parse_script(value))
+        except ScriptSyntaxError:
+            return []  # the node's reading reports it
+        return [*names.reads, *names.writes]
+    return []

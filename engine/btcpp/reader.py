@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping
+from pathlib import Path
 
 from engine.btcpp.errors import XmlFileError, XmlProblem
 from engine.btcpp.imported import XmlImport
-from engine.btcpp.infer import infer_subtree_ports, instances_of
+from engine.btcpp.includes import expand_includes
+from engine.btcpp.infer import autoremapped, infer_subtree_ports, instances_of, names_used
 from engine.btcpp.logic import LOGIC_BY_MODEL, LogicModel
 from engine.btcpp.names import decode_id, decode_port
 from engine.btcpp.read_parts import Model, ReaderBase, read_models
@@ -38,9 +40,13 @@ _CONDITIONS: Mapping[str, Condition] = {c.attribute: c for c in Condition}
 
 
 class _Reader(ReaderBase):
-    def __init__(self, manifests: Mapping[str, OperationManifest] | None) -> None:
+    def __init__(
+        self, manifests: Mapping[str, OperationManifest] | None, file: Path | None = None
+    ) -> None:
         super().__init__()
         self.manifests = manifests
+        self.file = file  # the file read (None: a text)
+        self.folder = file.parent if file is not None else Path.cwd()  # <include> paths start
         self.subtrees: dict[str, SubtreeSpec] = {}  # BehaviorTree ID -> definition
         self.ids: set[str] = set()
         self.foreign = False  # True: not written by us (no CostarPlan element)
@@ -51,6 +57,8 @@ class _Reader(ReaderBase):
             return PlanSpec()
         if root.attrs.get("BTCPP_format", "4") != "4":
             self.problem(root.line, 'BTCPP_format="4"', repr(root.attrs["BTCPP_format"]))
+        own_trees = [c.attrs.get("ID", "") for c in root.children if c.tag == "BehaviorTree"]
+        expand_includes(root, self.folder, self.problem, self.file)
         groups: dict[str, list[Element]] = {}
         for child in root.children:
             groups.setdefault(child.tag, []).append(child)
@@ -59,7 +67,7 @@ class _Reader(ReaderBase):
         data = self._the_one(groups, "CostarPlan")
         self.foreign = data is None
         trees = self._trees(groups.get("BehaviorTree", []))
-        main_id = self._main_id(root, data, trees)
+        main_id = self._main_id(root, data, trees, own_trees)
         plan = PlanSpec(name=main_id or "")
         self._read_subtrees(trees, main_id)
         if main_id is not None:
@@ -102,6 +110,10 @@ class _Reader(ReaderBase):
                     sub.inputs, sub.outputs = infer_subtree_ports(
                         element, instances, self._port_info
                     )
+                    if any(autoremapped(i) for i in instances):
+                        ports = {p.name for p in [*sub.inputs, *sub.outputs]}
+                        used = names_used(tree_id, trees)
+                        sub.shared_names = [n for n in used if n not in ports]
         for tree_id, element in trees.items():
             if tree_id != main_id:
                 sub = self.subtrees[tree_id]
@@ -142,12 +154,23 @@ class _Reader(ReaderBase):
         return self._node(tree.children[0], layout) if tree.children else None
 
     def _main_id(
-        self, root: Element, data: Element | None, trees: dict[str, Element]
+        self,
+        root: Element,
+        data: Element | None,
+        trees: dict[str, Element],
+        own_trees: list[str],
     ) -> str | None:
+        """The tree to run: the one named, else the file's only tree (not an included one),
+        else its first. BehaviorTree.CPP refuses a file of several trees that names none
+        unless its caller names one; what BehaviorTree.CPP itself writes (WriteTreeToXML: the
+        main tree first, no main_tree_to_execute) is such a file, so the first is taken.
+        """
         wanted = data.attrs.get("tree") if data is not None else None
         wanted = wanted or root.attrs.get("main_tree_to_execute")
+        if wanted is None and len(own_trees) == 1 and own_trees[0]:
+            wanted = own_trees[0]
         if wanted is None and trees:
-            wanted = next(iter(trees))  # as BehaviorTree.CPP: the first when none is named
+            wanted = next(iter(trees))
         if wanted is None or wanted not in trees:
             got = repr(wanted) if wanted else "no BehaviorTree"
             self.problem(root.line, "the main tree named and present", got)
@@ -283,10 +306,10 @@ class _Reader(ReaderBase):
         if sub is None:
             self.problem(element.line, "a SubTree whose BehaviorTree is in the file", repr(tree_id))
             return None
-        if element.attrs.get("_autoremap", "false") != "false":
+        if autoremapped(element) and tree_id in self.models:
             self.problem(
                 element.line,
-                '_autoremap="false" (declare the names a subtree shares)',
+                '_autoremap="false" for a subtree whose model declares its ports and shared names',
                 "_autoremap",
             )
         node = NodeSpec(NodeKind.SUBTREE, subtree=sub.ref)
@@ -317,9 +340,12 @@ def _setting_text(text: str) -> str | float:
 
 
 def _read(
-    root: Element, source_name: str, manifests: Mapping[str, OperationManifest] | None
+    root: Element,
+    source_name: str,
+    manifests: Mapping[str, OperationManifest] | None,
+    file: Path | None = None,
 ) -> XmlImport:
-    reader = _Reader(manifests)
+    reader = _Reader(manifests, file)
     plan = reader.plan(root)
     if reader.problems:
         raise XmlFileError(source_name, reader.problems)
@@ -379,7 +405,7 @@ def read_xml(
         raise XmlFileError(file, [XmlProblem(0, expected, f"{exc.size} bytes")]) from None
     except XmlSyntaxError as exc:
         raise _syntax_error(file, exc) from None
-    return _read(root, file, manifests)
+    return _read(root, file, manifests, Path(file).resolve())
 
 
 def load_xml(
