@@ -57,6 +57,7 @@ class FailureMark:
     time: float
     tick: int
     node_id: str
+    index: int  # the failure's transition (0: the record's first)
     message: str = ""
     error: str = ""
 
@@ -158,6 +159,7 @@ class Timeline:
                             at,
                             int(event.get("tick", 0)),
                             event["node"],
+                            len(self.times) - 1,
                             str(event.get("message", "")),
                             str(event.get("error", "")),
                         )
@@ -239,7 +241,10 @@ class Timeline:
 
     def statuses_at(self, t: float) -> dict[str, Status]:
         """Every node's status at ``t`` (IDLE for those not started yet)."""
-        index = self.index_at(t)
+        return self.statuses_after(self.index_at(t))
+
+    def statuses_after(self, index: int) -> dict[str, Status]:
+        """Every node's status after the record's first ``index`` transitions."""
         state = self._state_at(index)
         return {node_id: _STATUSES[state[slot]] for node_id, slot in self._slot.items()}
 
@@ -255,7 +260,11 @@ class Timeline:
 
     def running_at(self, t: float) -> list[str]:
         """The nodes RUNNING at ``t``, in the plan's order (outermost first)."""
-        state = self._state_at(self.index_at(t))
+        return self.running_after(self.index_at(t))
+
+    def running_after(self, index: int) -> list[str]:
+        """The nodes RUNNING after the record's first ``index`` transitions."""
+        state = self._state_at(index)
         return [node_id for node_id, slot in self._slot.items() if state[slot] == _RUNNING]
 
     def values_at(self, t: float) -> list[BlackboardEntry]:

@@ -106,7 +106,10 @@ def test_figures_count_starts_results_ticks_and_time_running(tmp_path: Path) -> 
     assert (grasp.starts, grasp.successes, grasp.failures, grasp.ticks) == (2, 1, 1, 4)
     assert abs(grasp.running_s - 0.5) < 1e-9
     assert timeline.figures("a").failures == 1
-    assert [(m.node_id, m.tick, m.error) for m in timeline.failures] == [("b", 3, "grasp_failed")]
+    assert [(m.node_id, m.tick, m.error, m.index) for m in timeline.failures] == [
+        ("b", 3, "grasp_failed", 2)
+    ]
+    assert timeline.statuses_after(3) == {"a": Status.RUNNING, "b": Status.FAILURE}
     assert timeline.failure_near(0.45, 0.1) == timeline.failures[0]
     assert timeline.failure_near(0.2, 0.1) is None
     assert timeline.running_at(0.3) == ["a", "b"]

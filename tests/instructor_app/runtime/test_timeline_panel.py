@@ -1,0 +1,128 @@
+"""The Timeline panel: a record of a `costar run` opened in the window shows each moment's
+statuses on the canvas, the nodes running then, the values, and goes to a failure's moment
+when its mark is clicked.
+"""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+from typing import Any
+
+import pytest
+from PySide6.QtCore import QPoint, Qt
+
+from capabilities.cli import main as costar
+from engine.files import save_plan
+from engine.spec import NodeKind, NodeSpec, PlanSpec
+from engine.status import Status
+from instructor_app.main_window import MainWindow
+from instructor_app.runtime.session import CellSession
+from tests.instructor_app.gui_driver import ScriptedDialogs, make_window, node_named
+from tests.instructor_app.runtime.plans import number, op, text
+
+
+def _plan() -> PlanSpec:
+    """Waits 10 ticks, writes a name, then a grasp fails twice behind a retry and "ask"
+    takes over: a run with RUNNING moments, a blackboard write and two failures.
+    """
+    wait = op("debug.running", "wait", ticks=number(10))
+    grasp = op("debug.fail", "grasp CUP", message=text("nothing between the fingers"))
+    retry = NodeSpec(
+        NodeKind.RETRY, name="pick twice", params={"count": number(2)}, children=[grasp]
+    )
+    fallback = NodeSpec(
+        NodeKind.SELECTOR, name="pick or ask", children=[retry, op("debug.succeed", "ask")]
+    )
+    return PlanSpec(NodeSpec(NodeKind.SEQUENCE, name="top", children=[wait, fallback]), "timed")
+
+
+@pytest.fixture
+def record(tmp_path: Path) -> Path:
+    """The record of a `costar run` of the plan on no cell."""
+    plan = tmp_path / "timed.costar.json"
+    save_plan(_plan(), plan)
+    runs = tmp_path / "runs"
+    out, err = io.StringIO(), io.StringIO()
+    code = costar(
+        ["run", "--cell", "none", str(plan), "--rate", "100", "--runs", str(runs)], out, err
+    )
+    assert code == 0, err.getvalue()
+    (path,) = runs.iterdir()
+    return path
+
+
+@pytest.fixture
+def window(qtbot: Any, none_session: CellSession, tmp_path: Path) -> MainWindow:
+    return make_window(qtbot, none_session, tmp_path, ScriptedDialogs())
+
+
+def _open(window: MainWindow, record: Path) -> None:
+    dialogs = window.dialogs
+    assert isinstance(dialogs, ScriptedDialogs)
+    dialogs.record_paths.append(str(record))
+    window.actions_by_name["open_record"].trigger()
+
+
+def test_a_moment_of_the_record_shows_its_statuses_on_the_canvas(
+    qtbot: Any, window: MainWindow, record: Path
+) -> None:
+    _open(window, record)
+    panel, canvas = window.views.timeline, window.views.canvas
+    assert panel.timeline is not None and window.document.plan.name == "timed"
+    wait, grasp = node_named(window, "wait"), node_named(window, "grasp CUP")
+    top = window.document.plan.tree.id
+    # The middle of the wait: "top" and "wait" run, the grasp has not started.
+    timeline = panel.timeline
+    started = timeline.figures(wait)
+    assert started.starts == 1 and started.ticks >= 10
+    moment = timeline.failures[0].time / 2
+    panel.slider.setValue(round(moment * 1000))
+    qtbot.waitUntil(lambda: canvas.status_of(wait) is Status.RUNNING)
+    assert canvas.status_of(top) is Status.RUNNING
+    assert canvas.status_of(grasp) in (None, Status.IDLE)
+    assert panel.running.node_ids()[:2] == [top, wait]
+    assert "s / " in panel.time_label.text()
+    # The end: everything succeeded but the grasp, which failed last.
+    panel.show_time(timeline.duration)
+    assert canvas.status_of(top) is Status.SUCCESS
+    assert canvas.status_of(grasp) is Status.FAILURE
+    assert panel.running.count() == 0
+    # Back to the start: the statuses go back too.
+    panel.show_time(0.0)
+    assert canvas.status_of(grasp) in (None, Status.IDLE)
+
+
+def test_clicking_a_failure_mark_goes_to_that_failure(
+    qtbot: Any, window: MainWindow, record: Path
+) -> None:
+    _open(window, record)
+    window.raise_dock("timeline")
+    panel, canvas = window.views.timeline, window.views.canvas
+    timeline = panel.timeline
+    assert timeline is not None and len(timeline.failures) >= 2
+    grasp = node_named(window, "grasp CUP")
+    assert {m.node_id for m in timeline.failures} == {grasp}
+    panel.show_time(timeline.duration)
+    slider = panel.slider
+    qtbot.waitExposed(slider)
+    mark = slider.marks()[0]
+    x = slider.mark_x(mark)
+    qtbot.mouseClick(slider, Qt.MouseButton.LeftButton, pos=QPoint(x, slider.height() // 2))
+    qtbot.waitUntil(lambda: slider.value() == mark)
+    qtbot.waitUntil(lambda: canvas.status_of(grasp) is Status.FAILURE)
+    assert abs(panel.time - timeline.failures[0].time) < 0.002
+
+
+def test_the_selected_node_shows_its_figures_and_last_run_opens_the_newest_record(
+    qtbot: Any, window: MainWindow, record: Path, monkeypatch: Any
+) -> None:
+    monkeypatch.setenv("COSTAR_RUNS", str(record.parent))
+    window.views.timeline.last_button.click()
+    panel = window.views.timeline
+    assert panel.timeline is not None and panel.timeline.name == record.name
+    grasp = node_named(window, "grasp CUP")
+    window.views.canvas.select(grasp)
+    qtbot.waitUntil(lambda: "grasp CUP" in panel.figures_label.text())
+    assert "2 failures" in panel.figures_label.text()
+    assert "started 2" in panel.figures_label.text()
