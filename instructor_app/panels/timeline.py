@@ -56,9 +56,11 @@ class TimelineSlider(QSlider):
         super().__init__(Qt.Orientation.Horizontal, parent)
         self.setObjectName("TimelineSlider")
         self._marks: list[int] = []
+        self._xs: tuple[tuple[int, int, int], list[int]] = ((0, 0, 0), [])  # (key, x per mark)
 
     def set_marks(self, values: list[int]) -> None:
         self._marks = sorted(values)
+        self._xs = ((0, 0, 0), [])
         self.update()
 
     def marks(self) -> list[int]:
@@ -82,6 +84,18 @@ class TimelineSlider(QSlider):
         left, span = self._groove()
         return left + QStyle.sliderPositionFromValue(self.minimum(), self.maximum(), value, span)
 
+    def _mark_xs(self) -> list[int]:
+        """The x of every mark, kept until the slider's width or range changes (a record
+        may have thousands of failures: the track is painted at every move).
+        """
+        key = (self.width(), self.minimum(), self.maximum())
+        if self._xs[0] != key:
+            left, span = self._groove()
+            low, high = self.minimum(), self.maximum()
+            position = QStyle.sliderPositionFromValue
+            self._xs = (key, [left + position(low, high, v, span) for v in self._marks])
+        return self._xs[1]
+
     def paintEvent(self, event: QPaintEvent) -> None:
         super().paintEvent(event)
         if not self._marks:
@@ -89,16 +103,16 @@ class TimelineSlider(QSlider):
         painter = QPainter(self)
         painter.setPen(QPen(FAILURE_COLOUR, 2))
         height = self.height()
-        for value in self._marks:
-            x = self.mark_x(value)
+        for x in sorted(set(self._mark_xs())):  # one line per pixel column
             painter.drawLine(x, 2, x, height - 3)
         painter.end()
 
     def mousePressEvent(self, event: QMouseEvent) -> None:
         x = event.position().x()
-        near = [v for v in self._marks if abs(self.mark_x(v) - x) <= _MARK_REACH_PX]
+        xs = self._mark_xs()
+        near = [i for i, mark_x in enumerate(xs) if abs(mark_x - x) <= _MARK_REACH_PX]
         if near and event.button() == Qt.MouseButton.LeftButton:
-            mark = min(near, key=lambda v: abs(self.mark_x(v) - x))
+            mark = self._marks[min(near, key=lambda i: abs(xs[i] - x))]
             self.setValue(mark)
             self.mark_clicked.emit(mark)
             event.accept()
@@ -138,6 +152,7 @@ class TimelinePanel(QWidget):
         self._joints: tuple[float, ...] | None = None
         self._selected = ""
         self.frames_shown = 0  # moments shown (the bench counts them)
+        self.last_changed: dict[str, Status] = {}  # what the last moment shown changed
         self._build()
         self._coalesce = QTimer(self)
         self._coalesce.setSingleShot(True)
@@ -224,6 +239,10 @@ class TimelinePanel(QWidget):
         self.slider.blockSignals(False)
         self.slider.set_marks([_ms(mark.time) for mark in timeline.failures])
         self.slider.setToolTip("\n".join(self._mark_tips()[:20]))
+        # As wide as its widest text: a label that changes width at every move would lay the
+        # row out again, and the slider's marks with it.
+        widest = f"{timeline.duration:.2f} s / {timeline.duration:.2f} s".replace("1", "0")
+        self.time_label.setFixedWidth(self.time_label.fontMetrics().horizontalAdvance(widest) + 8)
         self.show_time(0.0)
         self.show_figures(self._selected)
 
@@ -272,6 +291,7 @@ class TimelinePanel(QWidget):
         statuses = timeline.statuses_after(index)
         changed = changed_statuses(self._statuses, statuses)
         self._statuses = statuses
+        self.last_changed = changed
         if changed:
             self.statuses_changed.emit(changed)
         self._show_values(timeline.values_at(t))
