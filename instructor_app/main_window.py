@@ -349,6 +349,7 @@ class MainWindow(QMainWindow):
         controller.failure_changed.connect(self.failure_button.show_failure)
         controller.run_state_changed.connect(self.cells.follow_run_state)
         controller.run_starting.connect(views.teacher.leave_freedrive)
+        controller.run_starting.connect(lambda: views.timeline.set_timeline(None))  # live again
         controller.run_state_changed.connect(
             lambda state: views.teacher.set_run_active(
                 state not in (ExecutorState.READY, ExecutorState.FINISHED)

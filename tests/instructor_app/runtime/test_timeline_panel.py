@@ -18,7 +18,7 @@ from engine.spec import NodeKind, NodeSpec, PlanSpec
 from engine.status import Status
 from instructor_app.main_window import MainWindow
 from instructor_app.runtime.session import CellSession
-from tests.instructor_app.gui_driver import ScriptedDialogs, make_window, node_named
+from tests.instructor_app.gui_driver import ScriptedDialogs, make_window, node_named, run_to_end
 from tests.instructor_app.runtime.plans import number, op, text
 
 
@@ -126,3 +126,22 @@ def test_the_selected_node_shows_its_figures_and_last_run_opens_the_newest_recor
     qtbot.waitUntil(lambda: "grasp CUP" in panel.figures_label.text())
     assert "2 failures" in panel.figures_label.text()
     assert "started 2" in panel.figures_label.text()
+
+
+def test_last_run_opens_the_record_of_the_run_that_just_ended_and_a_run_closes_it(
+    qtbot: Any, window: MainWindow, figure3_path: Path
+) -> None:
+    window.open_plan(figure3_path)
+    run_to_end(qtbot, window)
+    panel = window.views.timeline
+    panel.last_button.click()
+    record = window.controller.last_record
+    assert record is not None and panel.timeline is not None
+    assert panel.timeline.name == record.name
+    assert window.document.path == figure3_path  # the same plan: the canvas keeps it
+    cup_found = node_named(window, "CUP found")
+    panel.go_to_failure(0)
+    assert window.views.canvas.status_of(cup_found) is Status.FAILURE
+    assert window.document.plan.tree.id in panel.running.node_ids()  # the plan went on
+    run_to_end(qtbot, window)
+    assert panel.timeline is None and not panel.slider.isEnabled()
