@@ -6,6 +6,7 @@ when its mark is clicked.
 from __future__ import annotations
 
 import io
+import json
 from pathlib import Path
 from typing import Any
 
@@ -145,3 +146,32 @@ def test_last_run_opens_the_record_of_the_run_that_just_ended_and_a_run_closes_i
     assert window.document.plan.tree.id in panel.running.node_ids()  # the plan went on
     run_to_end(qtbot, window)
     assert panel.timeline is None and not panel.slider.isEnabled()
+
+
+def test_a_moment_shows_the_values_and_the_robots_joints_of_that_moment(
+    qtbot: Any, window: MainWindow, figure3_path: Path, tmp_path: Path, monkeypatch: Any
+) -> None:
+    runs = tmp_path / "runs"
+    code = costar(
+        ["run", "--cell", "none", str(figure3_path), "--rate", "200", "--runs", str(runs)],
+        io.StringIO(),
+        io.StringIO(),
+    )
+    assert code == 0
+    (record,) = runs.iterdir()
+    with record.open("a", encoding="utf-8") as out:  # what a cell's arm adds, 10 times a second
+        start = json.loads(record.read_text().splitlines()[1])["time"]  # the run's start
+        for i in range(5):
+            out.write(f'{{"event":"joints","q":[{i},0,0,0,0,0],"time":{start + 0.1 * i}}}\n')
+    ghosts: list[Any] = []
+    monkeypatch.setattr(window.cell_views.scene3d, "show_ghost", ghosts.append)
+    _open(window, record)
+    panel, blackboard = window.views.timeline, window.views.blackboard
+    assert panel.timeline is not None
+    panel.show_time(0.25)
+    assert ghosts[-1] == [2.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    panel.show_time(panel.timeline.duration)
+    assert {"CUP_POSE", "BIN_POSE"} <= set(blackboard.values())
+    panel.show_time(0.0)
+    assert not {"CUP_POSE", "BIN_POSE"} & set(blackboard.values())
+    assert ghosts[-1] == [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
