@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 import time
 
-from PySide6.QtCore import Qt, QTimer, Signal
+from PySide6.QtCore import QLine, Qt, QTimer, Signal
 from PySide6.QtGui import QColor, QMouseEvent, QPainter, QPaintEvent, QPen
 from PySide6.QtWidgets import (
     QHBoxLayout,
@@ -102,9 +102,8 @@ class TimelineSlider(QSlider):
             return
         painter = QPainter(self)
         painter.setPen(QPen(FAILURE_COLOUR, 2))
-        height = self.height()
-        for x in sorted(set(self._mark_xs())):  # one line per pixel column
-            painter.drawLine(x, 2, x, height - 3)
+        bottom = self.height() - 3
+        painter.drawLines([QLine(x, 2, x, bottom) for x in set(self._mark_xs())])  # one a column
         painter.end()
 
     def mousePressEvent(self, event: QMouseEvent) -> None:
@@ -150,6 +149,7 @@ class TimelinePanel(QWidget):
         self._statuses: dict[str, Status] = {}
         self._entries: dict[str, BlackboardEntry] = {}
         self._joints: tuple[float, ...] | None = None
+        self._running: list[str] = []
         self._selected = ""
         self.frames_shown = 0  # moments shown (the bench counts them)
         self.last_changed: dict[str, Status] = {}  # what the last moment shown changed
@@ -216,7 +216,7 @@ class TimelinePanel(QWidget):
         """Show a record from its start (None: none)."""
         self.set_playing(False)
         self.timeline = timeline
-        self._statuses, self._entries, self._joints = {}, {}, None
+        self._statuses, self._entries, self._joints, self._running = {}, {}, None, []
         self.statuses_cleared.emit()
         has = timeline is not None
         for widget in (self.slider, self.play_button):
@@ -300,7 +300,8 @@ class TimelinePanel(QWidget):
             self._joints = joints
             self.joints_changed.emit(joints)
         running = timeline.running_after(index)
-        if running != self.running.node_ids():
+        if running != self._running:
+            self._running = running
             self.running.set_nodes(running)
         self.frames_shown += 1
 
