@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from engine.blackboard import BlackboardEntry
+from engine.build import ROOT_ID
 from engine.plan_format import PlanFileError
 from engine.plan_reader import loads_plan
 from engine.spec import PlanSpec
@@ -114,7 +115,9 @@ class Timeline:
         self.header = trace.header
         nodes = trace.header.get("nodes", [])
         self.labels: dict[str, str] = {n["id"]: n.get("label", n["id"]) for n in nodes}
-        self.node_ids: list[str] = [n["id"] for n in nodes]
+        # The run's own root (its run policy) above the plan's tree: outermost, first.
+        self.labels.setdefault(ROOT_ID, f"the run of {trace.header.get('plan') or 'the plan'}")
+        self.node_ids: list[str] = [ROOT_ID, *(n["id"] for n in nodes if n["id"] != ROOT_ID)]
         self._slot: dict[str, int] = {node_id: i for i, node_id in enumerate(self.node_ids)}
         self.start = self._start_time(trace)
         self.times: list[float] = []  # the status transitions, in order

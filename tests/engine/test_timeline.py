@@ -109,10 +109,15 @@ def test_figures_count_starts_results_ticks_and_time_running(tmp_path: Path) -> 
     assert [(m.node_id, m.tick, m.error, m.index) for m in timeline.failures] == [
         ("b", 3, "grasp_failed", 2)
     ]
-    assert timeline.statuses_after(3) == {"a": Status.RUNNING, "b": Status.FAILURE}
+    assert timeline.statuses_after(3) == {
+        "root": Status.IDLE,
+        "a": Status.RUNNING,
+        "b": Status.FAILURE,
+    }
     assert timeline.failure_near(0.45, 0.1) == timeline.failures[0]
     assert timeline.failure_near(0.2, 0.1) is None
     assert timeline.running_at(0.3) == ["a", "b"]
-    assert timeline.statuses_at(0.7) == {"a": Status.FAILURE, "b": Status.FAILURE}
+    failed = {"root": Status.IDLE, "a": Status.FAILURE, "b": Status.FAILURE}
+    assert timeline.statuses_at(0.7) == failed
     assert timeline.joints_at(0.1) is None and timeline.joints_at(0.3) == (1, 2, 3, 4, 5, 6)
     assert timeline.plan() is None  # a record without the plan's document

@@ -82,7 +82,8 @@ def test_a_moment_of_the_record_shows_its_statuses_on_the_canvas(
     qtbot.waitUntil(lambda: canvas.status_of(wait) is Status.RUNNING)
     assert canvas.status_of(top) is Status.RUNNING
     assert canvas.status_of(grasp) in (None, Status.IDLE)
-    assert panel.running.node_ids()[:2] == [top, wait]
+    assert panel.running.node_ids()[:3] == ["root", top, wait]  # the run's own root first
+    assert panel.running.item(0).text() == "the run of timed"
     assert "s / " in panel.time_label.text()
     # The end: everything succeeded but the grasp, which failed last.
     panel.show_time(timeline.duration)
