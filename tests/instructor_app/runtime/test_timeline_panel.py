@@ -176,3 +176,16 @@ def test_a_moment_shows_the_values_and_the_robots_joints_of_that_moment(
     panel.show_time(0.0)
     assert not {"CUP_POSE", "BIN_POSE"} & set(blackboard.values())
     assert ghosts[-1] == [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+
+
+def test_play_goes_on_through_the_run_and_stops_at_its_end(
+    qtbot: Any, window: MainWindow, record: Path
+) -> None:
+    _open(window, record)
+    panel = window.views.timeline
+    assert panel.timeline is not None and not panel.playing
+    panel.play_button.click()
+    assert panel.playing
+    qtbot.waitUntil(lambda: not panel.playing, timeout=5000)  # the run lasts about 0.12 s
+    assert panel.slider.value() == panel.slider.maximum()
+    assert not panel.play_button.isChecked()
