@@ -28,12 +28,13 @@ def wait(seconds: float) -> None:
 
 
 @contextmanager
-def sim_window() -> Iterator[MainWindow]:
-    """The main window on a simulated cell at real time, shown at 1920 x 1080, its settings
-    and recovery files in a scratch folder (the caller has made the QApplication); on leaving,
-    the run, the views and the autosaver are stopped and the cell is closed.
+def sim_window(cell: str = "sim") -> Iterator[MainWindow]:
+    """The main window on a simulated cell at real time (or on ``cell``: "none"), shown at
+    1920 x 1080, its settings and recovery files in a scratch folder (the caller has made the
+    QApplication); on leaving, the run, the views and the autosaver are stopped and the cell
+    is closed.
     """
-    session = CellSession("sim", speed=1.0)
+    session = CellSession(cell, speed=1.0)
     session.open()
     with tempfile.TemporaryDirectory() as scratch:
         settings = AppSettings(QSettings(str(Path(scratch, "s.ini")), QSettings.Format.IniFormat))

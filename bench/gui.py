@@ -20,12 +20,19 @@ Figures (all in one offscreen QApplication, view 1280 x 800):
   most 0.10), measured in a process of its own after the panels showed their first pictures
   and a few seconds' settling. ``idle_camera_frames`` / ``idle_scene3d_frames``: pictures the
   camera panel showed and frames the 3D scene drew meanwhile (0 when idle is quiet).
+- ``timeline_scrub_fps``: frames per second while the Timeline panel's slider is dragged
+  across a record of 100,000 transitions of the 1000-node plan (synthetic, several changes a
+  tick), in the main window on no cell at 1920 x 1080: each frame moves the slider as a drag
+  does (``setSliderPosition`` with the slider down) and ends when the canvas has painted the
+  moment (its statuses, the Blackboard panel's values, the running nodes); the drag goes
+  across the whole run in ``--frames`` steps and back at random (goal at least 30).
+  ``timeline_load_s``: reading the record and indexing it.
 - ``ngqt_create_node_1000_s``: the peer, NodeGraphQt's own ``NodeGraph.create_node`` with
   its defaults, 1000 times, in the same process (nodes with one input and one output port).
 
 Run from the repository root::
 
-    .venv/bin/python bench/gui.py [--json] [--frames 90] [--idle-seconds 30]
+    .venv/bin/python bench/gui.py [--json] [--frames 90] [--idle-seconds 30] [--timeline-only]
 """
 
 from __future__ import annotations
@@ -61,6 +68,7 @@ __all__ = [
     "measure_frames",
     "measure_idle",
     "measure_ngqt_create",
+    "measure_timeline_scrub",
     "main",
 ]
 
@@ -152,6 +160,65 @@ def measure_frames(app: QApplication, view: Any, ids: list[str], frames: int) ->
     return times
 
 
+def measure_timeline_scrub(
+    app: QApplication, plan: PlanSpec, frames: int, transitions: int = 100_000
+) -> dict[str, Any]:
+    """Frames per second of a drag of the Timeline slider over a record of ``plan`` (see
+    the module doc).
+    """
+    from bench._records import write_synthetic_record
+    from bench._window import sim_window, wait
+
+    with tempfile.TemporaryDirectory() as folder, sim_window("none") as window:
+        record = write_synthetic_record(Path(folder) / "big.trace.jsonl", plan, transitions)
+        app.processEvents()
+        start = time.perf_counter()
+        window.timeline.open_record(record)
+        load_s = time.perf_counter() - start
+        window.views.canvas.fit_all()
+        panel = window.views.timeline
+        slider = panel.slider
+        counter = _PaintCounter()
+        viewport = window.views.canvas.viewer.viewport()
+        viewport.installEventFilter(counter)
+        app.processEvents()
+        canvas = window.views.canvas
+        nodes = canvas.mirror.nodes
+
+        def on_screen(changed: dict[str, Any]) -> bool:
+            """Whether a changed node shows (a big tree fits only its top in the view)."""
+            shown = canvas.viewer.mapToScene(viewport.rect()).boundingRect()
+            return any(
+                nodes[n].item.sceneBoundingRect().intersects(shown) for n in changed if n in nodes
+            )
+
+        wait(1.0)  # what opening the plan left to do (its validation) is done
+        rnd = random.Random(2)
+        steps = [round(slider.maximum() * i / frames) for i in range(1, frames + 1)]
+        steps += [rnd.randint(0, slider.maximum()) for _ in range(frames)]
+        slider.setSliderDown(True)
+        start = time.perf_counter()
+        for value in steps:
+            before, shown = counter.count, panel.frames_shown
+            slider.setSliderPosition(value)
+            deadline = time.perf_counter() + 5.0  # (a frame never takes that long)
+            while panel.frames_shown == shown and time.perf_counter() < deadline:
+                app.processEvents(QEventLoop.ProcessEventsFlag.AllEvents, 5)  # the update
+            while counter.count == before and on_screen(panel.last_changed):  # its paint
+                if time.perf_counter() > deadline:
+                    raise RuntimeError(f"the canvas did not paint the moment at {value} ms")
+                app.processEvents(QEventLoop.ProcessEventsFlag.AllEvents, 5)
+        elapsed = time.perf_counter() - start
+        slider.setSliderDown(False)
+        viewport.removeEventFilter(counter)
+        transitions = panel.timeline.transitions if panel.timeline else 0
+    return {
+        "timeline_scrub_fps": round(len(steps) / elapsed, 1),
+        "timeline_load_s": round(load_s, 2),
+        "timeline_transitions": transitions,
+    }
+
+
 def measure_ngqt_create(count: int = 1000) -> float:
     """Seconds for NodeGraphQt's plain ``create_node`` (defaults) ``count`` times."""
     from NodeGraphQt import BaseNode, NodeGraph
@@ -190,6 +257,7 @@ def run_bench(frames: int, idle_seconds: float = 30.0) -> dict[str, Any]:
     view.viewer.show_rect(QRectF(root.center().x() - 640, root.top() - 40, 1280, 800))
     zoom100 = measure_frames(app, view, ids, frames)
     view.clear_statuses()
+    scrub = measure_timeline_scrub(app, document.plan, frames)
     return {
         "open_1000_s": round(open_s, 3),
         "frame_ms_median": round(statistics.median(fit), 2),
@@ -197,6 +265,7 @@ def run_bench(frames: int, idle_seconds: float = 30.0) -> dict[str, Any]:
         "frame_ms_median_zoom100": round(statistics.median(zoom100), 2),
         "frame_ms_p99_zoom100": round(_percentile(zoom100, 0.99), 2),
         "ngqt_create_node_1000_s": round(measure_ngqt_create(1000), 3),
+        **scrub,
         **measure_cell_views_in_a_process(),
         **measure_idle_in_a_process(idle_seconds),
     }
@@ -293,7 +362,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--idle-only", action="store_true", help="only the idle figures (in this process)"
     )
+    parser.add_argument("--timeline-only", action="store_true", help="only the timeline figures")
     args = parser.parse_args(argv)
+    if args.timeline_only:
+        app = QApplication.instance() or QApplication([])
+        print_figures(measure_timeline_scrub(app, build_plan(1000), args.frames), args.json, 26)
+        return 0
     if args.idle_only:
         print_figures(measure_idle(args.idle_seconds), args.json, 26)
         return 0

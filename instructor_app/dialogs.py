@@ -10,6 +10,7 @@ __all__ = [
     "CELL_FILTER",
     "DISCARD",
     "PLAN_FILTER",
+    "RECORD_FILTER",
     "SAVE",
     "XML_FILTER",
     "Dialogs",
@@ -19,6 +20,7 @@ APP_TITLE = "CoSTAR Instructor"
 PLAN_FILTER = "CoSTAR plans (*.costar.json);;JSON files (*.json);;All files (*)"
 CELL_FILTER = "CoSTAR cells (*.cell.json);;JSON files (*.json);;All files (*)"
 XML_FILTER = "BehaviorTree.CPP XML (*.xml);;All files (*)"
+RECORD_FILTER = "Run records (*.trace.jsonl);;All files (*)"
 SAVE, DISCARD, CANCEL = "save", "discard", "cancel"
 
 
@@ -79,6 +81,9 @@ class Dialogs:
 
     def open_path(self, parent: QWidget, folder: str) -> str:
         return QFileDialog.getOpenFileName(parent, "Open plan", folder, PLAN_FILTER)[0]
+
+    def record_open_path(self, parent: QWidget, folder: str) -> str:
+        return QFileDialog.getOpenFileName(parent, "Open run record", folder, RECORD_FILTER)[0]
 
     def open_cell_path(self, parent: QWidget, folder: str) -> str:
         return QFileDialog.getOpenFileName(parent, "Open cell file", folder, CELL_FILTER)[0]

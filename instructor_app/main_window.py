@@ -55,6 +55,7 @@ from instructor_app.settings import (
     RecentFilesMenu,
     app_version,
 )
+from instructor_app.timeline_wiring import TimelineController
 from instructor_app.views import Views, make_views
 from instructor_app.window_layout import arrange_cell_views, place_docks
 from instructor_app.xml_files import export_plan_xml, import_plan_xml
@@ -132,6 +133,15 @@ class MainWindow(QMainWindow):
             self,
         )
         self._build_layout()
+        self.timeline = TimelineController(
+            self.views.timeline,
+            self.document,
+            self.views,
+            self.cell_views.scene3d,
+            self,
+            lambda: self.controller.last_record,
+            self,
+        )
         self.actions_by_name: dict[str, QAction] = {}
         self._build_menus()
         self._wire_views()
@@ -207,6 +217,10 @@ class MainWindow(QMainWindow):
                 "&Import BehaviorTree.CPP XML…",
                 lambda: import_plan_xml(self),
             )
+        )
+        files.addSeparator()
+        files.addAction(
+            self._action("open_record", "Open &Run Record…", lambda: self.timeline.open_record())
         )
         files.addSeparator()
         files.addAction(self._action("quit", "&Quit", self.close, "Ctrl+Q"))
@@ -302,7 +316,7 @@ class MainWindow(QMainWindow):
             self.cell_views.scene3d, views.teacher, views.waypoints, self
         )
         self.session.cell_changed.connect(lambda _name: self._attach_operator())
-        self.operator_panel.prompt_shown.connect(lambda _text: self._raise_dock("operator"))
+        self.operator_panel.prompt_shown.connect(lambda _text: self.raise_dock("operator"))
         self._attach_operator()
         views.palette.item_activated.connect(self.add_palette_item)
         views.validation.node_selected.connect(self.select_node)
@@ -335,6 +349,7 @@ class MainWindow(QMainWindow):
         controller.failure_changed.connect(self.failure_button.show_failure)
         controller.run_state_changed.connect(self.cells.follow_run_state)
         controller.run_starting.connect(views.teacher.leave_freedrive)
+        controller.run_starting.connect(lambda: views.timeline.set_timeline(None))  # live again
         controller.run_state_changed.connect(
             lambda state: views.teacher.set_run_active(
                 state not in (ExecutorState.READY, ExecutorState.FINISHED)
@@ -349,6 +364,7 @@ class MainWindow(QMainWindow):
             self,
         )
         self.run_presenter.problems_shown.connect(lambda: self.docks["validation"].raise_())
+        self.timeline.message.connect(self.show_message)
 
     # ------------------------------------------------------------------ editing
 
@@ -360,7 +376,7 @@ class MainWindow(QMainWindow):
     def _selected_node(self) -> str | None:
         return self.selection[0] if len(self.selection) == 1 else None
 
-    def _raise_dock(self, name: str) -> None:
+    def raise_dock(self, name: str) -> None:
         self.docks[name].show()
         self.docks[name].raise_()
 

@@ -47,6 +47,7 @@ class Views:
     teacher: Any = None  # RobotTeacher: jog, freedrive, move-here off the GUI thread
     move: Any = None
     objects: Any = None
+    timeline: Any = None
 
     def set_registry(self, registry: Any) -> None:
         """Another cell: every view that shows operations rebuilds from its registry."""
@@ -101,6 +102,7 @@ def make_views(
     from instructor_app.panels.move import MovePanel
     from instructor_app.panels.object_library import ObjectLibraryPanel
     from instructor_app.panels.object_thumbnails import ThumbnailCache
+    from instructor_app.panels.timeline import TimelinePanel
     from instructor_app.runtime.teach import RobotTeacher
 
     registry = session.registry
@@ -128,6 +130,7 @@ def make_views(
             thumbnails=ThumbnailCache(data_folder / "thumbnails") if data_folder else None,
             parent=parent,
         ),
+        TimelinePanel(parent),
     )
     views.inspector.set_teacher(teacher)
     views.set_registry(registry)

@@ -111,6 +111,7 @@ def place_docks(
         ("blackboard", "Blackboard", views.blackboard),
         ("running", "Running nodes", running_panel),
         ("inside", "Inside instance", views.inside),
+        ("timeline", "Timeline", views.timeline),
     ]
     for name, title, widget in bottom:
         dock(name, title, widget, area.BottomDockWidgetArea)

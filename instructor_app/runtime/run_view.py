@@ -88,12 +88,17 @@ class RunningNodesPanel(QListWidget):
         self.itemClicked.connect(self._picked)
 
     def set_nodes(self, node_ids: list[str]) -> None:
-        self.clear()
-        for node_id in node_ids:
-            item = QListWidgetItem(self._label(node_id))
-            item.setData(Qt.ItemDataRole.UserRole, node_id)
-            self.addItem(item)
-        self._mark_held()
+        self.setUpdatesEnabled(False)  # one repaint for the whole list (a timeline's drag)
+        try:
+            self.clear()
+            for node_id in node_ids:
+                item = QListWidgetItem(self._label(node_id))
+                item.setData(Qt.ItemDataRole.UserRole, node_id)
+                self.addItem(item)
+            if self._held:
+                self._mark_held()
+        finally:
+            self.setUpdatesEnabled(True)
 
     def set_held(self, reason: str, text: str = "") -> None:
         """The run is held (why; "" when it goes on): the running nodes say so."""

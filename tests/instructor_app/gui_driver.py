@@ -82,7 +82,7 @@ class ScriptedDialogs(Dialogs):
         restore_answers: answers to "restore the unsaved plan?"; when empty, False.
         overwrite_answers: answers to "teach again a waypoint other nodes use?"; when
             empty, False.
-        open_paths / save_paths / cell_paths: what the file dialogs return ("" = cancelled).
+        open_paths / save_paths / cell_paths / record_paths: what the file dialogs return ("" = cancelled).
         port_answers: what the Groot2 port dialog returns (None = cancelled; when empty, None).
         asked: ("save" | "restore" | "overwrite", text) in order; errors: (title, text) in order.
     """
@@ -94,6 +94,7 @@ class ScriptedDialogs(Dialogs):
         self.open_paths: list[str] = []
         self.save_paths: list[str] = []
         self.cell_paths: list[str] = []
+        self.record_paths: list[str] = []
         self.asked: list[tuple[str, str]] = []
         self.errors: list[tuple[str, str]] = []
         self.port_answers: list[int | None] = []
@@ -119,6 +120,9 @@ class ScriptedDialogs(Dialogs):
 
     def open_path(self, parent: QWidget, folder: str) -> str:
         return self.open_paths.pop(0) if self.open_paths else ""
+
+    def record_open_path(self, parent: QWidget, folder: str) -> str:
+        return self.record_paths.pop(0) if self.record_paths else ""
 
     def open_cell_path(self, parent: QWidget, folder: str) -> str:
         return self.cell_paths.pop(0) if self.cell_paths else ""
