@@ -29,6 +29,7 @@ import threading
 from collections.abc import Callable
 from typing import Any, TextIO
 
+from capabilities.errors import CapabilityError
 from engine.blackboard import BlackboardError
 from engine.btcpp.values import parse_value
 from engine.debugger import Breakpoint
@@ -49,7 +50,7 @@ HELP = (
 _INDEX = re.compile(r"\[\d+\]")
 
 
-class BreakpointNotFound(ValueError):
+class BreakpointNotFound(CapabilityError):
     """No node, or more than one, has the path a breakpoint names."""
 
 
