@@ -60,12 +60,13 @@ _SYMBOLS: dict[NodeKind, str] = {
     NodeKind.SEQUENCE_WITH_MEMORY: "M->",
     NodeKind.ASYNC_SEQUENCE: "A->",
     NodeKind.ASYNC_FALLBACK: "A?",
-    NodeKind.PARALLEL_ALL: "|all|",
+    NodeKind.PARALLEL_ALL: "|*|",
     NodeKind.IF_THEN_ELSE: "if?",
-    NodeKind.WHILE_DO_ELSE: "while?",
+    NodeKind.WHILE_DO_ELSE: "w?",
     NodeKind.SWITCH: "=?",
-    NodeKind.TRY_CATCH: "try!",
+    NodeKind.TRY_CATCH: "tr!",
 }
+# The symbol box is three characters wide: a longer symbol runs under the node's edge.
 
 _MAX_PARAM_LINES = 4
 
