@@ -340,6 +340,9 @@ class HeadlessDialogs(Dialogs):
     def error(self, parent: QWidget, title: str, text: str) -> None:
         print(f"error: {title}: {text}", file=sys.stderr)
 
+    def ask_text(self, parent: QWidget, title: str, label: str, text: str) -> str | None:
+        return None
+
 
 if __name__ == "__main__":
     sys.exit(main())

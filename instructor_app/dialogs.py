@@ -113,5 +113,10 @@ class Dialogs:
         )
         return int(port) if ok else None
 
+    def ask_text(self, parent: QWidget, title: str, label: str, text: str) -> str | None:
+        """A line of text (None: cancelled)."""
+        answer, ok = QInputDialog.getText(parent, title, label, text=text)
+        return str(answer) if ok else None
+
     def about(self, parent: QWidget, text: str) -> None:
         QMessageBox.about(parent, f"About {APP_TITLE}", text)

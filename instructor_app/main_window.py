@@ -96,7 +96,12 @@ class MainWindow(QMainWindow):
         self.views: Views = make_views(self.document, session, self, self.autosaver.folder.parent)
         self.run_actions = RunActions(self.controller, self)
         self.debug_actions = DebugActions(
-            self.controller, self.views.canvas, self.show_message, self, self.settings
+            self.controller,
+            self.views.canvas,
+            self.show_message,
+            self,
+            self.settings,
+            lambda title, label, text: self._dialogs.ask_text(self, title, label, text),
         )
         self.running_panel = RunningNodesPanel(self._node_path, self)
         self.operator_panel = OperatorPanel(self)

@@ -6,6 +6,7 @@ that tests use a temporary file and never the user's settings.
 
 from __future__ import annotations
 
+import json
 from collections.abc import Callable
 from importlib import metadata
 from pathlib import Path
@@ -14,6 +15,9 @@ from PySide6.QtCore import QByteArray, QSettings
 from PySide6.QtGui import QAction
 from PySide6.QtWidgets import QMenu, QWidget
 
+from engine.debugger import Breakpoint
+from engine.json_text import JsonFileError, parse_json
+from engine.script import ScriptSyntaxError
 from resources import resource_path
 
 __all__ = [
@@ -130,17 +134,26 @@ class AppSettings:
         self.qsettings.setValue(_GROOT2_PORT, int(port))
         self.qsettings.sync()
 
-    def breakpoints(self, plan_id: str) -> list[str]:
-        """The node ids the operator set breakpoints on in the plan ``plan_id``."""
+    def breakpoints(self, plan_id: str) -> list[Breakpoint]:
+        """The breakpoints the operator set in the plan ``plan_id`` (one a setting cannot
+        give back is left out).
+        """
         value = self.qsettings.value(f"{_BREAKPOINTS}/{plan_id}", [])
         if isinstance(value, str):  # QSettings gives a lone string for a one-item list
             value = [value]
-        return [str(v) for v in (value or []) if v]
+        found = []
+        for text in (str(v) for v in (value or []) if v):
+            try:
+                found.append(_breakpoint_of(text))
+            except (JsonFileError, KeyError, ValueError, ScriptSyntaxError):
+                continue  # written by another version, or edited by hand
+        return found
 
-    def set_breakpoints(self, plan_id: str, node_ids: list[str]) -> None:
+    def set_breakpoints(self, plan_id: str, breakpoints: list[Breakpoint]) -> None:
         key = f"{_BREAKPOINTS}/{plan_id}"
-        if node_ids:
-            self.qsettings.setValue(key, sorted(node_ids))
+        if breakpoints:
+            texts = sorted(_breakpoint_text(b) for b in breakpoints)
+            self.qsettings.setValue(key, texts)
         else:
             self.qsettings.remove(key)
 
@@ -196,3 +209,22 @@ class RecentFilesMenu(QMenu):
     def _clear(self) -> None:
         self._settings.clear_recent()
         self.rebuild()
+
+
+def _breakpoint_text(breakpoint: Breakpoint) -> str:
+    """A plain node id for a breakpoint before it, else a JSON object."""
+    if breakpoint.before and not breakpoint.after and not breakpoint.condition:
+        return breakpoint.node_id
+    fields = {"node": breakpoint.node_id, "before": breakpoint.before, "after": breakpoint.after}
+    return json.dumps({**fields, "if": breakpoint.condition}, sort_keys=True)
+
+
+def _breakpoint_of(text: str) -> Breakpoint:
+    if not text.startswith("{"):
+        return Breakpoint(text)
+    data = parse_json(text, "settings", "breakpoint")
+    if not isinstance(data, dict):
+        raise ValueError("a breakpoint is an object")
+    return Breakpoint(
+        str(data["node"]), bool(data["before"]), bool(data["after"]), str(data.get("if", ""))
+    )

@@ -15,9 +15,10 @@ from PySide6.QtCore import QObject, Qt
 from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import QMenu, QWidget
 
-from engine.debugger import Forced
+from engine.debugger import Breakpoint, Forced
 from engine.error_types import ErrorType
 from engine.executor import ExecutorState
+from engine.script import ScriptSyntaxError
 from engine.status import FAILURE, SUCCESS
 from instructor_app.canvas.actions import MenuEntry
 from instructor_app.canvas.view import CanvasView
@@ -38,6 +39,16 @@ FAIL_TYPES = (
 )
 
 
+AskText = Callable[[str, str, str], "str | None"]
+
+
+def _where(breakpoint: Breakpoint) -> str:
+    """ "before", "after" or "before and after"."""
+    if breakpoint.before and breakpoint.after:
+        return "before and after"
+    return "before" if breakpoint.before else "after"
+
+
 class DebugActions(QObject):
     """Toggle Breakpoint (F9), Step (F11), Step Over (Shift+F11), Run to Selected Node
     (Ctrl+F10) and Continue (F8); marks on the canvas; what the status bar says.
@@ -48,6 +59,8 @@ class DebugActions(QObject):
         say: shows a line in the status bar (text, for how many ms; 0: until replaced).
         parent: owner of the actions (the main window, so that shortcuts work everywhere).
         settings: where the breakpoints of each plan are kept (None: nowhere).
+        ask_text: asks the operator for a line of text (title, label, text now; None:
+            cancelled), for a breakpoint's condition.
     """
 
     def __init__(
@@ -57,10 +70,12 @@ class DebugActions(QObject):
         say: Callable[[str, int], None],
         parent: QWidget,
         settings: AppSettings | None = None,
+        ask_text: AskText | None = None,
     ) -> None:
         super().__init__(parent)
         self.controller, self.canvas, self._say = controller, canvas, say
         self._settings = settings
+        self._ask_text: AskText = ask_text or (lambda _title, _label, _text: None)
         self.debugging = controller.debugging
         self.paused_at = ""  # the plan node the run is paused at ("" when it is not)
         self.toggle = self._action(parent, "Toggle &Breakpoint", "F9", self.toggle_selected)
@@ -124,6 +139,7 @@ class DebugActions(QObject):
                 "Clear Breakpoint" if debugging.has_breakpoint(node_id) else "Set Breakpoint",
                 functools.partial(self._toggle, node_id),
             ),
+            ("Breakpoint", self._breakpoint_entries(node_id)),
             (
                 "Do Not Skip This Node" if skipped else "Skip This Node",
                 functools.partial(debugging.set_skipped, node_id, not skipped),
@@ -140,12 +156,57 @@ class DebugActions(QObject):
         entries.append(("Force Result", force))
         return entries
 
+    def _breakpoint_entries(self, node_id: str) -> list[tuple[str, Callable[[], object]]]:
+        """Where the run pauses at the node: before it, after it, both; on a condition."""
+        now = self.debugging.breakpoint(node_id)
+        condition = now.condition if now is not None else ""
+        where = [("Before", True, False), ("After", False, True), ("Before and After", True, True)]
+        entries: list[tuple[str, Callable[[], object]]] = [
+            (text, functools.partial(self._put, Breakpoint(node_id, before, after, condition)))
+            for text, before, after in where
+        ]
+        entries.append(("Only When…", functools.partial(self._ask_condition, node_id)))
+        if now is not None:
+            entries.append(("Clear", functools.partial(self._put_none, node_id)))
+        return entries
+
+    def _ask_condition(self, node_id: str) -> None:
+        """Ask for the condition (a script on the node's names; empty: always)."""
+        now = self.debugging.breakpoint(node_id) or Breakpoint(node_id)
+        label = self.canvas.document.node(node_id).label
+        text = self._ask_text(
+            "Breakpoint condition",
+            f"Pause at {label} only when this is true (a script, e.g. COUNT >= 3; empty: always):",
+            now.condition,
+        )
+        if text is None:
+            return
+        try:
+            self._put(Breakpoint(node_id, now.before, now.after, text.strip()))
+        except ScriptSyntaxError as exc:
+            self._say(f"Breakpoint condition not set: {exc}", 0)
+
+    def _put(self, breakpoint: Breakpoint) -> None:
+        self.debugging.set_breakpoint(breakpoint.node_id, breakpoint)
+        self._keep()
+        label = self.canvas.document.node(breakpoint.node_id).label
+        when = f" when {breakpoint.condition}" if breakpoint.condition else ""
+        self._say(f"Breakpoint {_where(breakpoint)} {label}{when} set", 8000)
+
+    def _put_none(self, node_id: str) -> None:
+        self.debugging.set_breakpoint(node_id, None)
+        self._keep()
+
     def _toggle(self, node_id: str) -> bool:
         on = self.debugging.toggle_breakpoint(node_id)
+        self._keep()
+        return on
+
+    def _keep(self) -> None:
+        """Keep the plan's breakpoints in the settings (never in the plan file)."""
         if self._settings is not None:
             plan_id = self.canvas.document.plan.id
-            self._settings.set_breakpoints(plan_id, sorted(self.debugging.breakpoints))
-        return on
+            self._settings.set_breakpoints(plan_id, self.debugging.all_breakpoints())
 
     def _force(self, node_id: str, forced: Forced | None) -> None:
         self.debugging.set_forced(node_id, forced)
@@ -162,8 +223,9 @@ class DebugActions(QObject):
     def _on_plan_reset(self) -> None:
         """Another plan (or the same, reloaded): its breakpoints as they were kept."""
         plan = self.canvas.document.plan
-        kept = set(self._settings.breakpoints(plan.id)) if self._settings is not None else set()
-        self.debugging.load(kept & {node.id for _, node in plan.walk()})
+        kept = self._settings.breakpoints(plan.id) if self._settings is not None else []
+        ids = {node.id for _, node in plan.walk()}
+        self.debugging.load([b for b in kept if b.node_id in ids])
 
     def _on_plan_changed(self) -> None:
         self.debugging.forget({node.id for _, node in self.canvas.document.plan.walk()})

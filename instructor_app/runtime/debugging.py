@@ -30,7 +30,7 @@ class RunDebugging(QObject):
 
     def __init__(self, parent: QObject | None = None) -> None:
         super().__init__(parent)
-        self._breakpoints: set[str] = set()
+        self._breakpoints: dict[str, Breakpoint] = {}
         self._skipped: set[str] = set()
         self._forced: dict[str, Forced] = {}
         self._live: Debugger | None = None  # the debugger of the run going on
@@ -44,6 +44,13 @@ class RunDebugging(QObject):
     def breakpoints(self) -> frozenset[str]:
         return frozenset(self._breakpoints)
 
+    def breakpoint(self, node_id: str) -> Breakpoint | None:
+        """The breakpoint on ``node_id``: before or after it, with its condition."""
+        return self._breakpoints.get(node_id)
+
+    def all_breakpoints(self) -> list[Breakpoint]:
+        return list(self._breakpoints.values())
+
     def is_skipped(self, node_id: str) -> bool:
         return node_id in self._skipped
 
@@ -51,15 +58,19 @@ class RunDebugging(QObject):
         return self._forced.get(node_id)
 
     def note(self, node_id: str) -> str:
-        """What the node shows of them: "skipped", "forced: succeed", "forced: grasp_failed"."""
-        if node_id in self._skipped:
-            return "skipped"
+        """What the node shows of them besides a plain breakpoint's dot: "break after",
+        "break if COUNT > 2", "skipped", "forced: succeed", "forced: grasp_failed".
+        """
+        breakpoint = self._breakpoints.get(node_id)
+        parts = [_break_note(breakpoint)] if breakpoint is not None else []
         forced = self._forced.get(node_id)
-        if forced is None:
-            return ""
-        if forced.status is SUCCESS:
-            return "forced: succeed"
-        return f"forced: {forced.error.value if forced.error else 'fail'}"
+        if node_id in self._skipped:
+            parts.append("skipped")
+        elif forced is not None and forced.status is SUCCESS:
+            parts.append("forced: succeed")
+        elif forced is not None:
+            parts.append(f"forced: {forced.error.value if forced.error else 'fail'}")
+        return "; ".join(p for p in parts if p)
 
     def marked(self) -> set[str]:
         """Every node with a breakpoint, a skip or a forced result."""
@@ -68,18 +79,22 @@ class RunDebugging(QObject):
     # ------------------------------------------------------------------ changing
 
     def toggle_breakpoint(self, node_id: str) -> bool:
-        """Set or clear the breakpoint before ``node_id``; True when it is set now."""
+        """Set a breakpoint before ``node_id``, or clear the one it has; True when set now."""
         on = node_id not in self._breakpoints
-        if on:
-            self._breakpoints.add(node_id)
-            if self._live is not None:
-                self._live.set_breakpoint(Breakpoint(node_id))
-        else:
-            self._breakpoints.discard(node_id)
-            if self._live is not None:
-                self._live.clear_breakpoint(node_id)
-        self.changed.emit()
+        self.set_breakpoint(node_id, Breakpoint(node_id) if on else None)
         return on
+
+    def set_breakpoint(self, node_id: str, breakpoint: Breakpoint | None) -> None:
+        """Put ``breakpoint`` on ``node_id`` (None: clear it), in the run going on too."""
+        if breakpoint is None:
+            self._breakpoints.pop(node_id, None)
+        else:
+            self._breakpoints[node_id] = breakpoint
+        if self._live is not None:
+            self._live.clear_breakpoint(node_id)
+            if breakpoint is not None:
+                self._live.set_breakpoint(breakpoint)
+        self.changed.emit()
 
     def set_skipped(self, node_id: str, skipped: bool) -> None:
         """Skip the node in the runs (it reports SKIPPED), or no longer."""
@@ -106,9 +121,9 @@ class RunDebugging(QObject):
             self._forced[node_id] = forced
         self.changed.emit()
 
-    def load(self, breakpoints: set[str]) -> None:
+    def load(self, breakpoints: list[Breakpoint]) -> None:
         """Start afresh with these breakpoints (another plan was opened)."""
-        self._breakpoints = set(breakpoints)
+        self._breakpoints = {b.node_id: b for b in breakpoints}
         self._skipped.clear()
         self._forced.clear()
         self.changed.emit()
@@ -116,7 +131,7 @@ class RunDebugging(QObject):
     def forget(self, known: set[str]) -> None:
         """Drop what is set on nodes that are no longer in the plan."""
         before = self.marked()
-        self._breakpoints &= known
+        self._breakpoints = {k: v for k, v in self._breakpoints.items() if k in known}
         self._skipped &= known
         self._forced = {k: v for k, v in self._forced.items() if k in known}
         if self.marked() != before:
@@ -129,8 +144,8 @@ class RunDebugging(QObject):
         forgotten here).
         """
         debugger = Debugger()
-        for node_id in self._breakpoints:
-            debugger.set_breakpoint(Breakpoint(node_id))
+        for breakpoint in self._breakpoints.values():
+            debugger.set_breakpoint(breakpoint)
         for node_id in self._skipped:
             debugger.skip(node_id)
         for node_id, forced in self._forced.items():
@@ -143,3 +158,13 @@ class RunDebugging(QObject):
 
     def run_ended(self) -> None:
         self._live = None
+
+
+def _break_note(breakpoint: Breakpoint) -> str:
+    """ "" for a plain breakpoint before the node (its dot says it), else what it is."""
+    where = "" if breakpoint.before and not breakpoint.after else "break "
+    where += "after" if breakpoint.after and not breakpoint.before else ""
+    where += "before and after" if breakpoint.before and breakpoint.after else ""
+    if breakpoint.condition:
+        where = f"{where or 'break'} if {breakpoint.condition}"
+    return where.strip()

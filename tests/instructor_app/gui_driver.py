@@ -84,6 +84,8 @@ class ScriptedDialogs(Dialogs):
             empty, False.
         open_paths / save_paths / cell_paths / record_paths: what the file dialogs return ("" = cancelled).
         port_answers: what the Groot2 port dialog returns (None = cancelled; when empty, None).
+        text_answers: what a line-of-text question returns (None = cancelled; when empty,
+            None).
         asked: ("save" | "restore" | "overwrite", text) in order; errors: (title, text) in order.
     """
 
@@ -98,6 +100,7 @@ class ScriptedDialogs(Dialogs):
         self.asked: list[tuple[str, str]] = []
         self.errors: list[tuple[str, str]] = []
         self.port_answers: list[int | None] = []
+        self.text_answers: list[str | None] = []
 
     def ask_save_changes(self, parent: QWidget, name: str) -> str:
         self.asked.append(("save", name))
@@ -106,6 +109,10 @@ class ScriptedDialogs(Dialogs):
     def ask_groot2_port(self, parent: QWidget, current: int) -> int | None:
         self.asked.append(("groot2_port", str(current)))
         return self.port_answers.pop(0) if self.port_answers else None
+
+    def ask_text(self, parent: QWidget, title: str, label: str, text: str) -> str | None:
+        self.asked.append(("text", title))
+        return self.text_answers.pop(0) if self.text_answers else None
 
     def ask_restore(self, parent: QWidget, description: str) -> bool:
         self.asked.append(("restore", description))

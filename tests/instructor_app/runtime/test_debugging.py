@@ -157,3 +157,56 @@ def test_a_skipped_node_reports_skipped(
     assert finished.args[0].statuses[ids["move to GOAL"]] is Status.SKIPPED
     _menu_entry(window, ids["move to GOAL"], "Do Not Skip This Node").trigger()
     assert window.views.canvas.debug_marks(ids["move to GOAL"])[1] == ""
+
+
+def _counting_plan() -> PlanSpec:
+    """COUNT := 0, then three times: COUNT += 1 and a step."""
+    step = NodeSpec(
+        NodeKind.SEQUENCE,
+        name="one round",
+        children=[
+            NodeSpec(NodeKind.SCRIPT, name="count", params={"code": text("COUNT += 1")}),
+            op("debug.succeed", "step"),
+        ],
+    )
+    repeat = NodeSpec(NodeKind.REPEAT, name="three rounds", params={"count": number(3)})
+    repeat.children = [step]
+    start = NodeSpec(NodeKind.SCRIPT, name="start", params={"code": text("COUNT := 0")})
+    return PlanSpec(
+        tree=NodeSpec(NodeKind.SEQUENCE, name="top", children=[start, repeat]), name="count"
+    )
+
+
+def test_a_breakpoint_after_a_node_on_a_condition_set_from_its_menu(
+    qtbot: Any, none_session: CellSession, tmp_path: Path
+) -> None:
+    window = make_window(qtbot, none_session, tmp_path)
+    window.document.load_text(dump_plan(_counting_plan()), None)
+    ids = _ids(window)
+    canvas, controller = window.views.canvas, window.controller
+    window._dialogs.text_answers = ["COUNT >="]  # a script that does not parse: refused
+    _menu_entry(window, ids["step"], "Breakpoint", "Only When…").trigger()
+    assert controller.debugging.breakpoint(ids["step"]) is None
+    assert "condition not set" in window.statusBar().currentMessage()
+    window._dialogs.text_answers = ["COUNT >= 2"]
+    _menu_entry(window, ids["step"], "Breakpoint", "Only When…").trigger()
+    _menu_entry(window, ids["step"], "Breakpoint", "After").trigger()
+    assert canvas.debug_marks(ids["step"]) == (True, "break after if COUNT >= 2", False)
+    with qtbot.waitSignal(controller.run_paused, timeout=10000) as paused:
+        controller.run()
+    assert paused.args[0] == ids["step"] and "after step" in paused.args[1]
+    board = window.views.blackboard
+    qtbot.waitUntil(lambda: board.values().get("COUNT") == 2)  # not at the first round
+    with qtbot.waitSignal(controller.run_paused, timeout=10000):
+        controller.resume()
+    qtbot.waitUntil(lambda: board.values().get("COUNT") == 3)
+    with qtbot.waitSignal(controller.run_finished, timeout=10000) as finished:
+        controller.resume()
+    assert finished.args[0].status is Status.SUCCESS
+    window.document.load_text(dump_plan(window.document.plan), None)  # opened again: kept
+    kept = controller.debugging.breakpoint(ids["step"])
+    assert kept is not None and (kept.before, kept.after, kept.condition) == (
+        False,
+        True,
+        "COUNT >= 2",
+    )
