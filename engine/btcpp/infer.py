@@ -73,6 +73,12 @@ def infer_subtree_ports(
 
 
 _SCRIPT_PORTS = {("Script", "code"), ("ScriptCondition", "code")}
+# Ports that name an entry as it is, NAME as well as {NAME}.
+_ENTRY_PORTS = {
+    ("SkipUnlessUpdated", "entry"),
+    ("WaitValueUpdate", "entry"),
+    ("WasEntryUpdated", "entry"),
+}
 _CONDITION_ATTRS = frozenset(c.attribute for c in Condition)
 
 
@@ -104,6 +110,8 @@ def names_used(tree_id: str, trees: Mapping[str, Element]) -> list[str]:
 def _names_in(tag: str, attr: str, value: str) -> list[str]:
     if value.startswith("{") and value.endswith("}") and value != "{=}":
         return [value[1:-1].strip()]
+    if (tag, attr) in _ENTRY_PORTS:
+        return [value.strip()]
     if (tag, attr) in _SCRIPT_PORTS or attr in _CONDITION_ATTRS:
         try:
             names = script_names(parse_script(value))
