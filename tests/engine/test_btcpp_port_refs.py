@@ -84,3 +84,20 @@ def test_eq_is_the_entry_of_the_port_s_own_name(registry: CapabilityRegistry) ->
     spec = import_xml(text, "eq.xml", _manifests(registry))  # type: ignore[arg-type]
     assert _walk_ops(spec)[0].params["result"] == Binding.reference("result")
     assert build_tree(spec, registry).tick_until_done(max_ticks=5) is SUCCESS
+
+
+def test_a_subtree_without_a_model_takes_any_type_and_gives_back_what_scripts_write(
+    registry: CapabilityRegistry,
+) -> None:
+    """BehaviorTree.CPP 4.10 ran this to out = 8 (builtins/subtree_eq_remap.xml)."""
+    text = """<root BTCPP_format="4" main_tree_to_execute="Main">
+    <BehaviorTree ID="Inner"><Script code="out := x * 2"/></BehaviorTree>
+    <BehaviorTree ID="Main"><Sequence><Script code="x := 4; out := 0"/>
+      <SubTree ID="Inner" x="{=}" out="{=}" n="3"/></Sequence></BehaviorTree></root>"""
+    spec = import_xml(text, "eq.xml")
+    sub = spec.subtrees[0]
+    assert [(p.name, p.type.value) for p in sub.inputs] == [("x", "Any"), ("n", "Any")]
+    assert [(p.name, p.type.value) for p in sub.outputs] == [("out", "Any")]
+    tree = build_tree(spec, registry)
+    assert tree.tick_until_done(max_ticks=5) is SUCCESS
+    assert tree.blackboard.get("out") == 8
