@@ -77,13 +77,14 @@ def infer_subtree_ports(
     return inputs, outputs
 
 
-_SCRIPT_PORTS = {("Script", "code"), ("ScriptCondition", "code")}
+_SCRIPT_PORTS = {("Script", "code"), ("ScriptCondition", "code"), ("Precondition", "if")}
 # Ports that name an entry as it is, NAME as well as {NAME}.
 _ENTRY_PORTS = {
     ("SkipUnlessUpdated", "entry"),
     ("WaitValueUpdate", "entry"),
     ("WasEntryUpdated", "entry"),
-}
+    ("SetBlackboard", "output_key"),
+}  # not UnsetBlackboard's key: BehaviorTree.CPP's unset looks in the subtree's own entries
 _CONDITION_ATTRS = frozenset(c.attribute for c in Condition)
 
 
