@@ -248,6 +248,7 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             hold=hold_check(cell),
             lockstep=lockstep_of(cell),
         )
+        _groot2_hooks(publisher, executor)
         console = _break_console(args, executor, plan, out)
         restore = _install_interrupt(executor)
         operator = cell.interfaces().get("operator")
@@ -323,6 +324,16 @@ def _groot2(
     publisher = Groot2Publisher(monitor, args.groot2, args.groot2_host or DEFAULT_HOST)
     print(f"Groot2: publishing the run on {publisher.address}", file=out, flush=True)
     return publisher
+
+
+def _groot2_hooks(publisher: Groot2Publisher | None, executor: Executor) -> None:
+    """Groot2's breakpoints pause this run (on its debugger)."""
+    if publisher is None:
+        return
+    from capabilities.groot2.hooks import Groot2Hooks
+
+    monitor = publisher.monitor
+    monitor.hooks = Groot2Hooks(monitor.tree.uids, executor.debugger, executor.resume)
 
 
 def _breaks_found(args: argparse.Namespace, plan: PlanSpec, err: TextIO) -> bool:

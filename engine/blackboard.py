@@ -4,7 +4,8 @@ Queries write named parameters (the paper's CUP_POSE); other operations read the
 be declared with a type; a write of another type is refused, so a wrong value is caught
 where it is produced rather than where it is used. Each entry remembers who wrote it last
 (a node id, "plan" for a start value, :data:`OPERATOR` for a value the user set while the run
-was paused), at which tick and when (:meth:`Blackboard.entry`).
+was paused), at which tick and when (:meth:`Blackboard.entry`), and how many times it has been
+written (its sequence number, BehaviorTree.CPP's ``sequence_id``: :meth:`Blackboard.sequence`).
 """
 
 from __future__ import annotations
@@ -58,6 +59,8 @@ class BlackboardEntry:
             :data:`OPERATOR` (set by the user while paused), "resume".
         tick: the tick it was written at (0: before the first tick).
         time: when (seconds of ``time.monotonic``, as the executor's events).
+        sequence: how many times it has been written since it was created (1: once; it
+            starts again after an unset, as BehaviorTree.CPP's ``sequence_id``).
     """
 
     key: str
@@ -66,6 +69,7 @@ class BlackboardEntry:
     writer: str
     tick: int
     time: float
+    sequence: int = 0
 
 
 class Blackboard:
@@ -78,7 +82,8 @@ class Blackboard:
         self._values: dict[str, Any] = {}
         self._types: dict[str, ParamType] = dict(types or {})
         self._listeners: list[WriteListener] = []
-        self._written: dict[str, tuple[str, int, float]] = {}  # key -> writer, tick, time
+        # key -> writer, tick, time, sequence (the number of writes since it was created)
+        self._written: dict[str, tuple[str, int, float, int]] = {}
         self._ticks: Callable[[], int] = lambda: 0
 
     def count_ticks_with(self, ticks: Callable[[], int]) -> None:
@@ -112,7 +117,8 @@ class Blackboard:
         if ptype is not None and not check_value(ptype, value):
             raise _wrong_type(key, ptype, value)
         self._values[key] = value
-        self._written[key] = (writer, self._ticks(), _now())
+        last = self._written.get(key)
+        self._written[key] = (writer, self._ticks(), _now(), 1 if last is None else last[3] + 1)
         for listener in self._listeners:
             listener(key, value, writer)
 
@@ -131,8 +137,18 @@ class Blackboard:
         value = self._values.get(key, _NO_DEFAULT)
         if value is _NO_DEFAULT:
             return None
-        writer, tick, when = self._written.get(key, ("", 0, 0.0))
-        return BlackboardEntry(key, value, self._types.get(key), writer, tick, when)
+        writer, tick, when, sequence = self._written.get(key, ("", 0, 0.0, 0))
+        return BlackboardEntry(key, value, self._types.get(key), writer, tick, when, sequence)
+
+    def sequence(self, key: str) -> int:
+        """How many times ``key`` has been written since it was created (0: it has no value);
+        a node that remembers it can tell whether the entry was written since (BehaviorTree.CPP's
+        ``sequence_id``: it starts again when the entry is unset).
+        """
+        if key not in self._values:
+            return 0
+        written = self._written.get(key)
+        return 0 if written is None else written[3]
 
     def entries(self) -> list[BlackboardEntry]:
         """Every entry with a value, with its last write (a copy, safe for another thread)."""

@@ -46,6 +46,7 @@ from engine.decorators import (
     RunOnce,
     Timeout,
 )
+from engine.entry_updates import SkipUnlessUpdated, WaitValueUpdate, WasEntryUpdated
 from engine.error_types import parse_error_types
 from engine.errors import EngineError
 from engine.instances import ROOT_SCOPE, InputCopy, Scope, SubtreeInstance
@@ -171,6 +172,15 @@ def _builtin_factories(
         ),
         NodeKind.UNSET_BLACKBOARD: lambda: UnsetBlackboard(
             ctx, node_id, label, cfg["key"], key=scope.key
+        ),
+        NodeKind.SKIP_UNLESS_UPDATED: lambda: SkipUnlessUpdated(
+            ctx, node_id, label, cfg["entry"], key=scope.key
+        ),
+        NodeKind.WAIT_VALUE_UPDATE: lambda: WaitValueUpdate(
+            ctx, node_id, label, cfg["entry"], key=scope.key
+        ),
+        NodeKind.WAS_ENTRY_UPDATED: lambda: WasEntryUpdated(
+            ctx, node_id, label, cfg["entry"], key=scope.key
         ),
     }
 

@@ -21,7 +21,8 @@ debugger; stepping looks at status changes, which the executor already hears of.
   node starts.
 - A skipped node reports SKIPPED each time its parent would start it, for the whole run; a
   forced result (SUCCESS, or FAILURE with an error type that a Catch takes) is given once,
-  the first time the node would start, instead of running it.
+  the first time the node would start, instead of running it (one forced while the run is
+  paused before the node is given when the run goes on).
 """
 
 from __future__ import annotations
@@ -237,7 +238,10 @@ class Debugger:
                 given = self._given(node)
                 if given is not None:
                     return given
-                self._before(node)
+                if self._before(node):  # a result forced while paused there is given now
+                    given = self._given(node)
+                    if given is not None:
+                        return given
             new = tick()
             if new is not status and (new is SUCCESS or new is FAILURE):
                 self._after(node)
@@ -258,16 +262,19 @@ class Debugger:
             return None
         return node.give(forced.status, forced.message, forced.error)
 
-    def _before(self, node: Node) -> None:
+    def _before(self, node: Node) -> bool:
+        """Pause before the node if it is to; True when the run paused."""
         if node.id == self._run_to:
             self.arm(None)
             self._stop(node, BEFORE, f"ran to {node.name}")
-            return
+            return True
         breakpoint = self._breakpoints.get(node.id)
         if breakpoint is not None and breakpoint.before:
             why = self._hit(node)
             if why is not None:
                 self._stop(node, BEFORE, f"breakpoint before {node.name}{why}")
+                return True
+        return False
 
     def _after(self, node: Node) -> None:
         breakpoint = self._breakpoints.get(node.id)

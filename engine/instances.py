@@ -137,7 +137,11 @@ class Scope:
     stack: tuple[SubtreeRef, ...] = ()
 
     def key(self, name: str) -> str:
-        """The blackboard key of ``name`` as the nodes of this scope use it."""
+        """The blackboard key of ``name`` as the nodes of this scope use it (``@name``: the
+        top-level entry, as BehaviorTree.CPP's root blackboard).
+        """
+        if name.startswith("@"):
+            return name[1:]
         if self.outer is not None and name in self.shared:
             return self.outer.key(name)
         return f"{self.names}{name}"

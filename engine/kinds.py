@@ -162,6 +162,14 @@ KIND_PORTS: dict[NodeKind, tuple[PortSpec, ...]] = {
         _text("output_key", "the name of the entry written" + _ENTRY),
     ),
     NodeKind.UNSET_BLACKBOARD: (_text("key", "the name of the entry removed" + _ENTRY),),
+    **{
+        kind: (_text("entry", "the name of the entry watched (or {key})"),)
+        for kind in (
+            NodeKind.SKIP_UNLESS_UPDATED,
+            NodeKind.WAIT_VALUE_UPDATE,
+            NodeKind.WAS_ENTRY_UPDATED,
+        )
+    },
 }
 # The ports that hold a script.
 _SCRIPT_PORTS = {
@@ -241,6 +249,12 @@ KIND_DOC: dict[NodeKind, str] = {
     NodeKind.SET_BLACKBOARD: "Sets a named parameter to a value (BehaviorTree.CPP's "
     "SetBlackboard).",
     NodeKind.UNSET_BLACKBOARD: "Removes a named parameter (BehaviorTree.CPP's UnsetBlackboard).",
+    NodeKind.SKIP_UNLESS_UPDATED: "Runs its child when a named parameter was written since it "
+    "last looked, else is skipped (BehaviorTree.CPP's SkipUnlessUpdated).",
+    NodeKind.WAIT_VALUE_UPDATE: "Waits until a named parameter is written, then runs its "
+    "child (BehaviorTree.CPP's WaitValueUpdate).",
+    NodeKind.WAS_ENTRY_UPDATED: "Succeeds when a named parameter was written since it last "
+    "looked (BehaviorTree.CPP's WasEntryUpdated).",
     NodeKind.OPERATION: "Runs a capability operation.",
 }
 

@@ -88,6 +88,10 @@ class NodeKind(str, enum.Enum):
     PRECONDITION = "precondition"
     # LoopInt, LoopDouble, LoopBool, LoopString: the element type is a setting.
     LOOP = "loop"
+    # Whether an entry was written since the node last looked (its sequence number).
+    SKIP_UNLESS_UPDATED = "skip_unless_updated"
+    WAIT_VALUE_UPDATE = "wait_value_update"
+    WAS_ENTRY_UPDATED = "was_entry_updated"
     ALWAYS_SUCCESS = "always_success"
     ALWAYS_FAILURE = "always_failure"
     SET_BLACKBOARD = "set_blackboard"
@@ -128,6 +132,9 @@ KIND_CATEGORY: dict[NodeKind, Category] = {
     NodeKind.RUN_ONCE: Category.DECORATOR,
     NodeKind.PRECONDITION: Category.DECORATOR,
     NodeKind.LOOP: Category.DECORATOR,
+    NodeKind.SKIP_UNLESS_UPDATED: Category.DECORATOR,
+    NodeKind.WAIT_VALUE_UPDATE: Category.DECORATOR,
+    NodeKind.WAS_ENTRY_UPDATED: Category.LEAF,
     NodeKind.ALWAYS_SUCCESS: Category.LEAF,
     NodeKind.ALWAYS_FAILURE: Category.LEAF,
     NodeKind.SET_BLACKBOARD: Category.LEAF,

@@ -149,8 +149,14 @@ def inner_writes(subtree: SubtreeSpec, check: Check) -> dict[str, tuple[ParamTyp
 
 
 def _add_crossings(check: Check, node: NodeSpec, subtree: SubtreeSpec) -> None:
-    """Shared names: writes inside count in this scope; reads inside need a writer here."""
+    """Shared names: writes inside count in this scope; reads inside need a writer here.
+    A write inside to ``@name`` writes the top-level name (counted when this is the top).
+    """
     written = inner_writes(subtree, check)
+    for ref, types in written.items():
+        name = check.name_of(ref) if ref.startswith("@") else None
+        if name is not None:
+            check.writers.setdefault(name, []).append(Writer(repr(node.label), types, node))
     for name in subtree.shared_names:
         if name in written:
             writer = Writer(repr(node.label), written[name], node, crossing=True)

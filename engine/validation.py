@@ -110,7 +110,7 @@ def validate_plan(
     Returns:
         The problems; empty when the plan is fine. Plan-wide problems come first.
     """
-    check = Check(plan, source)
+    check = Check(plan, source, inside=given is not None or bool(stack))
     if plan.tree is None:
         check.add(ERROR, None, EMPTY_PLAN)
     _check_parameters(check)
@@ -626,10 +626,13 @@ def _operation_reads(check: Check, node: NodeSpec, available: frozenset[str]) ->
         port = manifest.port(port_name) if manifest is not None else None
         if binding.ref is None or port is None:
             continue
+        name = check.name_of(binding.ref)
+        if name is None:
+            continue  # a top-level entry, from inside a subtree
         if port.direction is Direction.OUT:
-            written.add(binding.ref)
+            written.add(name)
             continue
-        _check_reference(check, node, port_name, binding.ref, port.types, available)
+        _check_reference(check, node, port_name, name, port.types, available)
     return frozenset(written)
 
 

@@ -108,6 +108,15 @@ class Check:
     found: list[tuple[int, int, Problem]] = field(default_factory=list)
     # id(instance) -> the shared names its inside reads without writing them first
     crossing_reads: dict[int, tuple[str, ...]] = field(default_factory=dict)
+    inside: bool = False  # the plan checked is the inside of a subtree
+
+    def name_of(self, ref: str) -> str | None:
+        """The name a reference stands for: ``@name`` (BehaviorTree.CPP's top-level entry)
+        is ``name`` at the top; inside a subtree it is not checked (None).
+        """
+        if not ref.startswith("@"):
+            return ref
+        return None if self.inside else ref[1:]
 
     def add(
         self,
@@ -191,7 +200,9 @@ def check_output(
         )
         return
     assert binding.ref is not None
-    check.writers.setdefault(binding.ref, []).append(Writer(repr(node.label), types, node))
+    name = check.name_of(binding.ref)
+    if name is not None:
+        check.writers.setdefault(name, []).append(Writer(repr(node.label), types, node))
 
 
 def check_fixed(

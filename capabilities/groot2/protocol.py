@@ -15,9 +15,13 @@ BehaviorTree.CPP does). What follows depends on the request:
 - TOGGLE_RECORDING (``r``, "start" or "stop"): on start, the wall time in microseconds as
   text; GET_TRANSITIONS (``t``): 9 bytes per status change since, the microseconds since the
   start (6 bytes), the ``_uid`` (uint16) and the new status (1 byte); the last 1000 are kept.
-- The hooks (breakpoints): none are ever set here. HOOKS_DUMP answers ``[]``,
-  REMOVE_ALL_HOOKS and DISABLE_ALL_HOOKS the bare header (there is nothing to remove);
-  HOOK_INSERT, HOOK_REMOVE and BREAKPOINT_UNLOCK the error reply.
+- The hooks (breakpoints): HOOK_INSERT, HOOK_REMOVE and BREAKPOINT_UNLOCK (a JSON second
+  part), HOOKS_DUMP (a JSON list), REMOVE_ALL_HOOKS and DISABLE_ALL_HOOKS are served by the
+  run's :class:`~capabilities.groot2.hooks.Groot2Hooks` (the engine's debugger); a reached
+  breakpoint is announced on the PUB socket as a BREAKPOINT_REACHED request header and the
+  ``_uid`` as text (:meth:`Groot2Monitor.reached_breakpoints`). Without hooks (a monitor
+  with no run to pause) HOOKS_DUMP answers ``[]``, REMOVE_ALL_HOOKS and DISABLE_ALL_HOOKS the
+  bare header, the other three the error reply.
 
 A request that cannot be served gets BehaviorTree.CPP's error reply: two parts, ``error`` and
 the reason. Numbers are little-endian, as BehaviorTree.CPP writes them on the machines it
@@ -44,8 +48,9 @@ from typing import Any
 import msgpack
 
 from capabilities.base import CapabilityError
+from capabilities.groot2.hooks import Groot2Hooks, HookRefused
 from engine.btcpp.runtime import LoadedTree
-from engine.events import BlackboardWritten, Event, StatusChanged
+from engine.events import BlackboardWritten, Event, RunPaused, StatusChanged
 from engine.status import Status
 from engine.types import encode_value
 
@@ -235,6 +240,19 @@ class Groot2Monitor:
             maxlen=MAX_TRANSITIONS
         )
         self.last_request = 0.0  # the clock at the last request (Groot2 is connected)
+        self.hooks: Groot2Hooks | None = None  # Groot2's breakpoints (none: refused)
+        self._reached: collections.deque[int] = collections.deque()  # uids to announce
+
+    def reached_breakpoints(self) -> list[bytes]:
+        """The PUB messages of the breakpoints reached since the last call, each a
+        BREAKPOINT_REACHED header and the ``_uid`` as text (the publisher sends them).
+        """
+        parts: list[bytes] = []
+        while self._reached:
+            uid = self._reached.popleft()
+            header = RequestHeader.new(RequestType.BREAKPOINT_REACHED).encode()
+            parts.extend([header, str(uid).encode("ascii")])
+        return parts
 
     # ---------------------------------------------------------------- the run (a listener)
 
@@ -252,6 +270,10 @@ class Groot2Monitor:
         elif isinstance(event, BlackboardWritten):
             with self._lock:
                 self._board[event.key] = event.value
+        elif isinstance(event, RunPaused) and self.hooks is not None:
+            uid = self.hooks.reached(event.node_id, event.where)
+            if uid is not None:
+                self._reached.append(uid)
 
     def statuses(self) -> dict[int, int]:
         """``_uid`` -> status byte now."""
@@ -288,6 +310,14 @@ class Groot2Monitor:
                 transitions = list(self._transitions)
                 self._transitions.clear()
             return [encode_transitions(transitions)]
+        hooks = self.hooks
+        if hooks is not None:
+            served = _HOOK_REQUESTS.get(request_type)
+            if served is not None:
+                try:
+                    return served(hooks, parts)
+                except HookRefused as exc:
+                    raise _Refused(str(exc)) from exc
         if request_type == RequestType.HOOKS_DUMP:
             return [b"[]"]
         if request_type in (RequestType.REMOVE_ALL_HOOKS, RequestType.DISABLE_ALL_HOOKS):
@@ -333,6 +363,21 @@ class Groot2Monitor:
 
 class _Refused(CapabilityError):
     """A request answered with the error reply."""
+
+
+def _done(call: Callable[[], None]) -> list[bytes]:
+    call()
+    return []
+
+
+_HOOK_REQUESTS: dict[int, Callable[[Groot2Hooks, Sequence[bytes]], list[bytes]]] = {
+    RequestType.HOOK_INSERT: lambda h, parts: _done(lambda: h.insert(_second(parts))),
+    RequestType.HOOK_REMOVE: lambda h, parts: _done(lambda: h.remove(_second(parts))),
+    RequestType.BREAKPOINT_UNLOCK: lambda h, parts: _done(lambda: h.unlock(_second(parts))),
+    RequestType.REMOVE_ALL_HOOKS: lambda h, _parts: _done(h.remove_all),
+    RequestType.DISABLE_ALL_HOOKS: lambda h, _parts: _done(h.disable_all),
+    RequestType.HOOKS_DUMP: lambda h, _parts: [h.dump()],
+}
 
 
 def _second(parts: Sequence[bytes]) -> bytes:

@@ -1,9 +1,9 @@
 """Serves a run to Groot2 over ZeroMQ, as BehaviorTree.CPP's ``Groot2Publisher`` does.
 
 A REP socket on PORT answers the requests of :mod:`capabilities.groot2.protocol`; a PUB socket
-is bound on PORT+1 as well, where BehaviorTree.CPP announces reached breakpoints (there are
-none here, so nothing is sent on it; BehaviorTree.CPP publishes no heartbeat or transitions
-there either: Groot2 asks). Both are bound to 127.0.0.1 unless another host is given
+is bound on PORT+1 as well, where reached breakpoints are announced, as BehaviorTree.CPP does
+(nothing else is sent on it: BehaviorTree.CPP publishes no heartbeat or transitions there
+either, Groot2 asks). Both are bound to 127.0.0.1 unless another host is given
 ("*": every interface).
 
 The requests are served on a thread of the publisher's own; the run's events reach it through
@@ -95,6 +95,7 @@ class Groot2Publisher:
         poller.register(self._server, zmq.POLLIN)
         while not self._stop.is_set():
             try:
+                self._announce()
                 if not poller.poll(_POLL_MS):
                     continue
                 request = self._server.recv_multipart()
@@ -111,6 +112,15 @@ class Groot2Publisher:
                 self._renew_server()
                 poller = zmq.Poller()
                 poller.register(self._server, zmq.POLLIN)
+
+    def _announce(self) -> None:
+        """Send the reached breakpoints on the PUB socket (this thread's own)."""
+        parts = self.monitor.reached_breakpoints()
+        for index in range(0, len(parts), 2):
+            try:
+                self._publisher.send_multipart(parts[index : index + 2])
+            except zmq.ZMQError:
+                return  # no subscriber keeps up: BehaviorTree.CPP goes on as well
 
     def _renew_server(self) -> None:
         self._server.close(0)

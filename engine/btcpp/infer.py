@@ -53,12 +53,17 @@ def infer_subtree_ports(
     tree: Element, instances: list[Element], port_of: PortOf
 ) -> tuple[list[SubtreePort], list[SubtreePort]]:
     """(inputs, outputs) of a subtree from its instances and the nodes inside: a name an
-    operation inside writes is an output of that port's type, any other an input, typed by
-    the first port that reads it (Text when none says).
+    operation inside writes is an output of that port's type, as is one that only scripts
+    write (Any); any other an input, typed by the first port that reads it (Any when none
+    says: BehaviorTree.CPP's remapped entries take any type).
     """
     names = _remapped(instances)
     written: dict[str, ParamType] = {}
     read: dict[str, ParamType] = {}
+    scripted = _script_names(tree)
+    for name in names:
+        if name in scripted[1] and name not in scripted[0]:
+            written[name] = ParamType.ANY
     for element in _walk(tree):
         for attr, value in element.attrs.items():
             if not (value.startswith("{") and value.endswith("}")) or value[1:-1] not in names:
@@ -67,13 +72,38 @@ def infer_subtree_ports(
             if known is not None:
                 into = written if known[0] is Direction.OUT else read
                 into.setdefault(value[1:-1], known[1])
-    inputs = [SubtreePort(n, read.get(n, ParamType.TEXT)) for n in names if n not in written]
+    inputs = [SubtreePort(n, read.get(n, ParamType.ANY)) for n in names if n not in written]
     outputs = [SubtreePort(n, written[n]) for n in names if n in written]
     return inputs, outputs
 
 
-_SCRIPT_PORTS = {("Script", "code"), ("ScriptCondition", "code")}
+_SCRIPT_PORTS = {("Script", "code"), ("ScriptCondition", "code"), ("Precondition", "if")}
+# Ports that name an entry as it is, NAME as well as {NAME}.
+_ENTRY_PORTS = {
+    ("SkipUnlessUpdated", "entry"),
+    ("WaitValueUpdate", "entry"),
+    ("WasEntryUpdated", "entry"),
+    ("SetBlackboard", "output_key"),
+}  # not UnsetBlackboard's key: BehaviorTree.CPP's unset looks in the subtree's own entries
 _CONDITION_ATTRS = frozenset(c.attribute for c in Condition)
+
+
+def _script_names(tree: Element) -> tuple[set[str], set[str]]:
+    """(names read, names written) by the scripts of a tree (Script, ScriptCondition, pre-
+    and post-conditions; a script that does not parse is reported where it is read).
+    """
+    reads: set[str] = set()
+    writes: set[str] = set()
+    for element in _walk(tree):
+        for attr, value in element.attrs.items():
+            if (element.tag, attr) in _SCRIPT_PORTS or attr in _CONDITION_ATTRS:
+                try:
+                    names = script_names(parse_script(value))
+                except ScriptSyntaxError:
+                    continue
+                reads.update(names.reads)
+                writes.update(names.writes)
+    return reads, writes
 
 
 def autoremapped(instance: Element) -> bool:
@@ -104,6 +134,8 @@ def names_used(tree_id: str, trees: Mapping[str, Element]) -> list[str]:
 def _names_in(tag: str, attr: str, value: str) -> list[str]:
     if value.startswith("{") and value.endswith("}") and value != "{=}":
         return [value[1:-1].strip()]
+    if (tag, attr) in _ENTRY_PORTS:
+        return [value.strip()]
     if (tag, attr) in _SCRIPT_PORTS or attr in _CONDITION_ATTRS:
         try:
             names = script_names(parse_script(value))

@@ -260,6 +260,24 @@ LOGIC: dict[NodeKind, LogicModel] = {
         LogicModel(
             NodeKind.UNSET_BLACKBOARD, "UnsetBlackboard", "Action", settings={"key": _text("key")}
         ),
+        LogicModel(
+            NodeKind.SKIP_UNLESS_UPDATED,
+            "SkipUnlessUpdated",
+            "Decorator",
+            settings={"entry": _text("entry")},
+        ),
+        LogicModel(
+            NodeKind.WAIT_VALUE_UPDATE,
+            "WaitValueUpdate",
+            "Decorator",
+            settings={"entry": _text("entry")},
+        ),
+        LogicModel(
+            NodeKind.WAS_ENTRY_UPDATED,
+            "WasEntryUpdated",
+            "Action",
+            settings={"entry": _text("entry")},
+        ),
     )
 }
 SWITCH_MODELS = tuple(f"Switch{n}" for n in range(2, 7))

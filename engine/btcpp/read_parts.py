@@ -6,13 +6,13 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
 from engine.btcpp.errors import XmlProblem
 from engine.btcpp.imported import XmlLines
 from engine.btcpp.names import decode_port
-from engine.btcpp.values import param_type_of_model, parse_value
+from engine.btcpp.values import param_type_of_model, parse_value, untyped_constant
 from engine.btcpp.xmltree import Element
 from engine.spec import (
     NodeKind,
@@ -27,7 +27,7 @@ from engine.spec import (
 from engine.tree import DEFAULT_GIVE_UP_AFTER
 from engine.types import ParamType, Waypoint
 
-__all__ = ["Model", "ReaderBase", "read_models"]
+__all__ = ["Model", "ReaderBase", "model_remaps", "read_models"]
 
 
 @dataclass
@@ -58,12 +58,58 @@ def read_models(
         for port in item.children:
             doc = port.attrs.get("description") or port.text.strip()
             ptype = param_type_of_model(port.attrs.get("type"))
+            if item.tag == "SubTree" and "type" not in port.attrs:
+                ptype = ParamType.ANY  # BehaviorTree.CPP's SubTree ports take any type
+
             entry = (port.tag, ptype, port.attrs.get("default"), doc)
             try:
                 model.ports[decode_port(port.attrs.get("name", ""))] = entry
             except ValueError:
                 continue  # not one of ours: its nodes are reported where they are used
     return models
+
+
+# A SubTree instance, or the BehaviorTree of a subtree (the defaults of its model's ports).
+_SUBTREE_TAGS = ("SubTree", "BehaviorTree")
+
+
+def _is_pointer(text: str) -> bool:
+    """``{key}`` (BehaviorTree.CPP's isBlackboardPointer)."""
+    stripped = text.strip()
+    return len(stripped) >= 3 and stripped[0] == "{" and stripped[-1] == "}"
+
+
+def model_remaps(
+    tree_id: str, model: Model, given: Iterable[str], problem: Callable[[str, str], None]
+) -> dict[str, str]:
+    """What a ``<SubTree>`` instance that leaves out ports of its TreeNodesModel gets, as
+    BehaviorTree.CPP's XML parser gives it: port -> the key its ``{key}`` default remaps it
+    to. A default of another value is the subtree port's default (an input's); a port left
+    out with no default is refused, with BehaviorTree.CPP's reason, told to
+    ``problem(expected, got)``, and so is a default of ``{=}`` (BehaviorTree.CPP reads
+    ``{=}`` as the port's own name only in an instance; as a default it remaps the port to an
+    entry called ``=``, which nothing can write).
+    """
+    remaps: dict[str, str] = {}
+    for name, (_direction, _ptype, default, _doc) in model.ports.items():
+        if name in given:
+            continue
+        if default is None:
+            problem(
+                f'a remapping of every port of the <TreeNodesModel>\'s <SubTree ID="{tree_id}"> '
+                "without a default",
+                f"a mandatory port called [{name}] that is not remapped",
+            )
+        elif _is_pointer(default):
+            key = default.strip()[1:-1].strip()
+            if key == "=":
+                problem(
+                    f'a default of port [{name}] of <SubTree ID="{tree_id}"> other than {{=}}',
+                    "{=} (an entry called '=')",
+                )
+            else:
+                remaps[name] = key
+    return remaps
 
 
 class ReaderBase:
@@ -130,6 +176,8 @@ class ReaderBase:
             return ParamType.ANY
 
     def _value(self, element: Element, ptype: ParamType, text: str, what: str) -> object:
+        if ptype is ParamType.ANY and element.tag in _SUBTREE_TAGS and not text.startswith("json:"):
+            return untyped_constant(text)
         try:
             return parse_value(ptype, text)
         except ValueError as exc:
@@ -159,7 +207,7 @@ class ReaderBase:
         for name, (direction, ptype, default, doc) in (model.ports if model else {}).items():
             value = (
                 None
-                if default is None
+                if default is None or _is_pointer(default)  # {key}: a remap of the instance
                 else self._value(element, ptype, default, f"default of {name}")
             )
             port = SubtreePort(name, ptype, doc, value if direction != "output_port" else None)

@@ -12,7 +12,7 @@ from engine.btcpp.includes import expand_includes
 from engine.btcpp.infer import autoremapped, infer_subtree_ports, instances_of, names_used
 from engine.btcpp.logic import LOGIC_BY_MODEL, LogicModel
 from engine.btcpp.names import decode_id, decode_port
-from engine.btcpp.read_parts import Model, ReaderBase, read_models
+from engine.btcpp.read_parts import Model, ReaderBase, model_remaps, read_models
 from engine.btcpp.writer import UNUSED_OUTPUT
 from engine.btcpp.xmltree import Element, XmlSyntaxError, XmlTooLarge, parse, parse_file
 from engine.conditions import Condition
@@ -313,7 +313,16 @@ class _Reader(ReaderBase):
                 "_autoremap",
             )
         node = NodeSpec(NodeKind.SUBTREE, subtree=sub.ref)
-        for port, text in self._ports(element).items():
+        given = self._ports(element)
+        model = self.models.get(tree_id)
+        if model is not None and model.element == "SubTree" and not autoremapped(element):
+            remaps = model_remaps(
+                tree_id, model, given, lambda want, got: self.problem(element.line, want, got)
+            )
+            for port, key in remaps.items():
+                if sub.port(port) is not None:
+                    node.params[port] = Binding.reference(key)
+        for port, text in given.items():
             spec = sub.port(port)
             if spec is None and port in sub.shared_names and text == "{" + port + "}":
                 continue

@@ -28,12 +28,20 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from collections.abc import Callable
 from typing import Any
 
 from engine.types import ParamType, ValueShapeError, decode_value, encode_value
 
-__all__ = ["MODEL_TYPE", "param_type_of_model", "parse_value", "value_text"]
+__all__ = [
+    "MODEL_TYPE",
+    "param_type_of_model",
+    "parse_value",
+    "untyped_constant",
+    "untyped_text",
+    "value_text",
+]
 
 # The type names our ports have in a TreeNodesModel: C++'s where one fits, so that Groot2
 # and BehaviorTree.CPP show familiar ones, our own names in a ``costar::`` namespace else.
@@ -184,3 +192,32 @@ def parse_value(ptype: ParamType, text: str) -> Any:
         return decode_value(ptype, raw, "value")
     except ValueShapeError as exc:
         raise ValueError(f"{exc.expected} ({ptype.value}), not {text!r}") from None
+
+
+_INT_TEXT = re.compile(r"[+-]?\d+")
+
+
+def untyped_constant(text: str) -> object:
+    """A constant given to an untyped SubTree port, as BehaviorTree.CPP stores it in the
+    subtree's blackboard: an integer when the whole text is one, else a real, else the text.
+    """
+    if _INT_TEXT.fullmatch(text):
+        return int(text)
+    if "." in text or "e" in text or "E" in text:
+        try:
+            number = float(text)
+        except ValueError:
+            return text
+        return number if math.isfinite(number) else text
+    return text
+
+
+def untyped_text(value: Any) -> str | None:
+    """The text of a value for an untyped SubTree port that :func:`untyped_constant` reads
+    back as the same value (None: the value needs ``json:``).
+    """
+    if isinstance(value, bool) or not isinstance(value, (int, float, str)):
+        return None
+    text = value if isinstance(value, str) else repr(value)
+    again = untyped_constant(text)
+    return text if type(again) is type(value) and again == value else None

@@ -12,7 +12,7 @@ from typing import Any
 from engine.btcpp.errors import XmlExportError
 from engine.btcpp.logic import BUILTIN_MODELS, LOGIC, LOGIC_BY_MODEL, model_of
 from engine.btcpp.names import encode_id, encode_port, readable_tree_id
-from engine.btcpp.values import MODEL_TYPE, value_text
+from engine.btcpp.values import MODEL_TYPE, untyped_text, value_text
 from engine.conditions import Condition
 from engine.kinds import KIND_PORTS
 from engine.operations import Direction, OperationKind, OperationManifest
@@ -169,6 +169,9 @@ class _Writer:
         element.append(self._node(sub.tree, sub.layout, f"{sub.name}:{sub.tree.label}"))
         _unique_subtree_names(element)
         ports = {p.name: _port_of_spec(Direction.IN, p.type, p.default, p.doc) for p in sub.inputs}
+        for port in sub.inputs:  # an untyped default as BehaviorTree.CPP reads it: 5, not json:5
+            if port.type is ParamType.ANY and (text := untyped_text(port.default)) is not None:
+                ports[port.name].default = text
         for port in sub.outputs:
             ports[port.name] = _port_of_spec(Direction.OUT, port.type, None, port.doc)
         self.models[self.tree_ids[(sub.id, sub.version)]] = _Model("SubTree", ports)
@@ -264,6 +267,12 @@ class _Writer:
         if tree_id not in self.models:
             self._subtree_tree(sub)  # declares its model
         self._bindings(node, self.models[tree_id], attrs, path)
+        for name, binding in node.params.items():  # untyped constants: 5, not json:5
+            declared = self.models[tree_id].ports.get(name)
+            if binding.ref is None and declared is not None and declared.ptype is ParamType.ANY:
+                text = untyped_text(binding.value)
+                if text is not None and binding.type in (None, ParamType.ANY):
+                    attrs[encode_port(name)] = text
         for port in sub.outputs:  # BehaviorTree.CPP wants every port remapped: a sink
             attrs.setdefault(encode_port(port.name), UNUSED_OUTPUT)
         for name in sub.shared_names:  # crosses the scope on purpose: remapped to itself

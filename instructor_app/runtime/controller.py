@@ -406,6 +406,13 @@ class RunController(QObject):
             lockstep=lockstep_of(self.session.cell),
             debugger=self.debugging.debugger(),
         )
+        if groot2 is not None:  # Groot2's breakpoints pause this run
+            from capabilities.groot2.hooks import Groot2Hooks
+            from capabilities.groot2.protocol import Groot2Monitor
+
+            assert isinstance(groot2, Groot2Monitor)
+            executor = self._executor
+            groot2.hooks = Groot2Hooks(groot2.tree.uids, executor.debugger, executor.resume)
         self._executor.start(paused=paused)
         self._timer.start()
         self._set_state(ExecutorState.PAUSED if paused else ExecutorState.RUNNING)

@@ -192,11 +192,11 @@ def test_unknown_node_types_are_all_reported_with_their_lines() -> None:
   <BehaviorTree ID="Main">
     <Sequence>
       <OpenDoor speed="1"/>
-      <SkipUnlessUpdated entry="{x}">
+      <Levitate height="{x}">
         <FlyAway/>
-        <WasEntryUpdated entry="{x}"/>
+        <IsAirborne entry="{x}"/>
         <Hover/>
-      </SkipUnlessUpdated>
+      </Levitate>
       <Sleep msec="soon"/>
       <Inverter _skipIf="x == 1"><Action ID="Teleport"/></Inverter>
     </Sequence>
@@ -209,9 +209,9 @@ def test_unknown_node_types_are_all_reported_with_their_lines() -> None:
     unknown = [(p.line, p.got) for p in problems if p.got.startswith("unknown node type")]
     assert unknown == [
         (4, "unknown node type 'OpenDoor'"),
-        (5, "unknown node type 'SkipUnlessUpdated'"),
+        (5, "unknown node type 'Levitate'"),
         (6, "unknown node type 'FlyAway'"),
-        (7, "unknown node type 'WasEntryUpdated'"),
+        (7, "unknown node type 'IsAirborne'"),
         (8, "unknown node type 'Hover'"),
         (11, "unknown node type 'Teleport'"),
     ]

@@ -60,6 +60,9 @@ EVERY_BUILTIN = """<root BTCPP_format="4" main_tree_to_execute="Main">
       <Precondition if="picked == 'two'" else="FAILURE"><AlwaysSuccess/></Precondition>
       <SetBlackboard value="{picked}" output_key="copy"/>
       <UnsetBlackboard key="copy"/>
+      <WasEntryUpdated entry="mode"/>
+      <SkipUnlessUpdated entry="{picked}"><AlwaysSuccess/></SkipUnlessUpdated>
+      <WaitValueUpdate entry="mode"><AlwaysSuccess/></WaitValueUpdate>
     </Sequence>
   </BehaviorTree>
 </root>
@@ -82,6 +85,9 @@ NEW_KINDS = [
     NodeKind.ALWAYS_FAILURE,
     NodeKind.SET_BLACKBOARD,
     NodeKind.UNSET_BLACKBOARD,
+    NodeKind.SKIP_UNLESS_UPDATED,
+    NodeKind.WAIT_VALUE_UPDATE,
+    NodeKind.WAS_ENTRY_UPDATED,
 ]
 
 

@@ -188,6 +188,19 @@ def test_a_forced_failure_runs_the_handler_of_a_catch_that_takes_its_type() -> N
     assert debugger.forced == {}  # given once: the next run runs the grasp
 
 
+def test_a_result_forced_while_paused_before_a_node_is_given_when_the_run_goes_on() -> None:
+    tree, leaves = three_steps()
+    debugger = Debugger()
+    debugger.set_breakpoint(Breakpoint("c"))
+    executor, recorder = start(tree, debugger)
+    assert paused(recorder).node_id == "c"
+    debugger.force("c", Forced(FAILURE))
+    executor.resume()
+    result = executor.wait(5.0)
+    assert result is not None and result.status is FAILURE
+    assert leaves["c"].updates == 0 and leaves["d"].updates == 0
+
+
 def test_no_breakpoint_leaves_every_node_its_class_tick() -> None:
     tree, _ = three_steps()
     debugger = Debugger()

@@ -6,12 +6,19 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from engine.conditions import Condition
 from engine.spec import NodeKind, NodeSpec, PlanSpec
 from engine.types import ParamType
 from tools.generators.plan_builder import fixed
 
 N = NodeKind
 One = Callable[[str, str, str, Callable[..., NodeSpec]], PlanSpec]
+
+
+def _skip_if(node: NodeSpec, script: str) -> NodeSpec:
+    """``node`` skipped when ``script`` is true (BehaviorTree.CPP's ``_skipIf``)."""
+    node.conditions = {Condition.SKIP_IF: script}
+    return node
 
 
 def builtin_examples(one: One) -> dict[str, PlanSpec]:
@@ -99,6 +106,44 @@ def builtin_examples(one: One) -> dict[str, PlanSpec]:
                 m.debug("fail", "lift"),
                 m.debug("log", "release the part", message=fixed("released", ParamType.TEXT)),
                 catch_on_halt="true",
+            ),
+        ),
+        "entry_updates": one(
+            "entry_updates",
+            "SkipUnlessUpdated, WaitValueUpdate, WasEntryUpdated",
+            "BehaviorTree.CPP's nodes that look whether a named parameter was written since "
+            "they last looked: three rounds count on, a SkipUnlessUpdated sees the count in "
+            "the two rounds that wrote it (the second does not), a WaitValueUpdate runs its "
+            "check at once (the count was written before it first looked), and "
+            "WasEntryUpdated succeeds on its first look. Runs to SUCCESS.",
+            lambda m: m.node(
+                N.SEQUENCE,
+                "watch the count",
+                m.node(N.SCRIPT, "none yet", code="COUNT := 0; SEEN := 0; ROUND := 0"),
+                m.node(
+                    N.REPEAT,
+                    "three rounds",
+                    m.node(
+                        N.SEQUENCE,
+                        "one round",
+                        m.node(N.SCRIPT, "next round", code="ROUND += 1"),
+                        _skip_if(m.node(N.SCRIPT, "count", code="COUNT += 1"), "ROUND == 2"),
+                        m.node(
+                            N.SKIP_UNLESS_UPDATED,
+                            "when counted",
+                            m.node(N.SCRIPT, "see it", code="SEEN += 1"),
+                            entry="COUNT",
+                        ),
+                    ),
+                    count=3,
+                ),
+                m.node(
+                    N.WAIT_VALUE_UPDATE,
+                    "a count",
+                    m.node(N.SCRIPT_CONDITION, "seen twice", code="SEEN == 2"),
+                    entry="{COUNT}",
+                ),
+                m.node(N.WAS_ENTRY_UPDATED, "counted?", entry="COUNT"),
             ),
         ),
         "btcpp_decorators": one(
