@@ -21,7 +21,7 @@ from PySide6.QtCore import QObject, QTimer, Signal
 
 from capabilities.cell_features import ReportsStatus, lockstep_of
 from capabilities.faults import hold_check
-from capabilities.run_sampler import JointSampler
+from capabilities.run_sampler import record_samplers
 from engine.blackboard import OPERATOR, Blackboard, BlackboardEntry, BlackboardError
 from engine.build import BuildError, build_tree
 from engine.events import Listener, RunFinished
@@ -437,9 +437,7 @@ class RunController(QObject):
             return []
         prune_records(folder, keep=path)
         self.last_record = path
-        cell = self.session.cell
-        arm = cell.interfaces().get("arm") if cell is not None else None
-        return [recorder] if arm is None else [recorder, JointSampler(arm, recorder)]
+        return [recorder, *record_samplers(self.session.cell, recorder)]
 
     def _resume_at(self, tree: BehaviorTree, node_id: str) -> dict[str, Status] | None:
         """Mark the nodes before ``node_id`` done and carry the last run's values over."""
