@@ -14,7 +14,13 @@ dispatcher's:
   (a real camera: its own device, not the cell's thread). At 160x120 and quality 60 a
   picture of the simulated cell is 2-3 KB (about 25 MB an hour for two cameras, in base64).
 
-:func:`record_samplers` gives both for a cell, as `costar run` and the Instructor use them.
+- :class:`OperatorActions`: what the operator console asked the people at the cell and
+  what they did, as it happens (an ``operator`` record each: ``action`` asked, answered,
+  withdrawn or pressed; the question's ``text`` and ``prompt`` id, who asked (``source``),
+  the ``answer`` and who gave it (``by``), the ``button`` pressed). Stops and holds are the
+  run's own events (``held``, ``paused``, ``finished``), kept by the recorder itself.
+
+:func:`record_samplers` gives them for a cell, as `costar run` and the Instructor use them.
 """
 
 from __future__ import annotations
@@ -27,11 +33,13 @@ from typing import Any, Protocol
 import cv2
 import numpy as np
 
+from capabilities.collaboration.console import ConsoleEvent, ConsoleEventKind, OperatorConsole
 from engine.events import Event, RunFinished, RunStarted
 from engine.trace import TraceRecorder
 
 __all__ = [
     "JointSampler",
+    "OperatorActions",
     "SAMPLE_PERIOD_S",
     "THUMBNAIL_PERIOD_S",
     "THUMBNAIL_QUALITY",
@@ -170,9 +178,54 @@ class ThumbnailSampler(_Sampler):
         return records
 
 
+class OperatorActions:
+    """A run listener that writes the operator console's questions, answers and button
+    presses to ``recorder`` from its making (before the run starts: a plan may ask at its
+    first tick) to the run's end (see the module doc). The console's listener runs on the
+    thread that made the change and only writes a line.
+    """
+
+    def __init__(self, console: OperatorConsole, recorder: TraceRecorder) -> None:
+        self._console = console
+        self._recorder = recorder
+        self._lock = threading.Lock()
+        self._asked: set[str] = set()  # the prompts whose question is in the record
+        console.add_listener(self._heard)
+
+    def __call__(self, event: Event) -> None:
+        if isinstance(event, RunFinished):
+            self._console.remove_listener(self._heard)
+
+    def _heard(self, event: ConsoleEvent) -> None:
+        prompt = event.prompt
+        by = {"by": event.by} if event.by else {}
+        if event.kind is ConsoleEventKind.BUTTON_PRESSED:
+            self._note({"action": "pressed", "button": event.button, **by})
+            return
+        if prompt is None:
+            return
+        with self._lock:  # a question before its answer, though another thread may answer
+            if prompt.id not in self._asked:  # it before this one hears it was shown
+                self._asked.add(prompt.id)
+                source = {"source": prompt.source} if prompt.source else {}
+                self._note({"action": "asked", "prompt": prompt.id, "text": prompt.text, **source})
+            if event.kind is ConsoleEventKind.PROMPT_SHOWN:
+                return
+            self._asked.discard(prompt.id)
+        closed = {"prompt": prompt.id, "text": prompt.text}
+        if prompt.answer is None:
+            self._note({"action": "withdrawn", **closed, "reason": prompt.reason, **by})
+        else:
+            answer = "yes" if prompt.answer else "no"
+            self._note({"action": "answered", **closed, "answer": answer, **by})
+
+    def _note(self, record: dict[str, Any]) -> None:
+        self._recorder.note({"event": "operator", **record})
+
+
 def record_samplers(cell: Any, recorder: TraceRecorder) -> list[Callable[[Event], None]]:
-    """The samplers of ``cell`` for a run's record: its arm's joints, its cameras' thumbnails
-    (none for a cell without them).
+    """What ``cell`` adds to a run's record: its arm's joints, its cameras' thumbnails, its
+    operator console's questions and answers (none for a cell without them).
     """
     interfaces = cell.interfaces() if cell is not None else {}
     listeners: list[Callable[[Event], None]] = []
@@ -182,4 +235,7 @@ def record_samplers(cell: Any, recorder: TraceRecorder) -> list[Callable[[Event]
     cameras = {k.split(":", 1)[1]: v for k, v in interfaces.items() if k.startswith("rgbd:")}
     if cameras:
         listeners.append(ThumbnailSampler(cameras, recorder))
+    console = interfaces.get("operator")
+    if isinstance(console, OperatorConsole):
+        listeners.append(OperatorActions(console, recorder))
     return listeners

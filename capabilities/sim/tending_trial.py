@@ -219,7 +219,7 @@ class TendingTrial:
         if self.session.hold_reason():
             self.session.clear()  # on the pendant: unlocks once the delay allows
         if press:
-            self.session.operator.press("continue")
+            self.session.operator.press("continue", "the simulated operator")
         with self._lock:
             self._pending -= 1
 
