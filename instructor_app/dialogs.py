@@ -113,5 +113,10 @@ class Dialogs:
         )
         return int(port) if ok else None
 
+    def ask_runs_folder(self, parent: QWidget, current: str) -> str | None:
+        """The folder to keep run records in (None: cancelled)."""
+        folder = QFileDialog.getExistingDirectory(parent, "Keep run records in", current)
+        return folder or None
+
     def about(self, parent: QWidget, text: str) -> None:
         QMessageBox.about(parent, f"About {APP_TITLE}", text)

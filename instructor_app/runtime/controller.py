@@ -165,6 +165,7 @@ class RunController(QObject):
         self._stopping = False  # a stop was asked: the halt's IDLE resets are not shown
         self._held = ""  # why the cell holds the run ("" when it does not)
         self.last_record: Path | None = None  # the record of the last run started
+        self.runs_setting = ""  # the runs folder of the settings ("": the default)
         self._idled: set[str] = set()  # nodes that went RUNNING -> IDLE at the last drain
         self._groot2_port: int | None = None  # publish runs for Groot2 on it (None: do not)
         self._groot2: Groot2Publisher | None = None  # serving, once a run was published
@@ -423,12 +424,16 @@ class RunController(QObject):
             self.log_message.emit(f"Run of {plan.name or 'the plan'} started", "info")
         return True
 
+    def runs_folder(self) -> Path:
+        """Where run records go: $COSTAR_RUNS, else the setting, else the user's data folder."""
+        return runs_folder(setting=self.runs_setting or None)
+
     def _recorder(self, plan: PlanSpec) -> list[Listener]:
-        """This run's record in the runs folder ($COSTAR_RUNS, else the user's; the oldest
-        removed past its size limit), as `costar run` keeps one; none when it cannot be
-        written (said in the Log: the run goes on).
+        """This run's record in the runs folder (:meth:`runs_folder`; the oldest removed
+        past its size limit), as `costar run` keeps one; none when it cannot be written
+        (said in the Log: the run goes on).
         """
-        folder = runs_folder()
+        folder = self.runs_folder()
         try:
             path = new_record_path(folder, plan.name)
             recorder = TraceRecorder(path, plan)

@@ -98,6 +98,7 @@ class ScriptedDialogs(Dialogs):
         self.asked: list[tuple[str, str]] = []
         self.errors: list[tuple[str, str]] = []
         self.port_answers: list[int | None] = []
+        self.folder_answers: list[str | None] = []
 
     def ask_save_changes(self, parent: QWidget, name: str) -> str:
         self.asked.append(("save", name))
@@ -106,6 +107,10 @@ class ScriptedDialogs(Dialogs):
     def ask_groot2_port(self, parent: QWidget, current: int) -> int | None:
         self.asked.append(("groot2_port", str(current)))
         return self.port_answers.pop(0) if self.port_answers else None
+
+    def ask_runs_folder(self, parent: QWidget, current: str) -> str | None:
+        self.asked.append(("runs_folder", current))
+        return self.folder_answers.pop(0) if self.folder_answers else None
 
     def ask_restore(self, parent: QWidget, description: str) -> bool:
         self.asked.append(("restore", description))

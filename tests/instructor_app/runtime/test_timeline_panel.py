@@ -217,3 +217,27 @@ def test_a_moment_shows_the_cameras_pictures_of_that_moment(
     out_, err_ = io.StringIO(), io.StringIO()  # a reader that knows no pictures goes on
     assert costar(["runs", "show", str(record)], out_, err_) == 0, err_.getvalue()
     assert "thumbnail" not in out_.getvalue() and "run finished" in out_.getvalue()
+
+
+def test_the_runs_folder_is_a_setting_that_runs_and_last_run_use(
+    qtbot: Any, none_session: CellSession, figure3_path: Path, tmp_path: Path, monkeypatch: Any
+) -> None:
+    monkeypatch.delenv("COSTAR_RUNS")  # the variable would override the setting
+    dialogs = ScriptedDialogs()
+    window = make_window(qtbot, none_session, tmp_path, dialogs)
+    chosen = tmp_path / "chosen runs"
+    dialogs.folder_answers.append(str(chosen))
+    window.actions_by_name["runs_folder"].trigger()
+    assert window.settings.runs_folder() == str(chosen)
+    window.open_plan(figure3_path)
+    run_to_end(qtbot, window)
+    record = window.controller.last_record
+    assert record is not None and record.parent == chosen
+    window.close()
+    again = make_window(qtbot, none_session, tmp_path, ScriptedDialogs())  # the same settings
+    assert again.controller.runs_folder() == chosen
+    again.views.timeline.last_button.click()  # no run in this window: the folder's newest
+    timeline = again.views.timeline.timeline
+    assert timeline is not None and timeline.name == record.name
+    monkeypatch.setenv("COSTAR_RUNS", str(tmp_path / "env"))
+    assert again.controller.runs_folder() == tmp_path / "env"
