@@ -3,7 +3,10 @@
 The first line is a header with the plan's nodes (id, label, kind, path), so a trace can be
 read without the plan; each further line is one event. When the run had failures, a
 ``failures`` record before the last one names their root causes (``engine.run_report``):
-the one that failed the run (``cause``) and those on the way.
+the one that failed the run (``cause``) and those on the way. A cell adds records of its
+own between the events (:meth:`TraceRecorder.note`, ``capabilities.run_sampler``): the
+robot's ``joints``, a camera's ``thumbnail`` (a JPEG in base64), the ``operator`` console's
+questions, answers and presses. A reader skips the kinds it does not know.
 """
 
 from __future__ import annotations
