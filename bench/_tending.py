@@ -12,9 +12,11 @@ at ``speed`` times real time. A trial is the same every time it runs with the sa
 
 from __future__ import annotations
 
+import json
 import multiprocessing
 import os
 import sys
+import tempfile
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -30,6 +32,7 @@ __all__ = [
     "PLANS",
     "TendingJob",
     "c_output_to_stderr",
+    "measure_record_size",
     "measure_tending",
     "table_one",
 ]
@@ -151,6 +154,52 @@ def measure_tending(
         mine = [r for j, r in zip(work, results, strict=True) if j.plan == name]
         figures[name] = _total(mine) | (_spread(mine, 2) if pairs else {})
     return figures
+
+
+def measure_record_size(
+    seed: int, parts: int, speed: float | None = 1.0, plan: str = "ours"
+) -> dict[str, Any]:
+    """The size of the tending plan's run record per hour: one trial of ``parts`` parts
+    paced at ``speed`` times real time, its record's bytes (by record kind) over the time
+    its run took, scaled to an hour (the header, the plan as it ran, counted once). Paced at real time (1.0), as on the cell, the record's
+    samples (joints ten times a wall second, a picture of each camera a wall second) and the
+    plan's events (simulated time) come at the rates a real hour gives.
+    """
+    started = time.perf_counter()
+    with tempfile.TemporaryDirectory(prefix="costar-tending-record-") as folder:
+        record = Path(folder) / "tending.trace.jsonl"
+        with trial_session("tending", seed, speed) as session:
+            trial = TendingTrial(session, PLANS[plan], OperatorModel(), record=record)
+            trial.run(parts=parts, wall_timeout=300.0 * parts)
+            sim_s = session.clock()
+        kinds: dict[str, int] = {}
+        times: list[float] = []
+        lines = record.read_bytes().splitlines(keepends=True)
+        for line in lines[1:]:
+            event = json.loads(line)
+            kinds[event["event"]] = kinds.get(event["event"], 0) + len(line)
+            if isinstance(event.get("time"), (int, float)):
+                times.append(float(event["time"]))
+        size = record.stat().st_size
+    span = max(times) - min(times) if times else 0.0
+    header = len(lines[0]) if lines else 0  # the plan as it ran: once a record, not scaled
+    per_hour = header + (size - header) / span * 3600 if span > 0 else 0.0
+    return {
+        "plan": plan,
+        "parts": parts,
+        "speed": speed,
+        "bytes": size,
+        "header_bytes": header,
+        "run_s": round(span, 1),
+        "sim_s": round(sim_s, 1),
+        "mb_per_hour": round(per_hour / 1e6, 1),
+        "mb_per_hour_by_kind": {
+            k: round(v / span * 3600 / 1e6, 2) for k, v in sorted(kinds.items())
+        }
+        if span > 0
+        else {},
+        "wall_s": round(time.perf_counter() - started, 1),
+    }
 
 
 ROWS = ("produced", "caught", "scrapped", "bad_weld", "bad_grasp", "lost_to_stops",

@@ -9,6 +9,12 @@ that the task was done.
 - ``tending`` (section V-B, Table I): the paper's plan and ours tend the wire bender for two
   trials of ``--parts`` parts from ``--seed`` on (see ``bench/_tending.py``); their counters
   are printed side by side with the paper's Table I.
+- ``tending_record`` (with ``tending``): the size of the tending plan's run record per hour
+  (goal at most 50 MB): one trial of ``--record-parts`` parts of our plan paced at real time
+  (as on the cell: the record's samples come per wall second, the plan's events per
+  simulated second) writes its record as `costar run` does (events, joints at 10 Hz, a
+  160x120 JPEG of each camera a second); its bytes over the time its run took, times an
+  hour (``bench/_tending.py``: ``measure_record_size``).
 - ``kitting``: resources/examples/kitting.costar.json on scene ``kitting_handoff`` (Figure 7):
   each of the three plates lies inside the kit bin and the bin stands at the return place.
 - ``cup_to_bin``: resources/examples/cup_to_bin_vision.costar.json on scene ``cup_to_bin``
@@ -19,11 +25,12 @@ scorer ``(session) -> str`` that returns "" when the task was done, else what is
 from the repository root::
 
     .venv/bin/python bench/casestudies.py [--runs 100] [--only kitting] [--seed 1000]
-        [--parts 50] [--json]
+        [--parts 50] [--record-parts 2] [--json]
 
 JSON: ``{"tending": {"paper": {"produced": 100, "caught": 80, ...}, "ours": {...}},
 "kitting": {"runs": 100, "succeeded": 99, "failures": {"seed": "why", ...},
-"wall_s_per_run": 17.2}, "cup_to_bin": {...}}`` (wall seconds per run, divided by ``--jobs``
+"wall_s_per_run": 17.2}, "cup_to_bin": {...}, "tending_record": {"mb_per_hour": 21.5,
+"bytes": ..., "run_s": ..., "mb_per_hour_by_kind": {...}, ...}}`` (wall seconds per run, divided by ``--jobs``
 in effect).
 """
 
@@ -49,6 +56,7 @@ from bench._tending import (  # noqa: E402
     RESET_S,
     SPEED,
     c_output_to_stderr,
+    measure_record_size,
     measure_tending,
     table_one,
 )
@@ -118,6 +126,7 @@ CASES: dict[str, CaseStudy] = {
     ),
 }
 TENDING = "tending"
+RECORD = "tending_record"  # the size of the tending plan's run record per hour
 
 
 def run_case(case: CaseStudy, seed: int) -> str:
@@ -196,12 +205,27 @@ def _arguments(argv: list[str] | None) -> argparse.Namespace:
     )
     parser.add_argument("--plan", choices=sorted(PLANS), action="append",
                         help="tending: only this plan (default: both)")  # fmt: skip
+    parser.add_argument(
+        "--record-parts",
+        type=int,
+        default=2,
+        help="tending_record: parts of the paced trial whose run record is "
+        "measured (0: no tending_record)",
+    )
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     return parser.parse_args(argv)  # fmt: skip
 
 
 def _print(figures: dict[str, Any]) -> None:
     for name, fig in figures.items():
+        if name == RECORD:
+            print(
+                f"tending record: {fig['mb_per_hour']} MB per hour (goal <= 50): "
+                f"{fig['bytes']} bytes over {fig['run_s']} s of a {fig['parts']}-part trial of "
+                f"the {fig['plan']} plan at real time, scaled to an hour; by kind (MB/h): "
+                + ", ".join(f"{k} {v}" for k, v in fig["mb_per_hour_by_kind"].items())
+            )
+            continue
         if name == TENDING:
             print(table_one(fig))
             for plan, entry in fig.items():
@@ -230,6 +254,8 @@ def _measure_all(args: argparse.Namespace) -> dict[str, Any]:
             )
         else:
             figures[name] = measure(name, args.runs, args.first_seed, args.jobs)
+    if TENDING in (args.only or [TENDING]) and args.record_parts > 0:
+        figures[RECORD] = measure_record_size(args.seed, args.record_parts)
     return figures
 
 

@@ -12,9 +12,14 @@ counting pass on an instance of their own, never timed), then times them:
   total visits.
 
 Each figure is the median of several repetitions after a warm-up, with the garbage
-collector disabled inside the timed loops. Run from the repository root::
+collector disabled inside the timed loops.
 
-    .venv/bin/python bench/engine_ticks.py [--json] [--trees PATH]
+``recording_tick_ratio``: ticks a second of a running plan (at 50 Hz) with its run record
+on (the trace, joints at 10 Hz, two cameras' thumbnails a second) divided by off (goal at
+least 0.95); ``recording.flat_out``: the same with the executor ticking as fast as it can
+(``bench/_recording.py``). Run from the repository root::
+
+    .venv/bin/python bench/engine_ticks.py [--json] [--trees PATH] [--recording-s 3]
 """
 
 from __future__ import annotations
@@ -45,6 +50,7 @@ from bench._bt_trees import (
     load_trees,
     type_name,
 )
+from bench._recording import recording_tick_ratio
 from engine.composites import Sequence
 from engine.context import TreeContext
 from engine.executor import Executor
@@ -305,12 +311,17 @@ def _percentile(values: list[float], fraction: float) -> float:
 
 
 def run_bench(
-    trees_path: Path, reps: int = 7, min_time: float = 0.05, wakeup_runs: int = 300
+    trees_path: Path,
+    reps: int = 7,
+    min_time: float = 0.05,
+    wakeup_runs: int = 300,
+    recording_s: float = 3.0,
 ) -> dict[str, Any]:
     """Verify and time every tree in both engines, then measure wake-up latency.
 
     Returns the ``--json`` object: ``{"trees": {id: {"ours_ns", "py_trees_ns", "ratio"}},
-    "wakeup_median_us", "wakeup_p99_us"}``. Raises BenchError when a tree does not match
+    "wakeup_median_us", "wakeup_p99_us", "recording_tick_ratio", "recording": {...}}``
+    (``recording_s`` 0: no recording figures). Raises BenchError when a tree does not match
     the file.
     """
     trees = load_trees(trees_path)
@@ -325,6 +336,10 @@ def run_bench(
     latencies = measure_wakeup(wakeup_runs)
     report["wakeup_median_us"] = round(statistics.median(latencies), 1)
     report["wakeup_p99_us"] = round(_percentile(latencies, 0.99), 1)
+    if recording_s > 0:
+        recording = recording_tick_ratio(recording_s)
+        report["recording_tick_ratio"] = recording.pop("recording_tick_ratio")
+        report["recording"] = recording
     return report
 
 
@@ -341,6 +356,16 @@ def _print_table(trees: list[TreeDef], report: dict[str, Any]) -> None:
         f"{report['wakeup_median_us']:.1f} us, p99 {report['wakeup_p99_us']:.1f} us"
     )
     print("(ours: tick + reset of node 0; gc disabled while timing; median of repetitions)")
+    if "recording_tick_ratio" in report:
+        print(f"recording_tick_ratio {report['recording_tick_ratio']:.3f} (goal >= 0.95)")
+        for name in ("at_plan_rate", "flat_out"):
+            rec = report["recording"][name]
+            print(
+                f"  {name} ({rec['rate_hz']:g} Hz asked): ratio {rec['ratio']:.3f}, "
+                f"{rec['ticks_per_s_recording']} ticks/s recorded, "
+                f"{rec['ticks_per_s_not_recording']} not, "
+                f"{rec['record_bytes_per_s']} bytes/s of record"
+            )
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -351,9 +376,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--reps", type=int, default=7, help="timed repetitions per tree")
     parser.add_argument("--min-time", type=float, default=0.05, help="seconds per repetition")
     parser.add_argument("--wakeup-runs", type=int, default=300, help="wake-up samples")
+    parser.add_argument("--recording-s", type=float, default=3.0,
+                        help="seconds of each run with the record on and off (0: none)")  # fmt: skip
     args = parser.parse_args(argv)
     try:
-        report = run_bench(args.trees, args.reps, args.min_time, args.wakeup_runs)
+        report = run_bench(args.trees, args.reps, args.min_time, args.wakeup_runs, args.recording_s)
     except BenchError as exc:
         print(f"engine_ticks: {exc}", file=sys.stderr)
         return 2

@@ -27,7 +27,7 @@ from capabilities.collaboration.answers import CONFIRM_MODES, PromptAnswerer
 from capabilities.doctor import cmd_doctor
 from capabilities.faults import hold_check
 from capabilities.hold_watch import DEFAULT_HOLD_TIMEOUT, HoldWatch
-from capabilities.run_sampler import JointSampler
+from capabilities.run_sampler import record_samplers
 from capabilities.shipped_examples import cmd_examples
 from capabilities.xml_commands import add_xml_commands
 from engine.build import BuildError, build_tree
@@ -230,10 +230,7 @@ def _cmd_run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         record = _record_path(args, plan.name, err)
         if record is not None:  # first: what a line on screen says is already in the record
             recorder = TraceRecorder(record, plan, _run_settings(args))
-            listeners.append(recorder)
-            arm = cell.interfaces().get("arm")
-            if arm is not None:
-                listeners.append(JointSampler(arm, recorder))
+            listeners += [recorder, *record_samplers(cell, recorder)]
         if publisher is not None:
             listeners.append(publisher.monitor)
         holds = HoldWatch(out, args.hold_timeout, cell)

@@ -9,6 +9,8 @@ moment ``t`` (seconds since the run started) without going through the record ag
 - the nodes running, outermost first (the plan's order);
 - the blackboard's values: each name's writes in time order, found by bisection;
 - the robot's joints: the last sample (10 Hz) at or before ``t``;
+- the cameras' pictures: each camera's last thumbnail (a JPEG, about one a second) at or
+  before ``t``;
 - per-node figures (ticks, starts, successes, failures, time RUNNING), counted at load;
 - the failure moments: one per tick in which a node failed, naming the first node that did
   (the leaf, as the engine reports the failing leaf before the nodes that pass it up).
@@ -16,6 +18,8 @@ moment ``t`` (seconds since the run started) without going through the record ag
 
 from __future__ import annotations
 
+import base64
+import binascii
 import json
 import os
 from bisect import bisect_right
@@ -127,6 +131,7 @@ class Timeline:
         self._writes: dict[str, tuple[list[float], list[BlackboardEntry]]] = {}
         self._joint_times: list[float] = []
         self._joints: list[tuple[float, ...]] = []
+        self._thumbnails: dict[str, tuple[list[float], list[str]]] = {}  # camera -> base64s
         self.failures: list[FailureMark] = []
         self.duration = 0.0
         self._counting: dict[str, _Counting] = {}
@@ -182,6 +187,10 @@ class Timeline:
             elif kind == "joints" and event.get("q"):
                 self._joint_times.append(at)
                 self._joints.append(tuple(float(a) for a in event["q"]))
+            elif kind == "thumbnail" and isinstance(event.get("jpeg"), str):
+                times, pictures = self._thumbnails.setdefault(str(event.get("camera")), ([], []))
+                times.append(at)
+                pictures.append(event["jpeg"])
         for counting in self._counting.values():  # still running when the record ends
             if counting.running_since is not None:
                 counting.figures.running_s += self.duration - counting.running_since
@@ -287,6 +296,31 @@ class Timeline:
     @property
     def has_joints(self) -> bool:
         return bool(self._joints)
+
+    @property
+    def cameras(self) -> list[str]:
+        """The cameras the record has pictures of, by name."""
+        return sorted(self._thumbnails)
+
+    def pictures_at(self, t: float) -> dict[str, bytes]:
+        """Each camera's picture at ``t`` (JPEG bytes): its last thumbnail at or before ``t``
+        (a camera with none yet, or a picture that is not base64, is left out).
+        """
+        pictures = {}
+        for camera, (times, encoded) in self._thumbnails.items():
+            index = bisect_right(times, t)
+            if index:
+                try:
+                    pictures[camera] = base64.b64decode(encoded[index - 1], validate=True)
+                except (binascii.Error, ValueError):
+                    continue
+        return pictures
+
+    def picture_time(self, camera: str, t: float) -> float | None:
+        """When the picture of ``camera`` shown at ``t`` was taken (None: none yet)."""
+        times = self._thumbnails.get(camera, ([], []))[0]
+        index = bisect_right(times, t)
+        return times[index - 1] if index else None
 
     def figures(self, node_id: str) -> NodeFigures:
         """What the node did over the run (all zero: it never ran)."""

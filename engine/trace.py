@@ -3,7 +3,10 @@
 The first line is a header with the plan's nodes (id, label, kind, path), so a trace can be
 read without the plan; each further line is one event. When the run had failures, a
 ``failures`` record before the last one names their root causes (``engine.run_report``):
-the one that failed the run (``cause``) and those on the way.
+the one that failed the run (``cause``) and those on the way. A cell adds records of its
+own between the events (:meth:`TraceRecorder.note`, ``capabilities.run_sampler``): the
+robot's ``joints``, a camera's ``thumbnail`` (a JPEG in base64), the ``operator`` console's
+questions, answers and presses. A reader skips the kinds it does not know.
 """
 
 from __future__ import annotations
@@ -34,7 +37,14 @@ from engine.spec import PlanSpec
 from engine.status import Status
 from engine.types import encode_value
 
-__all__ = ["TraceRecorder", "Trace", "TraceError", "read_trace", "format_timeline"]
+__all__ = [
+    "TraceRecorder",
+    "Trace",
+    "TraceError",
+    "read_trace",
+    "format_timeline",
+    "in_time_order",
+]
 
 TRACE_FORMAT = "costar-trace"
 TRACE_VERSION = 1
@@ -236,11 +246,51 @@ def _held_words(event: dict[str, Any]) -> str:
     return f"held: {event['reason']}" if event.get("reason") else "resumed"
 
 
+def _operator_words(event: dict[str, Any]) -> str:
+    """What a record of the operator console says: a question, its answer, a press."""
+    action, text = event.get("action"), event.get("text", "")
+    by = f" (by {event['by']})" if event.get("by") else ""
+    if action == "asked":
+        source = f" (asked by {event['source']})" if event.get("source") else ""
+        return f"operator asked: {text}{source}"
+    if action == "answered":
+        return f"operator answered {event.get('answer')}{by}: {text}"
+    if action == "withdrawn":
+        return f"question withdrawn ({event.get('reason') or 'no reason given'}): {text}"
+    if action == "pressed":
+        return f"operator pressed {event.get('button', '')}{by}"
+    return f"operator: {action}"
+
+
+def _failure_lines(event: dict[str, Any], tick: str) -> Iterable[str]:
+    """What a record of the run's failures says: the cause, then those on the way."""
+    if isinstance(event.get("cause"), dict):
+        yield f"{tick}the run failed: {RootCause.from_record(event['cause']).describe()}"
+    for other in event.get("on_the_way", []):
+        if isinstance(other, dict):
+            yield f"{tick}on the way: {RootCause.from_record(other).describe()}"
+
+
+def in_time_order(events: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The records by their times: the cell's own (joints, pictures, the operator's
+    actions), written from other threads as they happen, go between the run's events,
+    which the dispatcher writes a moment later. A record without a time keeps its place
+    after the one before it; records of the same time keep their order.
+    """
+    keys, last = [], float("-inf")
+    for event in events:
+        stamp = event.get("time")
+        last = float(stamp) if isinstance(stamp, (int, float)) else last
+        keys.append(last)
+    order = sorted(range(len(events)), key=keys.__getitem__)
+    return [events[i] for i in order]
+
+
 def format_timeline(trace: Trace) -> Iterable[str]:
-    """Readable lines: time since start, tick, node, change, message."""
+    """Readable lines in time order: time since start, tick, node, change, message."""
     labels = trace.labels()
     start: float | None = None
-    for event in trace.events:
+    for event in in_time_order(trace.events):
         stamp = float(event.get("time", 0.0))
         start = stamp if start is None else start
         head = f"{stamp - start:9.3f}s"
@@ -261,11 +311,8 @@ def format_timeline(trace: Trace) -> Iterable[str]:
         elif kind in ("held", "paused"):
             yield f"{head} tick {event['tick']:>5}  run {_held_words(event)}"
         elif kind == "failures":
-            tick = f"{head} tick {event['tick']:>5}  "
-            if isinstance(event.get("cause"), dict):
-                yield f"{tick}the run failed: {RootCause.from_record(event['cause']).describe()}"
-            for other in event.get("on_the_way", []):
-                if isinstance(other, dict):
-                    yield f"{tick}on the way: {RootCause.from_record(other).describe()}"
+            yield from _failure_lines(event, f"{head} tick {event['tick']:>5}  ")
+        elif kind == "operator":
+            yield f"{head}             {_operator_words(event)}"
         elif kind == "started":
             yield f"{head} run of {event.get('plan') or 'plan'} started"

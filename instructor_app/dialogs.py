@@ -118,5 +118,10 @@ class Dialogs:
         answer, ok = QInputDialog.getText(parent, title, label, text=text)
         return str(answer) if ok else None
 
+    def ask_runs_folder(self, parent: QWidget, current: str) -> str | None:
+        """The folder to keep run records in (None: cancelled)."""
+        folder = QFileDialog.getExistingDirectory(parent, "Keep run records in", current)
+        return folder or None
+
     def about(self, parent: QWidget, text: str) -> None:
         QMessageBox.about(parent, f"About {APP_TITLE}", text)

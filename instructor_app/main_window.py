@@ -93,6 +93,7 @@ class MainWindow(QMainWindow):
         self.document = PlanDocument(self)
         self.autosaver = Autosaver(self.document, recovery_folder, autosave_interval_ms, self)
         self.controller = RunController(self.document, session, rate_hz=rate_hz, parent=self)
+        self.controller.runs_setting = self.settings.runs_folder()  # Run > Runs Folder…
         self.views: Views = make_views(self.document, session, self, self.autosaver.folder.parent)
         self.run_actions = RunActions(self.controller, self)
         self.debug_actions = DebugActions(
@@ -146,6 +147,7 @@ class MainWindow(QMainWindow):
             self,
             lambda: self.controller.last_record,
             self,
+            self.controller.runs_folder,
         )
         self.actions_by_name: dict[str, QAction] = {}
         self._build_menus()
@@ -242,6 +244,7 @@ class MainWindow(QMainWindow):
         groot2.setToolTip("Serve each run to Groot2's monitor, as BehaviorTree.CPP does")
         run_menu.addAction(groot2)
         run_menu.addAction(self._action("groot2_port", "Groot2 &Port…", self._ask_groot2_port))
+        run_menu.addAction(self._action("runs_folder", "Runs &Folder…", self._ask_runs_folder))
         self._apply_groot2()
         self.debug_actions.fill_menu(bar.addMenu("&Debug"))
         self.library.fill_menu(bar.addMenu("&Library"))
@@ -275,6 +278,19 @@ class MainWindow(QMainWindow):
         if port is not None:
             self.settings.set_groot2_port(port)
             self._apply_groot2()
+
+    def _ask_runs_folder(self) -> None:
+        """Run > Runs Folder…: where the next runs' records go (and Last run looks)."""
+        folder = self.dialogs.ask_runs_folder(self, str(self.controller.runs_folder()))
+        if folder is None:
+            return
+        self.settings.set_runs_folder(folder)
+        self.controller.runs_setting = folder
+        now = self.controller.runs_folder()
+        self.show_message(
+            f"Run records go to {now}"
+            + (" ($COSTAR_RUNS overrides the setting)" if folder and now != Path(folder) else "")
+        )
 
     def _build_edit_menus(self) -> None:
         edit = self.menuBar().addMenu("&Edit")

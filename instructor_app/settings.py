@@ -43,6 +43,7 @@ DISTRIBUTION = "costar-instructor"
 _RECENT = "files/recent"
 _LAST_DIR = "files/last_dir"
 _LIBRARY = "library/folder"
+_RUNS = "runs/folder"
 _GEOMETRY = "window/geometry"
 _STATE = "window/state"
 _BREAKPOINTS = "debug/breakpoints"  # + "/<plan id>": the node ids, kept out of the plan file
@@ -113,6 +114,16 @@ class AppSettings:
 
     def set_library_folder(self, folder: str | Path) -> None:
         self.qsettings.setValue(_LIBRARY, str(folder))
+
+    def runs_folder(self) -> str:
+        """The runs folder chosen in the settings ("" when none was: $COSTAR_RUNS, else the
+        user's data folder; ``engine.run_records.runs_folder``).
+        """
+        return str(self.qsettings.value(_RUNS, "") or "")
+
+    def set_runs_folder(self, folder: str | Path) -> None:
+        """Keep run records in ``folder`` ("": back to the default)."""
+        self.qsettings.setValue(_RUNS, str(folder))
 
     def groot2_publish(self) -> bool:
         """Whether runs are published for Groot2 (Run > Publish Runs for Groot2)."""

@@ -43,6 +43,7 @@ class TimelineController(QObject):
         window: asks the questions (its ``dialogs``, ``maybe_save``, ``show_canvas``,
             ``select_node``).
         last_record: the record of the last run the window started (None: none yet).
+        folder: the runs folder now (the setting may change it).
 
     Signals:
         message(str): a line for the status bar.
@@ -59,11 +60,13 @@ class TimelineController(QObject):
         window: Any,
         last_record: Callable[[], Path | None],
         parent: QObject | None = None,
+        folder: Callable[[], Path] = runs_folder,
     ) -> None:
         super().__init__(parent)
         self.panel, self.document, self._window = panel, document, window
         self._canvas, self._blackboard, self._scene3d = views.canvas, views.blackboard, scene3d
         self._last_record = last_record
+        self._folder = folder
         panel.open_requested.connect(lambda: self.open_record())
         panel.last_run_requested.connect(self.open_last_run)
         panel.statuses_changed.connect(self._canvas.set_statuses)
@@ -79,7 +82,7 @@ class TimelineController(QObject):
         """Open a run record (asks for the file when ``path`` is None); False when not."""
         if path is None:
             parent: QWidget = self._window
-            path = self._window.dialogs.record_open_path(parent, str(runs_folder()))
+            path = self._window.dialogs.record_open_path(parent, str(self._folder()))
             if not path:
                 return False
         try:
@@ -98,7 +101,7 @@ class TimelineController(QObject):
         path = self._last_record()
         if path is None or not path.exists():
             try:
-                path = find_record(runs_folder(), "last")
+                path = find_record(self._folder(), "last")
             except RunRecordError as exc:
                 self.message.emit(f"No run record to open: {exc}")
                 return False

@@ -57,7 +57,7 @@ class PromptAnswerer:
         prompt = event.prompt
         if self._mode != "ask":
             self._print(f"operator: {prompt.text} -> {self._mode} (--confirm {self._mode})")
-            self._console.answer(prompt.id, self._mode == "yes")
+            self._console.answer(prompt.id, self._mode == "yes", f"--confirm {self._mode}")
             return
         self._print(f"operator: {prompt.text} [y/n]")
         with self._lock:
@@ -89,9 +89,9 @@ class PromptAnswerer:
         with self._lock:
             for prompt in self._console.pending():
                 if self._lines:
-                    self._console.answer(prompt.id, _yes(self._lines.popleft()))
+                    self._console.answer(prompt.id, _yes(self._lines.popleft()), "the terminal")
                 elif self._eof:
-                    self._console.answer(prompt.id, False)
+                    self._console.answer(prompt.id, False, "end of input")
                     unanswered.append(prompt.text)
         for text in unanswered:
             self._print(f"operator: {text} -> no (end of input)")

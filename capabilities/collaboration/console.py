@@ -6,6 +6,9 @@ the paper's foot pedal). The console knows no Qt: it is called from the engine's
 worker thread, the GUI thread or a digital-input poller, and tells its listeners what
 changed from whichever thread made the change (the GUI marshals them to its own thread).
 
+Each answer and press says who gave it (``by``: "the Instructor", "--confirm yes", "the
+terminal", "digital input"...), so that a run's record keeps who did what, and when.
+
 Buttons latch: a press is remembered until an operation consumes it; several presses before
 the next consume count as one (a bounced pedal or a double click must not skip a step).
 """
@@ -61,6 +64,7 @@ class Prompt:
         self._lock = threading.Lock()
         self._state = PromptState.PENDING
         self._reason = ""
+        self._by = ""
         self._done = threading.Event()
         self._callbacks: list[Callable[[Prompt], None]] = []
 
@@ -84,6 +88,11 @@ class Prompt:
         return self._reason
 
     @property
+    def answered_by(self) -> str:
+        """Who answered or withdrew it ("" when nobody said)."""
+        return self._by
+
+    @property
     def closed(self) -> bool:
         return self._state is not PromptState.PENDING
 
@@ -99,11 +108,11 @@ class Prompt:
                 return
         fn(self)
 
-    def _close(self, state: PromptState, reason: str) -> bool:
+    def _close(self, state: PromptState, reason: str, by: str = "") -> bool:
         with self._lock:
             if self._state is not PromptState.PENDING:
                 return False
-            self._state, self._reason = state, reason
+            self._state, self._reason, self._by = state, reason, by
             callbacks, self._callbacks = self._callbacks, []
         self._done.set()
         for fn in callbacks:
@@ -124,11 +133,12 @@ class ConsoleEventKind(str, enum.Enum):
 
 @dataclass(frozen=True)
 class ConsoleEvent:
-    """What a listener hears: a prompt shown or closed, or a button pressed."""
+    """What a listener hears: a prompt shown or closed, or a button pressed (``by`` whom)."""
 
     kind: ConsoleEventKind
     prompt: Prompt | None = None
     button: str = ""
+    by: str = ""
 
 
 ConsoleListener = Callable[[ConsoleEvent], None]
@@ -179,12 +189,14 @@ class OperatorConsole:
 
     # ------------------------------------------------------------------ buttons
 
-    def press(self, name: str = "continue") -> None:
-        """The operator pressed a button (GUI thread, digital-input poller, tests)."""
+    def press(self, name: str = "continue", by: str = "") -> None:
+        """The operator pressed a button (GUI thread, digital-input poller, tests); ``by``:
+        where the press came from.
+        """
         with self._lock:
             self._latched[name] = self._latched.get(name, 0) + 1
             self._presses[name] = self._presses.get(name, 0) + 1
-        self._notify(ConsoleEvent(ConsoleEventKind.BUTTON_PRESSED, button=name))
+        self._notify(ConsoleEvent(ConsoleEventKind.BUTTON_PRESSED, button=name, by=by))
 
     def consume(self, name: str = "continue") -> bool:
         """True if the button was pressed since the last consume; clears the latch."""
@@ -218,9 +230,12 @@ class OperatorConsole:
         self._notify(ConsoleEvent(ConsoleEventKind.PROMPT_SHOWN, prompt))
         return prompt
 
-    def answer(self, prompt_id: str, yes: bool) -> bool:
-        """Answer an open prompt; False when it is unknown or already closed."""
-        return self._close(prompt_id, PromptState.YES if yes else PromptState.NO, "answered")
+    def answer(self, prompt_id: str, yes: bool, by: str = "") -> bool:
+        """Answer an open prompt (``by``: who answered); False when it is unknown or
+        already closed.
+        """
+        state = PromptState.YES if yes else PromptState.NO
+        return self._close(prompt_id, state, "answered", by)
 
     def cancel(self, prompt_id: str, reason: str = "withdrawn") -> bool:
         """Withdraw an open prompt (the plan stopped waiting); False when already closed."""
@@ -236,10 +251,10 @@ class OperatorConsole:
         with self._lock:
             return self._prompts.get(prompt_id)
 
-    def _close(self, prompt_id: str, state: PromptState, reason: str) -> bool:
+    def _close(self, prompt_id: str, state: PromptState, reason: str, by: str = "") -> bool:
         with self._lock:
             prompt = self._prompts.pop(prompt_id, None)
-        if prompt is None or not prompt._close(state, reason):
+        if prompt is None or not prompt._close(state, reason, by):
             return False
-        self._notify(ConsoleEvent(ConsoleEventKind.PROMPT_CLOSED, prompt))
+        self._notify(ConsoleEvent(ConsoleEventKind.PROMPT_CLOSED, prompt, by=by))
         return True

@@ -66,7 +66,7 @@ class DigitalInputButton:
         rising = level and not self._last
         self._last = level
         if rising:
-            self._console.press(self._button)
+            self._console.press(self._button, "digital input")
         return rising
 
     def start(self) -> None:

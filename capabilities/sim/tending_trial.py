@@ -31,6 +31,7 @@ operator, never by the plan.
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable
 from concurrent.futures import Future
 from concurrent.futures import TimeoutError as FutureTimeout
 from dataclasses import dataclass
@@ -40,6 +41,7 @@ from typing import Any
 from capabilities.base import CapabilityRegistry
 from capabilities.bullet import pybullet as p
 from capabilities.faults import hold_check
+from capabilities.run_sampler import record_samplers
 from capabilities.sim.bender_spec import FaultModel
 from capabilities.sim.errors import SimError
 from capabilities.sim.session import PERCEPTION_S, SimCellSession
@@ -50,6 +52,7 @@ from engine.executor import Executor
 from engine.files import load_plan
 from engine.hold import Hold
 from engine.status import Status
+from engine.trace import TraceRecorder
 from engine.validation import has_errors, validate_plan
 
 __all__ = ["OperatorModel", "TendingTrial", "TrialError", "trial_session"]
@@ -104,6 +107,7 @@ class TendingTrial:
         plan: the plan file.
         operator: who answers the plan's calls.
         rate_hz: the executor's tick rate.
+        record: keep the run's record in this file, as `costar run` does (None: none).
 
     Attributes:
         calls: simulated times at which the plan (or a held run) called the operator.
@@ -118,6 +122,7 @@ class TendingTrial:
         plan: Path,
         operator: OperatorModel | None = None,
         rate_hz: float = 50.0,
+        record: Path | None = None,
     ) -> None:
         if session.bender is None:
             raise TrialError(f"the scene {session.scene.name!r} has no wire bender")
@@ -150,8 +155,17 @@ class TendingTrial:
                 self._nodes.setdefault(node.id, (f"{sub.name}/{node.label}", node.op or ""))
         tree = build_tree(spec, registry, clock=session.clock)
         self._cell_hold = hold_check(session)
+        listeners: list[Callable[[Event], None]] = []
+        if record is not None:
+            recorder = TraceRecorder(record, spec, {"cell": "sim", "scene": "tending"})
+            listeners = [recorder, *record_samplers(session, recorder)]
         self.executor = Executor(
-            tree, rate_hz, hold=self._before_tick, lockstep=lockstep, inline=[self._heard]
+            tree,
+            rate_hz,
+            listeners,
+            hold=self._before_tick,
+            lockstep=lockstep,
+            inline=[self._heard],
         )
 
     # ------------------------------------------------------------------ the engine
@@ -219,7 +233,7 @@ class TendingTrial:
         if self.session.hold_reason():
             self.session.clear()  # on the pendant: unlocks once the delay allows
         if press:
-            self.session.operator.press("continue")
+            self.session.operator.press("continue", "the simulated operator")
         with self._lock:
             self._pending -= 1
 

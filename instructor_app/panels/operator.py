@@ -152,7 +152,7 @@ class OperatorPanel(QWidget):
     def press(self, button: str = "continue") -> None:
         """Press an operator button on the console."""
         if self._console is not None:
-            self._console.press(button)
+            self._console.press(button, "the Instructor")
 
     # ------------------------------------------------------------------ console events
 
@@ -193,7 +193,7 @@ class OperatorPanel(QWidget):
 
     def _answer(self, prompt_id: str, yes: bool) -> None:
         if self._console is not None:
-            self._console.answer(prompt_id, yes)
+            self._console.answer(prompt_id, yes, "the Instructor")
 
     def _update_state(self) -> None:
         count = len(self._rows)

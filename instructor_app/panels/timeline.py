@@ -1,8 +1,9 @@
 """The Timeline panel: a run record played back, moment by moment.
 
 A slider over the run's time (with play and pause, and the time shown), the failures as red
-marks on its track (clicking one goes there), the nodes running at that moment and the
-figures of the selected node. The panel says what the views should show as signals; the
+marks on its track (clicking one goes there), the nodes running at that moment, the cameras'
+pictures at that moment (the record's thumbnails, about one a second, in a small picture area
+of the panel's own) and the figures of the selected node. The panel says what the views should show as signals; the
 window's wiring (:mod:`instructor_app.timeline_wiring`) puts it on the canvas, the
 Blackboard panel and the 3D scene.
 
@@ -18,7 +19,7 @@ import math
 import time
 
 from PySide6.QtCore import QLine, Qt, QTimer, Signal
-from PySide6.QtGui import QColor, QMouseEvent, QPainter, QPaintEvent, QPen
+from PySide6.QtGui import QColor, QMouseEvent, QPainter, QPaintEvent, QPen, QPixmap
 from PySide6.QtWidgets import (
     QHBoxLayout,
     QLabel,
@@ -150,6 +151,8 @@ class TimelinePanel(QWidget):
         self._entries: dict[str, BlackboardEntry] = {}
         self._joints: tuple[float, ...] | None = None
         self._running: list[str] = []
+        self._picture_times: dict[str, float | None] = {}  # camera -> when its shown one was taken
+        self.picture_labels: dict[str, QLabel] = {}
         self._selected = ""
         self.frames_shown = 0  # moments shown (the bench counts them)
         self.last_changed: dict[str, Status] = {}  # what the last moment shown changed
@@ -200,9 +203,11 @@ class TimelinePanel(QWidget):
         column.addWidget(QLabel("Running at this moment:"))
         column.addWidget(self.running)
         below.addLayout(column, 1)
+        self.pictures_row = QHBoxLayout()
         side = QVBoxLayout()
         side.addWidget(self.record_label)
         side.addWidget(self.figures_label)
+        side.addLayout(self.pictures_row)
         side.addStretch(1)
         below.addLayout(side, 1)
         layout = QVBoxLayout(self)
@@ -218,6 +223,7 @@ class TimelinePanel(QWidget):
         self.timeline = timeline
         self._statuses, self._entries, self._joints, self._running = {}, {}, None, []
         self.statuses_cleared.emit()
+        self._set_cameras(timeline.cameras if timeline is not None else [])
         has = timeline is not None
         for widget in (self.slider, self.play_button):
             widget.setEnabled(has)
@@ -299,6 +305,7 @@ class TimelinePanel(QWidget):
         if joints != self._joints:
             self._joints = joints
             self.joints_changed.emit(joints)
+        self._show_pictures(t)
         running = timeline.running_after(index)
         if running != self._running:
             self._running = running
@@ -315,6 +322,46 @@ class TimelinePanel(QWidget):
         self._entries = now
         if changed:
             self.values_changed.emit(changed, False)
+
+    def _set_cameras(self, cameras: list[str]) -> None:
+        """One picture per camera of the record, captioned with its name (none: no area)."""
+        for label in self.picture_labels.values():
+            self.pictures_row.removeWidget(label)
+            label.deleteLater()
+        self.picture_labels, self._picture_times = {}, {}
+        for camera in cameras:
+            label = QLabel(f"{camera}: no picture yet")
+            label.setObjectName(f"TimelinePicture-{camera}")
+            label.setToolTip(f"The {camera} camera at this moment (a picture a second)")
+            label.setMinimumSize(160, 120)
+            label.setAlignment(Qt.AlignmentFlag.AlignCenter)
+            self.pictures_row.addWidget(label)
+            self.picture_labels[camera] = label
+
+    def _show_pictures(self, t: float) -> None:
+        """Each camera's picture at ``t``, decoded only when it is another one."""
+        timeline = self.timeline
+        assert timeline is not None
+        taken = {camera: timeline.picture_time(camera, t) for camera in self.picture_labels}
+        if taken == self._picture_times:
+            return
+        pictures = timeline.pictures_at(t)
+        for camera, label in self.picture_labels.items():
+            if taken[camera] == self._picture_times.get(camera, -1.0):
+                continue
+            pixmap = QPixmap()
+            if camera in pictures and pixmap.loadFromData(pictures[camera]):
+                label.setPixmap(pixmap)
+            else:
+                label.clear()
+                label.setText(f"{camera}: no picture yet")
+        self._picture_times = taken
+
+    def picture(self, camera: str) -> QPixmap | None:
+        """The picture shown of ``camera`` (None: none)."""
+        label = self.picture_labels.get(camera)
+        pixmap = label.pixmap() if label is not None else None
+        return pixmap if pixmap is not None and not pixmap.isNull() else None
 
     def _mark_clicked(self, value: int) -> None:
         assert self.timeline is not None

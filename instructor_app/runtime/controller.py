@@ -21,7 +21,7 @@ from PySide6.QtCore import QObject, QTimer, Signal
 
 from capabilities.cell_features import ReportsStatus, lockstep_of
 from capabilities.faults import hold_check
-from capabilities.run_sampler import JointSampler
+from capabilities.run_sampler import record_samplers
 from engine.blackboard import OPERATOR, Blackboard, BlackboardEntry, BlackboardError
 from engine.build import BuildError, build_tree
 from engine.events import Listener, RunFinished
@@ -165,6 +165,7 @@ class RunController(QObject):
         self._stopping = False  # a stop was asked: the halt's IDLE resets are not shown
         self._held = ""  # why the cell holds the run ("" when it does not)
         self.last_record: Path | None = None  # the record of the last run started
+        self.runs_setting = ""  # the runs folder of the settings ("": the default)
         self._idled: set[str] = set()  # nodes that went RUNNING -> IDLE at the last drain
         self._groot2_port: int | None = None  # publish runs for Groot2 on it (None: do not)
         self._groot2: Groot2Publisher | None = None  # serving, once a run was published
@@ -430,12 +431,16 @@ class RunController(QObject):
             self.log_message.emit(f"Run of {plan.name or 'the plan'} started", "info")
         return True
 
+    def runs_folder(self) -> Path:
+        """Where run records go: $COSTAR_RUNS, else the setting, else the user's data folder."""
+        return runs_folder(setting=self.runs_setting or None)
+
     def _recorder(self, plan: PlanSpec) -> list[Listener]:
-        """This run's record in the runs folder ($COSTAR_RUNS, else the user's; the oldest
-        removed past its size limit), as `costar run` keeps one; none when it cannot be
-        written (said in the Log: the run goes on).
+        """This run's record in the runs folder (:meth:`runs_folder`; the oldest removed
+        past its size limit), as `costar run` keeps one; none when it cannot be written
+        (said in the Log: the run goes on).
         """
-        folder = runs_folder()
+        folder = self.runs_folder()
         try:
             path = new_record_path(folder, plan.name)
             recorder = TraceRecorder(path, plan)
@@ -444,9 +449,7 @@ class RunController(QObject):
             return []
         prune_records(folder, keep=path)
         self.last_record = path
-        cell = self.session.cell
-        arm = cell.interfaces().get("arm") if cell is not None else None
-        return [recorder] if arm is None else [recorder, JointSampler(arm, recorder)]
+        return [recorder, *record_samplers(self.session.cell, recorder)]
 
     def _resume_at(self, tree: BehaviorTree, node_id: str) -> dict[str, Status] | None:
         """Mark the nodes before ``node_id`` done and carry the last run's values over."""

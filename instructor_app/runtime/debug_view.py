@@ -43,7 +43,7 @@ AskText = Callable[[str, str, str], "str | None"]
 
 
 def _where(breakpoint: Breakpoint) -> str:
-    """ "before", "after" or "before and after"."""
+    """Where the breakpoint pauses: "before", "after" or "before and after"."""
     if breakpoint.before and breakpoint.after:
         return "before and after"
     return "before" if breakpoint.before else "after"

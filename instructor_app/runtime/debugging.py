@@ -161,7 +161,9 @@ class RunDebugging(QObject):
 
 
 def _break_note(breakpoint: Breakpoint) -> str:
-    """ "" for a plain breakpoint before the node (its dot says it), else what it is."""
+    """What the node shows of its breakpoint: nothing for a plain one before it (the dot says
+    it), else "break after", "break if COUNT > 2"...
+    """
     where = "" if breakpoint.before and not breakpoint.after else "break "
     where += "after" if breakpoint.after and not breakpoint.before else ""
     where += "before and after" if breakpoint.before and breakpoint.after else ""

@@ -42,7 +42,8 @@ def test_a_tiny_run_prints_one_json_object_of_every_case(
     cup_to_bin.
     """
     argv = ["--only", "tending", "--only", "cup_to_bin", "--plan", "paper", "--parts", "1",
-            "--trials", "1", "--runs", "1", "--first-seed", "20", "--seed", "900", "--json"]  # fmt: skip
+            "--trials", "1", "--runs", "1", "--first-seed", "20", "--seed", "900", "--json",
+            "--record-parts", "0"]  # fmt: skip
     assert casestudies.main(argv) == 0
     figures = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
     assert set(figures) == {"tending", "cup_to_bin"}

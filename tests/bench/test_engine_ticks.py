@@ -83,10 +83,21 @@ def test_our_per_tick_tree_latches_until_reset(bench: ModuleType, trees: dict[st
 def test_the_command_prints_the_json_report(
     ticks: ModuleType, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    argv = ["--json", "--reps", "1", "--min-time", "0", "--wakeup-runs", "3"]
+    argv = ["--json", "--reps", "1", "--min-time", "0", "--wakeup-runs", "3",
+            "--recording-s", "0.2"]  # fmt: skip
     assert ticks.main(argv) == 0
     report = json.loads(capsys.readouterr().out)
-    assert set(report) == {"trees", "wakeup_median_us", "wakeup_p99_us"}
+    assert set(report) == {
+        "trees",
+        "wakeup_median_us",
+        "wakeup_p99_us",
+        "recording_tick_ratio",
+        "recording",
+    }
+    assert report["recording_tick_ratio"] > 0
+    for rates in ("at_plan_rate", "flat_out"):
+        figures = report["recording"][rates]
+        assert figures["ticks_per_s_recording"] > 0 and figures["record_bytes_per_s"] > 0
     assert set(report["trees"]) == set(TREE_IDS)
     for row in report["trees"].values():
         assert set(row) == {"ours_ns", "py_trees_ns", "ratio"}

@@ -4,8 +4,11 @@ against a naive replay of the record, and fast for a record of 100,000 transitio
 
 from __future__ import annotations
 
+import base64
 from pathlib import Path
 from typing import Any
+
+import pytest
 
 from bench._records import write_synthetic_record
 from engine.spec import NodeKind, NodeSpec, PlanSpec
@@ -104,3 +107,30 @@ def test_figures_count_starts_results_ticks_and_time_running(tmp_path: Path) -> 
     assert timeline.statuses_at(0.7) == failed
     assert timeline.joints_at(0.1) is None and timeline.joints_at(0.3) == (1, 2, 3, 4, 5, 6)
     assert timeline.plan() is None  # a record without the plan's document
+
+
+def test_the_picture_of_a_moment_is_each_cameras_last_thumbnail_before_it(
+    tmp_path: Path,
+) -> None:
+    path = tmp_path / "pictures.trace.jsonl"
+    first, second, wrist = b"\xff\xd8first", b"\xff\xd8second", b"\xff\xd8wrist"
+    b64 = {k: base64.b64encode(v).decode() for k, v in (("1", first), ("2", second), ("w", wrist))}
+    lines = [
+        '{"format":"costar-trace","format_version":1,"nodes":[]}',
+        '{"event":"started","plan":"p","time":10.0}',
+        f'{{"event":"thumbnail","camera":"shoulder","jpeg":"{b64["1"]}","time":10.2}}',
+        f'{{"event":"thumbnail","camera":"wrist","jpeg":"{b64["w"]}","time":10.3}}',
+        f'{{"event":"thumbnail","camera":"shoulder","jpeg":"{b64["2"]}","time":11.2}}',
+        '{"event":"thumbnail","camera":"shoulder","jpeg":"not base64!","time":12.2}',
+        '{"event":"finished","tick":3,"status":"SUCCESS","reason":"finished","message":"",'
+        '"time":12.5}',
+    ]
+    path.write_text("\n".join(lines) + "\n")
+    timeline = Timeline.load(path)
+    assert timeline.cameras == ["shoulder", "wrist"]
+    assert timeline.pictures_at(0.1) == {}
+    assert timeline.pictures_at(0.25) == {"shoulder": first}
+    assert timeline.pictures_at(1.5) == {"shoulder": second, "wrist": wrist}
+    assert timeline.pictures_at(2.3) == {"wrist": wrist}  # a broken picture is left out
+    assert timeline.picture_time("shoulder", 1.5) == pytest.approx(1.2)
+    assert timeline.picture_time("wrist", 0.25) is None

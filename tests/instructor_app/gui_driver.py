@@ -101,6 +101,7 @@ class ScriptedDialogs(Dialogs):
         self.errors: list[tuple[str, str]] = []
         self.port_answers: list[int | None] = []
         self.text_answers: list[str | None] = []
+        self.folder_answers: list[str | None] = []
 
     def ask_save_changes(self, parent: QWidget, name: str) -> str:
         self.asked.append(("save", name))
@@ -113,6 +114,10 @@ class ScriptedDialogs(Dialogs):
     def ask_text(self, parent: QWidget, title: str, label: str, text: str) -> str | None:
         self.asked.append(("text", title))
         return self.text_answers.pop(0) if self.text_answers else None
+
+    def ask_runs_folder(self, parent: QWidget, current: str) -> str | None:
+        self.asked.append(("runs_folder", current))
+        return self.folder_answers.pop(0) if self.folder_answers else None
 
     def ask_restore(self, parent: QWidget, description: str) -> bool:
         self.asked.append(("restore", description))

@@ -5,15 +5,19 @@ when its mark is clicked.
 
 from __future__ import annotations
 
+import base64
 import io
 import json
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 from PySide6.QtCore import QPoint, Qt
+from PySide6.QtGui import QColor
 
 from capabilities.cli import main as costar
+from capabilities.run_sampler import thumbnail_jpeg
 from engine.files import save_plan
 from engine.spec import NodeKind, NodeSpec, PlanSpec
 from engine.status import Status
@@ -189,3 +193,51 @@ def test_play_goes_on_through_the_run_and_stops_at_its_end(
     qtbot.waitUntil(lambda: not panel.playing, timeout=5000)  # the run lasts about 0.12 s
     assert panel.slider.value() == panel.slider.maximum()
     assert not panel.play_button.isChecked()
+
+
+def test_a_moment_shows_the_cameras_pictures_of_that_moment(
+    qtbot: Any, window: MainWindow, record: Path
+) -> None:
+    start = json.loads(record.read_text().splitlines()[1])["time"]  # the run's start
+    with record.open("a", encoding="utf-8") as out:  # what a cell's cameras add, once a second
+        for i, grey in enumerate((40, 200)):
+            jpeg = thumbnail_jpeg(np.full((120, 160, 3), grey, np.uint8))
+            line = {"event": "thumbnail", "camera": "wrist", "jpeg": "", "time": start + 0.05 * i}
+            out.write(json.dumps(line | {"jpeg": base64.b64encode(jpeg).decode()}) + "\n")
+    _open(window, record)
+    panel = window.views.timeline
+    assert list(panel.picture_labels) == ["wrist"]
+    panel.show_time(0.0)
+    dark = panel.picture("wrist")
+    assert dark is not None and (dark.width(), dark.height()) == (160, 120)
+    assert QColor(dark.toImage().pixel(80, 60)).red() < 100
+    panel.show_time(0.06)
+    light = panel.picture("wrist")
+    assert light is not None and QColor(light.toImage().pixel(80, 60)).red() > 150
+    out_, err_ = io.StringIO(), io.StringIO()  # a reader that knows no pictures goes on
+    assert costar(["runs", "show", str(record)], out_, err_) == 0, err_.getvalue()
+    assert "thumbnail" not in out_.getvalue() and "run finished" in out_.getvalue()
+
+
+def test_the_runs_folder_is_a_setting_that_runs_and_last_run_use(
+    qtbot: Any, none_session: CellSession, figure3_path: Path, tmp_path: Path, monkeypatch: Any
+) -> None:
+    monkeypatch.delenv("COSTAR_RUNS")  # the variable would override the setting
+    dialogs = ScriptedDialogs()
+    window = make_window(qtbot, none_session, tmp_path, dialogs)
+    chosen = tmp_path / "chosen runs"
+    dialogs.folder_answers.append(str(chosen))
+    window.actions_by_name["runs_folder"].trigger()
+    assert window.settings.runs_folder() == str(chosen)
+    window.open_plan(figure3_path)
+    run_to_end(qtbot, window)
+    record = window.controller.last_record
+    assert record is not None and record.parent == chosen
+    window.close()
+    again = make_window(qtbot, none_session, tmp_path, ScriptedDialogs())  # the same settings
+    assert again.controller.runs_folder() == chosen
+    again.views.timeline.last_button.click()  # no run in this window: the folder's newest
+    timeline = again.views.timeline.timeline
+    assert timeline is not None and timeline.name == record.name
+    monkeypatch.setenv("COSTAR_RUNS", str(tmp_path / "env"))
+    assert again.controller.runs_folder() == tmp_path / "env"
