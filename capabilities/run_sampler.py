@@ -28,14 +28,14 @@ from __future__ import annotations
 import base64
 import threading
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any, Protocol
-
-import cv2
-import numpy as np
+from typing import TYPE_CHECKING, Any, Protocol
 
 from capabilities.collaboration.console import ConsoleEvent, ConsoleEventKind, OperatorConsole
 from engine.events import Event, RunFinished, RunStarted
 from engine.trace import TraceRecorder
+
+if TYPE_CHECKING:
+    import numpy as np
 
 __all__ = [
     "JointSampler",
@@ -116,6 +116,9 @@ def thumbnail_jpeg(
     rgb: np.ndarray, size: tuple[int, int] = THUMBNAIL_SIZE, quality: int = THUMBNAIL_QUALITY
 ) -> bytes:
     """An HxWx3 RGB picture as a ``size`` JPEG (shrunk when it is larger)."""
+    import cv2  # here: a command that runs no camera loads neither
+    import numpy as np
+
     picture: np.ndarray = np.asarray(rgb, dtype=np.uint8)[..., :3]
     if (picture.shape[1], picture.shape[0]) != tuple(size):
         picture = cv2.resize(picture, size, interpolation=cv2.INTER_AREA)

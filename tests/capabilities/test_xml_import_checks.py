@@ -107,11 +107,13 @@ def test_a_subtree_that_holds_itself_is_refused(
     text = exports["nodes/subtree"]
     inner = '<debug__query name="find"'
     if through == "itself":
-        text = text.replace(inner, '<SubTree ID="Go_to" TARGET="{TARGET}" _uid="me"/>' + inner)
+        text = text.replace(
+            inner, '<SubTree ID="Go_to" TARGET="{TARGET}" REACHED="{R}" _uid="me"/>' + inner
+        )
     else:  # Go_to runs Again, which runs Go_to
         again = (
             '<BehaviorTree ID="Again" _uid="examples.again"><Sequence _uid="a1">'
-            '<SubTree ID="Go_to" TARGET="0.3;0.1;0.2;0.0;0.0;0.0;1.0" _uid="back"/>'
+            '<SubTree ID="Go_to" TARGET="0.3;0.1;0.2;0.0;0.0;0.0;1.0" REACHED="{R}" _uid="back"/>'
             "</Sequence></BehaviorTree>\n"
         )
         text = text.replace(inner, '<SubTree ID="Again" _uid="me"/>' + inner)
