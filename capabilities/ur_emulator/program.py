@@ -34,6 +34,9 @@ GET_TCP_OFFSET, IS_STEADY = 40, 47
 FREEDRIVE_MODE, END_FREEDRIVE_MODE, GET_FREEDRIVE_STATUS = 52, 53, 54
 WATCHDOG, STOP_SCRIPT = 99, 255
 FREEDRIVE_SINCE = (5, 10)
+# How many cycles in a row must see a silence past the watchdog's period before it trips (see
+# _watchdog_expired): 10 ms at 500 Hz when the emulator is not held up itself.
+_CONFIRM_CYCLES = 5
 
 
 class ControlProgram:
@@ -50,6 +53,7 @@ class ControlProgram:
         self._writes = 0
         self._watchdog: float | None = None  # s without an update of the command register
         self._watchdog_since = 0.0
+        self._silent_cycles = 0  # cycles in a row that saw a silence past the period
         self._handlers: dict[int, Callable[[], None]] = {
             MOVEJ: lambda: self._move_joints(self._floats(0, 6)),
             MOVEJ_IK: self._move_joints_ik,
@@ -148,6 +152,15 @@ class ControlProgram:
         register = f"input_int_register_{self._off}"
         silence = self._ctl.input_silence(register, self._watchdog_since)
         if silence <= self._watchdog or self._ctl.inputs_pending():
+            self._silent_cycles = 0
+            return False
+        # The emulator's own delay is not the client's silence: a package its server thread
+        # took from the socket waits for this cycle's lock, or for the interpreter while a
+        # camera frame is rendered (pybullet holds it ~0.2 s). It trips once the silence has
+        # lasted over cycles that let that thread apply what it holds (each cycle ends by
+        # letting go of the lock and the interpreter).
+        self._silent_cycles += 1
+        if self._silent_cycles < _CONFIRM_CYCLES:
             return False
         self._ctl.text(f"RTDE watchdog: {register} not updated for {silence:.2f} s")
         return True
