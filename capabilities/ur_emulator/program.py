@@ -37,6 +37,7 @@ FREEDRIVE_SINCE = (5, 10)
 # How many cycles in a row must see a silence past the watchdog's period before it trips (see
 # _watchdog_expired): 10 ms at 500 Hz when the emulator is not held up itself.
 _CONFIRM_CYCLES = 5
+_HELD_UP_S = 0.05  # a cycle this late means the emulator itself was held up
 
 
 class ControlProgram:
@@ -54,6 +55,7 @@ class ControlProgram:
         self._watchdog: float | None = None  # s without an update of the command register
         self._watchdog_since = 0.0
         self._silent_cycles = 0  # cycles in a row that saw a silence past the period
+        self._last_check = 0.0  # when the watchdog was last checked (a cycle's time)
         self._handlers: dict[int, Callable[[], None]] = {
             MOVEJ: lambda: self._move_joints(self._floats(0, 6)),
             MOVEJ_IK: self._move_joints_ik,
@@ -141,7 +143,7 @@ class ControlProgram:
         """rtde_set_watchdog(register, frequency, "stop") on the command register."""
         frequency = self._floats(0, 1)[0]
         self._watchdog = 1.0 / frequency if frequency > 0 else None
-        self._watchdog_since = time.monotonic()
+        self._watchdog_since = self._last_check = time.monotonic()
 
     def _watchdog_expired(self) -> bool:
         """True when the watched register was not written for a watchdog period: the
@@ -150,6 +152,13 @@ class ControlProgram:
         if self._watchdog is None:
             return False
         register = f"input_int_register_{self._off}"
+        now = time.monotonic()
+        if now - self._last_check > _HELD_UP_S:
+            # This emulator was held up itself (a camera frame rendered while it holds the
+            # interpreter, a loaded machine): what the client sent meanwhile waits unread or
+            # unapplied, so the client's period starts again now.
+            self._watchdog_since = now
+        self._last_check = now
         silence = self._ctl.input_silence(register, self._watchdog_since)
         if silence <= self._watchdog or self._ctl.inputs_pending():
             self._silent_cycles = 0
